@@ -1,0 +1,245 @@
+//! The built `embree` engine: set-up with a few raw calls, tracing with raw `rtcIntersect1` /
+//! `rtcOccluded1` (no error check per ray).
+
+use super::raw::{self, Device, Geometry, RayHit, Scene};
+use super::user::{self, UserPrims};
+use super::{EmbreeConfig, Quality};
+use crate::engine::{BuildInput, Counters, Engine, EngineError};
+use crate::geometry::Prim;
+use crate::ray::{Hit, Ray};
+use embree4_sys as sys;
+use std::collections::BTreeMap;
+use std::ffi::c_void;
+use std::ptr::null_mut;
+use std::time::Instant;
+
+/// geomID of the triangle geometry and of the user geometry (spheres, cones).
+const TRIANGLES: u32 = 0;
+const USER: u32 = 1;
+
+/// The `embree` engine. Field order is drop order and matters: the scene is released first
+/// (Embree then frees the BVH and reports it to the monitor, whose state the device owns), then
+/// the user primitives the scene's callbacks read, then the device.
+pub struct EmbreeEngine {
+    scene: Scene,
+    _user: Box<UserPrims>,
+    /// Kept for its lifetime only: the scene and the memory monitor need it.
+    _device: Device,
+    /// primID → scene object, per geomID (`objects[TRIANGLES]`, `objects[USER]`).
+    objects: [Vec<u32>; 2],
+    stats: BTreeMap<String, f64>,
+    structure_bytes: u64,
+}
+
+// SAFETY: after `build` nothing mutates the scene, the device or the user primitives. Embree
+// documents `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from any number of
+// threads at once; the callbacks read the user primitives only, count into thread-locals, and the
+// device's callback state is atomics and a mutex. Moving the handles between threads is allowed
+// by Embree (they are plain reference-counted pointers).
+unsafe impl Send for EmbreeEngine {}
+// SAFETY: see `Send`: every `&self` method only traces rays on the committed scene.
+unsafe impl Sync for EmbreeEngine {}
+
+fn build_err(reason: String) -> EngineError {
+    EngineError::Build { engine: "embree".into(), reason }
+}
+
+impl EmbreeEngine {
+    pub fn build(input: &BuildInput, config: &EmbreeConfig) -> Result<EmbreeEngine, EngineError> {
+        let t0 = Instant::now();
+        let geo = &input.geometry;
+        let device = Device::new(&config.device_config()).map_err(build_err)?;
+
+        // Split the prepared primitives: triangles for Embree, the rest for the user geometry.
+        let mut tri_object = Vec::new();
+        let mut user_object = Vec::new();
+        let mut user_prims = Vec::new();
+        let ntri = geo.prims.iter().filter(|p| matches!(p, Prim::Triangle(_))).count();
+        if ntri.checked_mul(3).map_or(true, |v| v > u32::MAX as usize) {
+            return Err(build_err(format!("{ntri} triangles: more than Embree's 32-bit indices can address")));
+        }
+        tri_object.reserve_exact(ntri);
+
+        // SAFETY: `device.handle` is a live device.
+        let scene = Scene(unsafe { sys::rtcNewScene(device.handle) });
+        device.check("rtcNewScene").map_err(build_err)?;
+        let mut flags = sys::RTCSceneFlags::NONE;
+        if config.robust {
+            flags |= sys::RTCSceneFlags::ROBUST;
+        }
+        if config.compact {
+            flags |= sys::RTCSceneFlags::COMPACT;
+        }
+        let quality = match config.quality {
+            Quality::Low => sys::RTCBuildQuality::LOW,
+            Quality::Medium => sys::RTCBuildQuality::MEDIUM,
+            Quality::High => sys::RTCBuildQuality::HIGH,
+        };
+        // SAFETY: `scene.0` is a live scene not yet committed.
+        unsafe {
+            sys::rtcSetSceneFlags(scene.0, flags);
+            sys::rtcSetSceneBuildQuality(scene.0, quality);
+        }
+        device.check("scene set-up").map_err(build_err)?;
+
+        let mut buffer_bytes = 0u64;
+        if ntri > 0 {
+            // SAFETY: `device.handle` is a live device.
+            let g = Geometry(unsafe { sys::rtcNewGeometry(device.handle, sys::RTCGeometryType::TRIANGLE) });
+            device.check("rtcNewGeometry(TRIANGLE)").map_err(build_err)?;
+            // SAFETY: `g.0` is a live geometry; Embree returns buffers of the requested item count
+            // and stride (or null on failure, checked before use).
+            let (vb, ib) = unsafe {
+                let vb = sys::rtcSetNewGeometryBuffer(
+                    g.0,
+                    sys::RTCBufferType::VERTEX,
+                    0,
+                    sys::RTCFormat::FLOAT3,
+                    12,
+                    3 * ntri,
+                ) as *mut f32;
+                let ib = sys::rtcSetNewGeometryBuffer(g.0, sys::RTCBufferType::INDEX, 0, sys::RTCFormat::UINT3, 12, ntri)
+                    as *mut u32;
+                (vb, ib)
+            };
+            device.check("rtcSetNewGeometryBuffer").map_err(build_err)?;
+            if vb.is_null() || ib.is_null() {
+                return Err(build_err("Embree gave no triangle buffers".into()));
+            }
+            // SAFETY: non-null buffers of 3·ntri FLOAT3 vertices and ntri UINT3 triangles, 4-byte
+            // aligned (Embree aligns to 16), owned by the geometry and written only here.
+            let (verts, idx) = unsafe {
+                (std::slice::from_raw_parts_mut(vb, 9 * ntri), std::slice::from_raw_parts_mut(ib, 3 * ntri))
+            };
+            let mut t = 0usize;
+            for (p, &obj) in geo.prims.iter().zip(&geo.prim_object) {
+                if let Prim::Triangle(vs) = p {
+                    for (j, v) in vs.iter().enumerate() {
+                        verts[9 * t + 3 * j..9 * t + 3 * j + 3].copy_from_slice(&v.to_array());
+                        idx[3 * t + j] = (3 * t + j) as u32;
+                    }
+                    tri_object.push(obj);
+                    t += 1;
+                }
+            }
+            buffer_bytes += (9 * ntri * 4 + 3 * ntri * 4) as u64;
+            // SAFETY: live geometry and scene, on the same device; the scene retains the geometry.
+            unsafe {
+                sys::rtcCommitGeometry(g.0);
+                sys::rtcAttachGeometryByID(scene.0, g.0, TRIANGLES);
+            }
+            device.check("triangle geometry").map_err(build_err)?;
+        }
+
+        for (p, &obj) in geo.prims.iter().zip(&geo.prim_object) {
+            if !matches!(p, Prim::Triangle(_)) {
+                user_prims.push(*p);
+                user_object.push(obj);
+            }
+        }
+        let user = Box::new(UserPrims { prims: user_prims });
+        if !user.prims.is_empty() {
+            let ptr = &*user as *const UserPrims as *mut c_void;
+            // SAFETY: `device.handle` is live. `ptr` points into a Box the engine keeps, unchanged,
+            // until after the scene is released (field order); the callbacks only read it.
+            unsafe {
+                let g = Geometry(sys::rtcNewGeometry(device.handle, sys::RTCGeometryType::USER));
+                device.check("rtcNewGeometry(USER)").map_err(build_err)?;
+                sys::rtcSetGeometryUserPrimitiveCount(g.0, user.prims.len() as u32);
+                sys::rtcSetGeometryUserData(g.0, ptr);
+                sys::rtcSetGeometryBoundsFunction(g.0, Some(user::bounds), ptr);
+                sys::rtcSetGeometryIntersectFunction(g.0, Some(user::intersect));
+                sys::rtcSetGeometryOccludedFunction(g.0, Some(user::occluded));
+                sys::rtcCommitGeometry(g.0);
+                sys::rtcAttachGeometryByID(scene.0, g.0, USER);
+            }
+            device.check("user geometry").map_err(build_err)?;
+        }
+        let setup_seconds = t0.elapsed().as_secs_f64();
+
+        let t1 = Instant::now();
+        // SAFETY: a live scene whose geometries are committed and whose user data is alive.
+        unsafe { sys::rtcCommitScene(scene.0) };
+        let commit_seconds = t1.elapsed().as_secs_f64();
+        device.check("rtcCommitScene").map_err(build_err)?;
+
+        let (embree_bytes, embree_peak) = device.memory();
+        let own_bytes = (tri_object.capacity() + user_object.capacity()) * 4
+            + user.prims.capacity() * std::mem::size_of::<Prim>();
+        let structure_bytes = embree_bytes.max(0) as u64 + own_bytes as u64;
+        let mut stats = BTreeMap::new();
+        stats.insert("setup_seconds".into(), setup_seconds);
+        stats.insert("commit_seconds".into(), commit_seconds);
+        stats.insert("triangles".into(), ntri as f64);
+        stats.insert("user_primitives".into(), user.prims.len() as f64);
+        stats.insert("embree_bytes".into(), embree_bytes as f64);
+        stats.insert("embree_peak_bytes".into(), embree_peak as f64);
+        stats.insert("embree_buffer_bytes".into(), buffer_bytes as f64);
+        stats.insert("own_bytes".into(), own_bytes as f64);
+        stats.insert("threads".into(), config.threads as f64);
+        stats.insert("embree_version".into(), device.property(sys::RTCDeviceProperty::VERSION) as f64);
+        Ok(EmbreeEngine {
+            scene,
+            _user: user,
+            _device: device,
+            objects: [tri_object, user_object],
+            stats,
+            structure_bytes,
+        })
+    }
+
+    /// Adds the user-geometry callbacks' counts of this thread to `counters` and resets them.
+    fn collect_user_counts(counters: &mut Counters) {
+        let tests = user::TESTS.with(|c| c.replace(0));
+        let hits = user::HITS.with(|c| c.replace(0));
+        if tests > 0 {
+            *counters.extra.entry("user_primitive_tests".into()).or_insert(0) += tests;
+            *counters.extra.entry("user_primitive_hits".into()).or_insert(0) += hits;
+        }
+    }
+}
+
+impl Engine for EmbreeEngine {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], counters: &mut Counters) {
+        assert_eq!(rays.len(), hits.len(), "one hit per ray");
+        user::TESTS.with(|c| c.set(0));
+        user::HITS.with(|c| c.set(0));
+        for (r, h) in rays.iter().zip(hits.iter_mut()) {
+            let mut rh = RayHit::new(raw::rtc_ray(r));
+            // SAFETY: the scene is committed and never changed (see `Sync`); `rh` is a properly
+            // aligned RTCRayHit with room for the fields newer Embree versions append; null
+            // arguments select Embree's defaults.
+            unsafe { sys::rtcIntersect1(self.scene.0, &mut rh.rh, null_mut()) };
+            let hit = &rh.rh.hit;
+            *h = match self.objects.get(hit.geomID as usize).and_then(|m| m.get(hit.primID as usize)) {
+                Some(&object) => Hit { t: rh.rh.ray.tfar, object, u: hit.u, v: hit.v },
+                None => Hit::MISS,
+            };
+        }
+        counters.rays += rays.len() as u64;
+        Self::collect_user_counts(counters);
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], counters: &mut Counters) {
+        assert_eq!(rays.len(), occluded.len(), "one answer per ray");
+        user::TESTS.with(|c| c.set(0));
+        user::HITS.with(|c| c.set(0));
+        for (r, o) in rays.iter().zip(occluded.iter_mut()) {
+            let mut ray = raw::rtc_ray(r);
+            // SAFETY: committed, unchanging scene; `ray` is a valid RTCRay (its layout is the same
+            // in every Embree 4); null arguments select Embree's defaults.
+            unsafe { sys::rtcOccluded1(self.scene.0, &mut ray, null_mut()) };
+            *o = ray.tfar == f32::NEG_INFINITY;
+        }
+        counters.rays += rays.len() as u64;
+        Self::collect_user_counts(counters);
+    }
+
+    fn structure_bytes(&self) -> u64 {
+        self.structure_bytes
+    }
+
+    fn build_stats(&self) -> BTreeMap<String, f64> {
+        self.stats.clone()
+    }
+}

@@ -1,0 +1,163 @@
+//! `embree`: Intel Embree 4, the cross-check and the performance anchor.
+//!
+//! Embree answers on the same primitives as every other engine: the prepared triangles of
+//! [`Geometry`](crate::geometry::Geometry) natively (one `RTC_GEOMETRY_TYPE_TRIANGLE` geometry,
+//! geomID 0), spheres and open cones/cylinders as one user geometry (geomID 1) whose callbacks
+//! call the shared kernels of [`crate::geometry::kernels`]. A map per geometry turns Embree's
+//! primID back into the scene's object index.
+//!
+//! Rays go through the raw `rtcIntersect1` / `rtcOccluded1` of embree4-sys: the embree4-rs
+//! wrapper checks the device error after every ray, which costs up to 31% of Embree's speed.
+//! embree4-rs is not used for set-up either: its `Device` cannot take a configuration string
+//! (it passes it without a terminating NUL) and neither it nor its `Scene` expose the raw handles
+//! that the raw calls need. The few set-up calls are wrapped here instead (`raw.rs`).
+//!
+//! Settings (`key=value`):
+//! - `threads` (default 1): Embree's build threads (`threads=N` in the device configuration;
+//!   0 lets Embree use every core). Tracing runs on the caller's threads either way.
+//! - `quality` (default `medium`, Embree's default): `low`, `medium` or `high` (`rtcSetSceneBuildQuality`).
+//! - `robust` (default false): `RTC_SCENE_FLAG_ROBUST` (Embree's watertight-ish triangle test).
+//! - `compact` (default false): `RTC_SCENE_FLAG_COMPACT`.
+//! - `isa` (default: the best the CPU has): `sse2`, `sse4.2`, `avx`, `avx2` or `avx512`.
+//! - `verbose` (default 0): Embree's verbosity (1 prints the device and the BVH chosen, on stdout).
+//!
+//! Memory: [`Engine::structure_bytes`] is what Embree holds after the build, as its memory monitor
+//! (`rtcSetDeviceMemoryMonitorFunction`) reports it — the BVH with its leaves (which copy the
+//! triangles) and the vertex and index buffers Embree was given — plus this engine's own
+//! primID → object maps and its copy of the spheres and cones. `build_stats` breaks it down and
+//! adds the peak during the build.
+//!
+//! Without the cargo feature `embree` the engine is listed but unavailable.
+
+use crate::engine::{BuildInput, Engine, EngineError, EngineInfo, Settings};
+#[cfg(feature = "embree")]
+mod engine;
+#[cfg(feature = "embree")]
+mod raw;
+#[cfg(feature = "embree")]
+mod user;
+
+/// The registry entry of the `embree` engine.
+pub fn info() -> EngineInfo {
+    EngineInfo {
+        name: "embree",
+        description: "Intel Embree 4 (raw rtcIntersect1/rtcOccluded1; spheres and cones as user geometry on the shared kernels): the cross-check and the performance anchor",
+        available,
+        build,
+    }
+}
+
+/// Typed configuration of the `embree` engine, parsed from `key=value` settings.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EmbreeConfig {
+    pub threads: u32,
+    pub quality: Quality,
+    pub robust: bool,
+    pub compact: bool,
+    pub isa: Option<String>,
+    pub verbose: u32,
+}
+
+impl Default for EmbreeConfig {
+    fn default() -> Self {
+        EmbreeConfig { threads: 1, quality: Quality::Medium, robust: false, compact: false, isa: None, verbose: 0 }
+    }
+}
+
+/// Embree's BVH build quality.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    Low,
+    Medium,
+    High,
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "low" => Ok(Quality::Low),
+            "medium" => Ok(Quality::Medium),
+            "high" => Ok(Quality::High),
+            _ => Err("expected low, medium or high".into()),
+        }
+    }
+}
+
+/// The instruction sets Embree's `isa=` accepts (and that cannot smuggle anything else into the
+/// configuration string).
+const ISAS: &[&str] = &["sse2", "sse4.2", "avx", "avx2", "avx512"];
+
+impl EmbreeConfig {
+    pub fn from_settings(mut s: Settings) -> Result<EmbreeConfig, EngineError> {
+        let d = EmbreeConfig::default();
+        let threads = s.get("threads", d.threads)?;
+        let quality = s.get("quality", d.quality)?;
+        let robust = s.get("robust", d.robust)?;
+        let compact = s.get("compact", d.compact)?;
+        let isa: String = s.get("isa", String::new())?;
+        let verbose = s.get("verbose", d.verbose)?;
+        s.finish()?;
+        let isa = if isa.is_empty() {
+            None
+        } else if ISAS.contains(&isa.as_str()) {
+            Some(isa)
+        } else {
+            return Err(EngineError::BadValue {
+                engine: "embree".into(),
+                key: "isa".into(),
+                value: isa,
+                reason: format!("expected one of {}", ISAS.join(", ")),
+            });
+        };
+        Ok(EmbreeConfig { threads, quality, robust, compact, isa, verbose })
+    }
+
+    /// The device configuration string handed to `rtcNewDevice`.
+    pub fn device_config(&self) -> String {
+        let mut c = format!("threads={},verbose={}", self.threads, self.verbose);
+        if let Some(isa) = &self.isa {
+            c.push_str(",isa=");
+            c.push_str(isa);
+        }
+        c
+    }
+}
+
+#[cfg(feature = "embree")]
+fn available() -> Result<(), String> {
+    static AVAILABLE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    AVAILABLE.get_or_init(|| raw::Device::new("verbose=0").map(|_| ())).clone()
+}
+
+#[cfg(not(feature = "embree"))]
+fn available() -> Result<(), String> {
+    Err("built without the embree feature".into())
+}
+
+#[cfg(feature = "embree")]
+fn build(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
+    let config = EmbreeConfig::from_settings(settings)?;
+    Ok(Box::new(engine::EmbreeEngine::build(input, &config)?))
+}
+
+#[cfg(not(feature = "embree"))]
+fn build(_input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
+    EmbreeConfig::from_settings(settings)?;
+    Err(EngineError::Unavailable { engine: "embree".into(), reason: "built without the embree feature".into() })
+}
+
+/// Embree's version as `major.minor.patch` (for the results' environment), or why there is none.
+pub fn version() -> Result<String, String> {
+    #[cfg(feature = "embree")]
+    {
+        raw::Device::new("verbose=0").map(|d| d.version())
+    }
+    #[cfg(not(feature = "embree"))]
+    {
+        Err("built without the embree feature".into())
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,138 @@
+//! `reference`: brute force in double precision on the scene's original primitives (polygons
+//! as polygons, not triangles). Slow by design: the ground truth for small scenes.
+
+use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::geometry::kernels::f64 as k;
+use crate::ray::{Hit, Ray};
+use glam::DVec3;
+use rtbench_scenes::Shape;
+use std::sync::Arc;
+
+pub fn info() -> EngineInfo {
+    EngineInfo {
+        name: "reference",
+        description:
+            "brute force in f64 over the original primitives: ground truth for small scenes",
+        available: || Ok(()),
+        build,
+    }
+}
+
+/// A primitive in f64, with what its test needs precomputed (polygon normals).
+enum RefPrim {
+    Sphere {
+        center: DVec3,
+        radius: f64,
+    },
+    Cone {
+        base: DVec3,
+        rb: f64,
+        apex: DVec3,
+        ra: f64,
+    },
+    Polygon {
+        verts: Vec<DVec3>,
+        normal: DVec3,
+    },
+    Triangle([DVec3; 3]),
+}
+
+pub struct Reference {
+    prims: Vec<RefPrim>,
+}
+
+fn build(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
+    settings.finish()?;
+    let prims = input
+        .scene
+        .objects
+        .iter()
+        .map(|o| match &o.shape {
+            Shape::Sphere { center, radius } => RefPrim::Sphere {
+                center: *center,
+                radius: *radius,
+            },
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+            } => RefPrim::Cone {
+                base: *base,
+                rb: *base_radius,
+                apex: *apex,
+                ra: *apex_radius,
+            },
+            Shape::Patch { vertices, .. } if vertices.len() == 3 => {
+                RefPrim::Triangle([vertices[0], vertices[1], vertices[2]])
+            }
+            Shape::Polygon(v) | Shape::Patch { vertices: v, .. } => RefPrim::Polygon {
+                normal: k::polygon_normal(v),
+                verts: v.clone(),
+            },
+        })
+        .collect();
+    let _keep: &Arc<_> = &input.scene;
+    Ok(Box::new(Reference { prims }))
+}
+
+impl Reference {
+    /// Nearest hit over all primitives; with `any`, the first found.
+    fn trace(&self, ray: &Ray, any: bool, c: &mut Counters) -> Hit {
+        let o = ray.origin.as_dvec3();
+        let d = ray.dir.as_dvec3();
+        let tmin = ray.tmin as f64;
+        let mut tmax = ray.tmax as f64;
+        let mut best = Hit::MISS;
+        c.rays += 1;
+        for (i, p) in self.prims.iter().enumerate() {
+            c.primitive_tests += 1;
+            let h = match p {
+                RefPrim::Sphere { center, radius } => {
+                    k::sphere(o, d, tmin, tmax, *center, *radius).map(|t| (t, 0.0, 0.0))
+                }
+                RefPrim::Cone { base, rb, apex, ra } => {
+                    k::cone(o, d, tmin, tmax, *base, *rb, *apex, *ra).map(|t| (t, 0.0, 0.0))
+                }
+                RefPrim::Polygon { verts, normal } => {
+                    k::polygon(o, d, tmin, tmax, verts, *normal).map(|t| (t, 0.0, 0.0))
+                }
+                RefPrim::Triangle([a, b, cc]) => {
+                    k::triangle_watertight(o, &k::WatertightRay::new(d), tmin, tmax, *a, *b, *cc)
+                }
+            };
+            if let Some((t, u, v)) = h {
+                c.primitive_hits += 1;
+                tmax = t;
+                best = Hit {
+                    t: t as f32,
+                    object: i as u32,
+                    u: u as f32,
+                    v: v as f32,
+                };
+                if any {
+                    break;
+                }
+            }
+        }
+        best
+    }
+}
+
+impl Engine for Reference {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], c: &mut Counters) {
+        for (r, h) in rays.iter().zip(hits.iter_mut()) {
+            *h = self.trace(r, false, c);
+        }
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], c: &mut Counters) {
+        for (r, o) in rays.iter().zip(occluded.iter_mut()) {
+            *o = self.trace(r, true, c).is_hit();
+        }
+    }
+
+    fn structure_bytes(&self) -> u64 {
+        0
+    }
+}

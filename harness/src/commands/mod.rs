@@ -1,0 +1,6 @@
+//! One module per subcommand.
+
+pub mod check;
+pub mod engines;
+pub mod render;
+pub mod scene;

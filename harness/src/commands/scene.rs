@@ -1,0 +1,121 @@
+//! `rtbench scene list | gen | stats` (../shared/CLI.md, "Scenes").
+
+use crate::error::{input, Result};
+use crate::output::{print_json, write_atomic};
+use crate::source::Source;
+use rtbench_scenes::nff::NffWriter;
+use rtbench_scenes::spd::Program;
+use rtbench_scenes::CountingSink;
+use serde_json::json;
+use std::io::Write;
+use std::path::Path;
+
+pub fn list(as_json: bool) -> Result<()> {
+    if as_json {
+        let v: Vec<_> = Program::ALL
+            .iter()
+            .map(|p| {
+                json!({"name": p.name(), "standard_sf": p.standard_sf(),
+                       "objects_at_standard_sf": p.object_count(p.standard_sf()),
+                       "description": p.description()})
+            })
+            .collect();
+        print_json(&json!(v));
+    } else {
+        println!(
+            "{:<10} {:>4} {:>10}  description",
+            "program", "sf", "objects"
+        );
+        for p in Program::ALL {
+            let n = p
+                .object_count(p.standard_sf())
+                .map(|n| n.to_string())
+                .unwrap_or_else(|| "?".into());
+            println!(
+                "{:<10} {:>4} {:>10}  {}",
+                p.name(),
+                p.standard_sf(),
+                n,
+                p.description()
+            );
+        }
+    }
+    Ok(())
+}
+
+pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
+    match out {
+        None => {
+            let stdout = std::io::stdout();
+            let mut w = NffWriter::new(std::io::BufWriter::with_capacity(1 << 20, stdout.lock()));
+            src.stream(&mut w)?;
+            w.finish()
+                .map_err(|e| input(format!("stdout: cannot write: {e}")))?;
+        }
+        Some(path) => {
+            let start = std::time::Instant::now();
+            let mut result = Ok(());
+            let mut bytes = 0;
+            write_atomic(path, |f| {
+                let mut w = NffWriter::new(f);
+                result = src.stream(&mut w);
+                bytes = w.bytes();
+                w.finish().map(|_| ())
+            })?;
+            result?;
+            let secs = start.elapsed().as_secs_f64();
+            eprintln!(
+                "wrote {} ({:.1} MB) in {:.2} s, {:.1} MB/s",
+                path.display(),
+                bytes as f64 / 1e6,
+                secs,
+                bytes as f64 / 1e6 / secs.max(1e-9)
+            );
+        }
+    }
+    Ok(())
+}
+
+pub fn stats(src: &Source, as_json: bool) -> Result<()> {
+    let mut c = CountingSink::default();
+    src.stream(&mut c)?;
+    let bounds = c
+        .bounds
+        .map(|b| json!([[b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]]));
+    let program = match src {
+        Source::Program(p, _) => json!(p.name()),
+        Source::File(f) => json!(f.display().to_string()),
+    };
+    let v = json!({
+        "program": program,
+        "sf": src.size_factor(),
+        "counts": c.counts,
+        "objects": c.counts.objects(),
+        "lights": c.lights,
+        "materials": c.materials,
+        "bounds": bounds,
+    });
+    if as_json {
+        print_json(&v);
+    } else {
+        let k = &c.counts;
+        let mut o = std::io::stdout().lock();
+        let _ = writeln!(o, "scene      {}", src.label());
+        let _ = writeln!(o, "objects    {}", k.objects());
+        let _ = writeln!(
+            o,
+            "  spheres  {}\n  cones    {}\n  polygons {}\n  patches  {}",
+            k.sphere, k.cone, k.polygon, k.patch
+        );
+        let _ = writeln!(o, "triangles  {}", k.triangles);
+        let _ = writeln!(o, "lights     {}", c.lights);
+        if let Some(b) = c.bounds {
+            let _ = writeln!(
+                o,
+                "bounds     [{} {} {}] .. [{} {} {}]",
+                b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,69 @@
+//! `rtbench`: the command-line harness. See ../shared/CLI.md for the contract.
+
+mod cli;
+mod commands;
+mod error;
+mod output;
+mod source;
+mod workload;
+
+use clap::Parser;
+use cli::{Cli, Command, SceneCommand};
+use error::Result;
+use source::Source;
+
+fn scene_source(s: &str, o: &cli::SceneOpts) -> Result<Source> {
+    Source::resolve(s, o.sf, o.tessellate, o.hash)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
+        Command::Scene(SceneCommand::Gen { scene, output }) => {
+            commands::scene::gen(&scene_source(&scene.scene, &scene.opts)?, output.as_deref())
+        }
+        Command::Scene(SceneCommand::Stats { scene, json }) => {
+            commands::scene::stats(&scene_source(&scene.scene, &scene.opts)?, json)
+        }
+        Command::Engines { json } => commands::engines::list(json),
+        Command::Render(a) => commands::render::run(&a),
+        Command::Check(a) => commands::check::run(&a),
+    }
+}
+
+fn main() {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                let _ = e.print();
+                std::process::exit(
+                    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                        2
+                    } else {
+                        0
+                    },
+                );
+            }
+            // One line: clap's first line names the problem and the argument.
+            let text = e.render().to_string();
+            let first = text
+                .lines()
+                .next()
+                .unwrap_or("bad usage")
+                .trim_start_matches("error: ");
+            eprintln!("rtbench: {first}");
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = run(cli) {
+        eprintln!("rtbench: {e}");
+        std::process::exit(e.exit_code());
+    }
+}

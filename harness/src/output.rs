@@ -1,0 +1,48 @@
+//! Writing results: atomically (a temp file beside the target, then rename), so an interrupted
+//! or failed write never leaves a half-written file.
+
+use crate::error::{input, Result};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Runs `write` on a temp file next to `path`, then renames it over `path`. On any error the
+/// temp file is removed and the error names `path`.
+pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+{
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| input(format!("{}: not a file name", path.display())))?;
+    let tmp: PathBuf = dir.join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| -> std::io::Result<()> {
+        let f = std::fs::File::create(&tmp)?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+        write(&mut w)?;
+        w.flush()?;
+        let f = w.into_inner().map_err(|e| e.into_error())?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(input(format!("{}: cannot write: {e}", path.display())));
+    }
+    Ok(())
+}
+
+/// Prints one JSON document on stdout (the `--json` contract).
+pub fn print_json(v: &serde_json::Value) {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(v).expect("JSON values serialise")
+    );
+}

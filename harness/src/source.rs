@@ -1,0 +1,112 @@
+//! Where a command's scene comes from: an SPD program at a size factor, or an NFF file.
+
+use crate::error::{input, Result};
+use rtbench_scenes::spd::{self, MountHash, Options, Program};
+use rtbench_scenes::{nff, Scene, SceneCollector, Sink};
+use std::path::PathBuf;
+
+/// `<program|FILE.nff> [--sf N] [--tessellate [RES]] [--hash …]`, resolved.
+#[derive(Clone, Debug)]
+pub enum Source {
+    Program(Program, Options),
+    File(PathBuf),
+}
+
+impl Source {
+    pub fn resolve(
+        scene: &str,
+        sf: Option<u32>,
+        tessellate: Option<u32>,
+        hash: Option<MountHash>,
+    ) -> Result<Source> {
+        if let Ok(program) = scene.parse::<Program>() {
+            let mut opts = Options::standard(program);
+            if let Some(sf) = sf {
+                opts.size_factor = sf;
+            }
+            opts.tessellate = tessellate;
+            if let Some(h) = hash {
+                if program != Program::Mount {
+                    return Err(input(format!(
+                        "--hash applies to mount only, not {program}"
+                    )));
+                }
+                opts.hash = h;
+            }
+            spd::validate(program, &opts)?;
+            return Ok(Source::Program(program, opts));
+        }
+        let path = PathBuf::from(scene);
+        if !scene.ends_with(".nff") && !path.exists() {
+            // Neither a program nor a file: say both.
+            return Err(input(format!(
+                "{}; nor is '{scene}' an NFF file",
+                scene.parse::<Program>().unwrap_err()
+            )));
+        }
+        if sf.is_some() || hash.is_some() {
+            return Err(input(format!(
+                "--sf and --hash apply to SPD programs, not to the file {scene}"
+            )));
+        }
+        if tessellate.is_some() {
+            return Err(input(format!(
+                "--tessellate applies to SPD programs, not to the file {scene}"
+            )));
+        }
+        if !path.is_file() {
+            return Err(input(format!("{scene}: no such file")));
+        }
+        Ok(Source::File(path))
+    }
+
+    /// Streams the scene into `sink`, never holding it.
+    pub fn stream(&self, sink: &mut dyn Sink) -> Result<()> {
+        match self {
+            Source::Program(p, o) => Ok(spd::generate(*p, o, sink)?),
+            Source::File(path) => Ok(nff::read_nff_file(path, sink)?),
+        }
+    }
+
+    pub fn load(&self) -> Result<Scene> {
+        let mut c = SceneCollector::default();
+        self.stream(&mut c)?;
+        let mut s = c.scene;
+        s.name = self.label();
+        Ok(s)
+    }
+
+    /// `balls4`, `balls4-tess3`, `mount6-jenkins`, or the file's name.
+    pub fn label(&self) -> String {
+        match self {
+            Source::Program(p, o) => {
+                let mut s = format!("{}{}", p.name(), o.size_factor);
+                if o.hash == MountHash::Jenkins {
+                    s.push_str("-jenkins");
+                }
+                if let Some(r) = o.tessellate {
+                    s.push_str(&format!("-tess{r}"));
+                }
+                s
+            }
+            Source::File(p) => p
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        }
+    }
+
+    pub fn program(&self) -> Option<Program> {
+        match self {
+            Source::Program(p, _) => Some(*p),
+            Source::File(_) => None,
+        }
+    }
+
+    pub fn size_factor(&self) -> Option<u32> {
+        match self {
+            Source::Program(_, o) => Some(o.size_factor),
+            Source::File(_) => None,
+        }
+    }
+}

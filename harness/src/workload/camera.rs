@@ -1,0 +1,41 @@
+//! The NFF camera and the SPD's eye rays: (size+1)² rays through the pixel corners
+//! (SPD procedure item 6). NFF's `angle` spans from the centre of the top sample row to the
+//! bottom one (NFF.TXT), i.e. from corner row 0 to corner row `size`; the aspect ratio is 1.
+
+use glam::Vec3;
+use rtbench_engines::Ray;
+use rtbench_scenes::View;
+
+pub struct Camera {
+    pub eye: Vec3,
+    /// Direction to the centre of the image, and the half-extent vectors at unit distance.
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    pub hither: f32,
+}
+
+impl Camera {
+    pub fn new(view: &View) -> Camera {
+        let eye = view.from.as_vec3();
+        let forward = (view.at - view.from).normalize().as_vec3();
+        let right = forward.cross(view.up.as_vec3()).normalize();
+        let up = right.cross(forward).normalize();
+        let half = (view.angle.to_radians() / 2.0).tan() as f32;
+        Camera {
+            eye,
+            forward,
+            right: right * half,
+            up: up * half,
+            hither: view.hither.max(0.0) as f32,
+        }
+    }
+
+    /// The eye ray through corner (i, j) of a `size`×`size` image; j = 0 is the top row.
+    pub fn corner_ray(&self, i: u32, j: u32, size: u32) -> Ray {
+        let x = 2.0 * i as f32 / size as f32 - 1.0;
+        let y = 1.0 - 2.0 * j as f32 / size as f32;
+        let d = (self.forward + self.right * x + self.up * y).normalize();
+        Ray::new(self.eye, d, self.hither, f32::INFINITY)
+    }
+}

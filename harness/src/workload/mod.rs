@@ -1,0 +1,86 @@
+//! The SPD workload: camera, surfaces, and the wavefront tracer.
+
+pub mod camera;
+pub mod surface;
+pub mod trace;
+
+use crate::error::{input, Result};
+use crate::source::Source;
+use rtbench_engines::geometry::Geometry;
+use rtbench_engines::{build_engine, BuildInput, Engine};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A scene ready for engines, with how long getting it ready took.
+pub struct Prepared {
+    pub input: BuildInput,
+    pub generate_s: f64,
+    pub prepare_s: f64,
+}
+
+pub fn prepare(src: &Source) -> Result<Prepared> {
+    let t = Instant::now();
+    let scene = src.load()?;
+    if scene.objects.is_empty() {
+        return Err(input(format!("{}: the scene has no objects", src.label())));
+    }
+    let generate_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let geometry = Geometry::from_scene(&scene);
+    let prepare_s = t.elapsed().as_secs_f64();
+    Ok(Prepared {
+        input: BuildInput {
+            scene: Arc::new(scene),
+            geometry: Arc::new(geometry),
+        },
+        generate_s,
+        prepare_s,
+    })
+}
+
+/// Parses `--set key=value` arguments.
+pub fn parse_settings(set: &[String]) -> Result<Vec<(String, String)>> {
+    set.iter()
+        .map(|s| match s.split_once('=') {
+            Some((k, v)) if !k.is_empty() => Ok((k.trim().to_string(), v.trim().to_string())),
+            _ => Err(input(format!("--set '{s}': expected key=value"))),
+        })
+        .collect()
+}
+
+/// Builds an engine and times the build (the SPD's preprocessing, with scene preparation).
+pub fn build(
+    name: &str,
+    input: &BuildInput,
+    settings: Vec<(String, String)>,
+) -> Result<(Box<dyn Engine>, f64)> {
+    let t = Instant::now();
+    let e = build_engine(name, input, settings)?;
+    Ok((e, t.elapsed().as_secs_f64()))
+}
+
+/// A rayon pool with `threads` threads (all cores when `None`).
+pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    if threads == Some(0) {
+        return Err(input("--threads must be at least 1"));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| input(format!("cannot start threads: {e}")))
+}
+
+pub fn check_size(size: u32) -> Result<()> {
+    if !(1..=16384).contains(&size) {
+        return Err(input(format!("--size {size}: must be from 1 to 16384")));
+    }
+    Ok(())
+}
+
+/// Peak resident set size of this process (Linux `VmHWM`), in bytes.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}

@@ -1,0 +1,345 @@
+//! The SPD workload, traced as wavefront generations (../shared/SPD.md, "The testing
+//! procedure"): all rays of one depth are answered as batches by the engine before shading makes
+//! the next generation. One shading code path serves every engine, so images and ray statistics
+//! agree across engines.
+//!
+//! Rules implemented: rays through the (size+1)² pixel corners; maximum ray-tree depth 5 (the eye
+//! ray is depth 1); a reflection ray from every hit on a reflective (Ks > 0) or transmitting
+//! surface; a refraction ray from every hit on a transmitting surface (Snell's law) unless under
+//! total internal reflection; shadow rays only towards lights the shading normal faces (also on
+//! transmitters); positional lights; NFF Phong with an ambient term; patches smooth-shaded.
+//!
+//! Policies this file states:
+//! - Sides: every surface is shaded as seen (normals are turned to face the ray). This makes the
+//!   teapot double-sided as the SPD asks; the other scenes are closed, or their backs unseen.
+//! - Media: each ray knows whether it travels inside a transmitting object; a refraction ray
+//!   entering uses 1/ior, one leaving uses ior. This does not depend on polygon winding.
+//! - Self-intersection: a secondary ray starts at the hit point moved off the surface along the
+//!   geometric normal by `OFFSET_REL` × the largest coordinate of the point (so the offset grows
+//!   with the rounding error of the point, about 2^-23 of it), with tmin = 0.
+
+use super::camera::Camera;
+use super::surface::Surfaces;
+use glam::Vec3;
+use rayon::prelude::*;
+use rtbench_engines::{Counters, Engine, Hit, Ray};
+use rtbench_scenes::Scene;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Maximum ray-tree depth (SPD procedure item 7).
+pub const MAX_DEPTH: u8 = 5;
+/// Offset of secondary ray origins, relative to the magnitude of the hit point: 2^-15, about
+/// 256 times f32's unit roundoff.
+pub const OFFSET_REL: f32 = 1.0 / 32768.0;
+/// Floor of the offset, for hit points at the origin.
+const OFFSET_MIN: f32 = 1e-7;
+/// Rays per engine call: large enough to amortise the call, small enough to split across threads.
+const BATCH: usize = 4096;
+
+/// What one ray of a generation carries besides the ray.
+#[derive(Clone, Copy)]
+struct Path {
+    corner: u32,
+    weight: Vec3,
+    depth: u8,
+    inside: bool,
+}
+
+/// Ray counts of one generation.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct GenerationStats {
+    pub generation: u32,
+    pub rays: u64,
+    pub hits: u64,
+    pub shadow: u64,
+    pub shadow_blocked: u64,
+    pub reflect: u64,
+    pub refract: u64,
+}
+
+/// Ray statistics of a whole render (the columns of the SPD table).
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct RayStats {
+    pub eye: u64,
+    pub eye_hit: u64,
+    pub shadow: u64,
+    pub shadow_blocked: u64,
+    pub reflect: u64,
+    pub refract: u64,
+    pub total: u64,
+    pub generations: Vec<GenerationStats>,
+}
+
+/// Every query of a render with its answer, for cross-checking another engine on the same rays.
+#[derive(Default)]
+pub struct Recording {
+    pub closest: Vec<(Ray, Hit)>,
+    pub any: Vec<(Ray, bool)>,
+}
+
+pub struct Render {
+    pub size: u32,
+    /// Colour at each of the (size+1)² corners, row by row from the top.
+    pub corners: Vec<Vec3>,
+    pub stats: RayStats,
+    pub counters: Counters,
+    pub intersect_s: f64,
+    pub shade_s: f64,
+    pub trace_s: f64,
+}
+
+impl Render {
+    /// The image: each pixel the average of its four corners, 8-bit sRGB-less RGB.
+    pub fn pixels(&self) -> Vec<u8> {
+        let n = self.size as usize;
+        let w = n + 1;
+        let mut out = Vec::with_capacity(n * n * 3);
+        for j in 0..n {
+            for i in 0..n {
+                let c = (self.corners[j * w + i]
+                    + self.corners[j * w + i + 1]
+                    + self.corners[(j + 1) * w + i]
+                    + self.corners[(j + 1) * w + i + 1])
+                    * 0.25;
+                for x in [c.x, c.y, c.z] {
+                    out.push((x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Runs closest-hit queries over a batch, split across the pool's threads.
+fn intersect_all(engine: &dyn Engine, rays: &[Ray], hits: &mut Vec<Hit>, counters: &mut Counters) {
+    hits.clear();
+    hits.resize(rays.len(), Hit::MISS);
+    let sums: Vec<Counters> = rays
+        .par_chunks(BATCH)
+        .zip(hits.par_chunks_mut(BATCH))
+        .map(|(r, h)| {
+            let mut c = Counters::default();
+            engine.intersect(r, h, &mut c);
+            c
+        })
+        .collect();
+    for c in &sums {
+        counters.add(c);
+    }
+}
+
+fn occluded_all(engine: &dyn Engine, rays: &[Ray], out: &mut Vec<bool>, counters: &mut Counters) {
+    out.clear();
+    out.resize(rays.len(), false);
+    let sums: Vec<Counters> = rays
+        .par_chunks(BATCH)
+        .zip(out.par_chunks_mut(BATCH))
+        .map(|(r, o)| {
+            let mut c = Counters::default();
+            engine.occluded(r, o, &mut c);
+            c
+        })
+        .collect();
+    for c in &sums {
+        counters.add(c);
+    }
+}
+
+fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
+    let scale = p.abs().max_element().max(OFFSET_MIN / OFFSET_REL) * OFFSET_REL;
+    p + n * scale
+}
+
+/// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels. With `record`,
+/// every query and its answer is kept.
+pub fn render(
+    scene: &Scene,
+    engine: &dyn Engine,
+    size: u32,
+    mut record: Option<&mut Recording>,
+) -> Render {
+    let start = Instant::now();
+    let camera = Camera::new(&scene.view);
+    let surfaces = Surfaces::new(scene);
+    let w = size + 1;
+    let n_corners = (w as usize) * (w as usize);
+    let mut corners = vec![Vec3::ZERO; n_corners];
+    let background = scene.background.as_vec3();
+    let lights: Vec<(Vec3, Vec3)> = scene
+        .lights
+        .iter()
+        .map(|l| {
+            // SPD's light scale for renderers that do not scale: 1/sqrt(#lights).
+            let i = 1.0 / (scene.lights.len() as f32).sqrt();
+            (
+                l.position.as_vec3(),
+                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
+            )
+        })
+        .collect();
+
+    let mut rays: Vec<Ray> = Vec::with_capacity(n_corners);
+    let mut paths: Vec<Path> = Vec::with_capacity(n_corners);
+    for j in 0..w {
+        for i in 0..w {
+            rays.push(camera.corner_ray(i, j, size));
+            paths.push(Path {
+                corner: j * w + i,
+                weight: Vec3::ONE,
+                depth: 1,
+                inside: false,
+            });
+        }
+    }
+
+    let mut stats = RayStats::default();
+    let mut counters = Counters::default();
+    let mut hits = Vec::new();
+    let mut blocked = Vec::new();
+    let mut shadow_rays: Vec<Ray> = Vec::new();
+    let mut shadow_gain: Vec<(u32, Vec3)> = Vec::new();
+    let mut next_rays = Vec::new();
+    let mut next_paths = Vec::new();
+    let (mut intersect_s, mut shade_s) = (0.0, 0.0);
+    let mut generation = 0;
+
+    while !rays.is_empty() {
+        generation += 1;
+        let mut g = GenerationStats {
+            generation,
+            rays: rays.len() as u64,
+            ..Default::default()
+        };
+        let t0 = Instant::now();
+        intersect_all(engine, &rays, &mut hits, &mut counters);
+        intersect_s += t0.elapsed().as_secs_f64();
+        if let Some(rec) = record.as_deref_mut() {
+            rec.closest
+                .extend(rays.iter().copied().zip(hits.iter().copied()));
+        }
+
+        let t1 = Instant::now();
+        shadow_rays.clear();
+        shadow_gain.clear();
+        next_rays.clear();
+        next_paths.clear();
+        for ((ray, hit), path) in rays.iter().zip(&hits).zip(&paths) {
+            if !hit.is_hit() {
+                corners[path.corner as usize] += path.weight * background;
+                continue;
+            }
+            g.hits += 1;
+            let m = &scene.materials[surfaces.material[hit.object as usize] as usize];
+            let color = m.color.as_vec3();
+            let d = ray.dir;
+            let p = ray.at(hit.t);
+            let (mut ns, mut ng) = surfaces.normals(hit, p);
+            if ng.dot(d) > 0.0 {
+                ng = -ng;
+                ns = -ns;
+            }
+            if ns.dot(d) > 0.0 {
+                // A smooth normal turned away from the viewer: fall back to the facing flat one.
+                ns = ng;
+            }
+            // Ambient term for every object.
+            corners[path.corner as usize] += path.weight * color * 0.1;
+            let above = offset_origin(p, ng);
+            for (lp, lc) in &lights {
+                let to_light = *lp - p;
+                if ns.dot(to_light) <= 0.0 {
+                    continue;
+                }
+                let dist = to_light.length();
+                let l = to_light / dist;
+                let diffuse = color * (m.kd as f32 * ns.dot(l));
+                let h = (l - d).normalize_or_zero();
+                let spec = if m.ks > 0.0 {
+                    m.ks as f32 * ns.dot(h).max(0.0).powf(m.shine as f32)
+                } else {
+                    0.0
+                };
+                let gain = path.weight * *lc * (diffuse + Vec3::splat(spec));
+                let o = above;
+                shadow_rays.push(Ray::new(o, l, 0.0, (*lp - o).length() * (1.0 - 1e-6)));
+                shadow_gain.push((path.corner, gain));
+            }
+            if path.depth >= MAX_DEPTH {
+                continue;
+            }
+            let (ks, kt) = (m.ks as f32, m.t as f32);
+            if ks > 0.0 || kt > 0.0 {
+                let r = (d - ns * (2.0 * d.dot(ns))).normalize();
+                next_rays.push(Ray::new(above, r, 0.0, f32::INFINITY));
+                let wr = if ks > 0.0 { ks } else { kt };
+                next_paths.push(Path {
+                    corner: path.corner,
+                    weight: path.weight * wr,
+                    depth: path.depth + 1,
+                    inside: path.inside,
+                });
+                g.reflect += 1;
+            }
+            if kt > 0.0 {
+                let ior = m.ior as f32;
+                let eta = if path.inside { ior } else { 1.0 / ior };
+                let cos_i = -d.dot(ns);
+                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                if k >= 0.0 {
+                    let t = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
+                    next_rays.push(Ray::new(offset_origin(p, -ng), t, 0.0, f32::INFINITY));
+                    next_paths.push(Path {
+                        corner: path.corner,
+                        weight: path.weight * kt * color,
+                        depth: path.depth + 1,
+                        inside: !path.inside,
+                    });
+                    g.refract += 1;
+                }
+            }
+        }
+        shade_s += t1.elapsed().as_secs_f64();
+
+        let t2 = Instant::now();
+        occluded_all(engine, &shadow_rays, &mut blocked, &mut counters);
+        intersect_s += t2.elapsed().as_secs_f64();
+        if let Some(rec) = record.as_deref_mut() {
+            rec.any
+                .extend(shadow_rays.iter().copied().zip(blocked.iter().copied()));
+        }
+        let t3 = Instant::now();
+        g.shadow = shadow_rays.len() as u64;
+        for ((corner, gain), b) in shadow_gain.iter().zip(&blocked) {
+            if *b {
+                g.shadow_blocked += 1;
+            } else {
+                corners[*corner as usize] += *gain;
+            }
+        }
+        shade_s += t3.elapsed().as_secs_f64();
+
+        if generation == 1 {
+            stats.eye = g.rays;
+            stats.eye_hit = g.hits;
+        }
+        stats.shadow += g.shadow;
+        stats.shadow_blocked += g.shadow_blocked;
+        stats.reflect += g.reflect;
+        stats.refract += g.refract;
+        stats.total += g.rays + g.shadow;
+        stats.generations.push(g);
+        std::mem::swap(&mut rays, &mut next_rays);
+        std::mem::swap(&mut paths, &mut next_paths);
+    }
+
+    Render {
+        size,
+        corners,
+        stats,
+        counters,
+        intersect_s,
+        shade_s,
+        trace_s: start.elapsed().as_secs_f64(),
+    }
+}

@@ -1,0 +1,8 @@
+//! NFF, the Neutral File Format of the SPD (../shared/SPD.md, "Output format").
+
+pub mod cfmt;
+pub mod read;
+pub mod write;
+
+pub use read::{read_nff, read_nff_file, NffError};
+pub use write::NffWriter;
