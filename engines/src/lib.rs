@@ -14,8 +14,10 @@
 //! assert!(hits[0].is_hit());
 //! ```
 
+pub mod bvh;
 pub mod engine;
 pub mod geometry;
+pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
 
@@ -24,7 +26,13 @@ pub use ray::{Hit, Ray};
 
 /// Every engine rtbench knows, available here or not.
 pub fn registry() -> Vec<EngineInfo> {
-    vec![reference::info()]
+    vec![
+        reference::info(),
+        bvh::info2(),
+        bvh::info4(),
+        bvh::info8(),
+        obvhs_engine::info(),
+    ]
 }
 
 /// Finds an engine by name, checks it is available, and builds it with `key=value` settings.

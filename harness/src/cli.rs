@@ -68,7 +68,7 @@ pub struct SceneArg {
 #[derive(Args, Debug, Clone)]
 pub struct SceneOpts {
     /// Size factor (default: the program's standard one).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub sf: Option<u32>,
     /// Tessellated output (SPD `-t`), at resolution RES (default 3).
     #[arg(long, num_args = 0..=1, default_missing_value = "3", value_name = "RES")]
@@ -101,7 +101,7 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Image size in pixels (rays go through the (size+1)² pixel corners).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
     pub size: u32,
     /// Threads for tracing (default: all cores).
     #[arg(long)]

@@ -6,6 +6,7 @@
 //! the gaps between the teeth). Patches are triangles already. Each prepared primitive keeps the
 //! index of its scene object, so hits name the NFF record.
 
+pub mod aabb;
 pub mod kernels;
 
 use crate::engine::TriangleTest;

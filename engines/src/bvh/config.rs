@@ -1,0 +1,185 @@
+//! The typed configuration of `bvh2`, `bvh4` and `bvh8`, parsed from `key=value` settings.
+//!
+//! | key | values | default |
+//! |---|---|---|
+//! | `builder` | `median` (001 object median), `sah-sweep` (001 full-sweep SAH), `sah-binned` | `sah-binned` |
+//! | `wide` | `collapse` (binary tree collapsed to N-wide), `direct` (001's own N-ary builders) | `collapse` |
+//! | `leaf` | most primitives per leaf, 1–16 (001 uses 1) | 1 for bvh2, 4 for bvh4/bvh8 |
+//! | `simd` | `on`, `off` (bvh4: SSE, bvh8: AVX2+FMA when the CPU has them) | `on` (bvh2: `off`) |
+//! | `triangle` | `watertight`, `moller` | `watertight` |
+//! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
+
+use super::node::MAX_LEAF_PRIMS;
+use crate::engine::{EngineError, Settings, TriangleTest};
+use std::str::FromStr;
+
+/// How the binary tree (or, with `wide=direct`, the N-ary tree) is split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Builder {
+    /// 001 §1.4 (thesis Ch. 3.4, after Kay and Kajiya 1986): the axis cycles X→Y→Z with depth, primitives are
+    /// ordered by the centre of their box and cut into equal counts.
+    Median,
+    /// 001 §1.5 (thesis Ch. 3.5, after Wald, Boulos and Shirley 2007): the exact SAH over every axis and every split
+    /// position between primitives sorted by box centre.
+    SahSweep,
+    /// Wald 2007, "On fast construction of SAH-based bounding volume hierarchies": the SAH
+    /// evaluated at the planes between `bins` equal bins of the centroid bounds.
+    SahBinned,
+}
+
+impl FromStr for Builder {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "median" => Ok(Builder::Median),
+            "sah-sweep" | "sweep" => Ok(Builder::SahSweep),
+            "sah-binned" | "binned" | "sah" => Ok(Builder::SahBinned),
+            _ => Err("expected median, sah-sweep or sah-binned".into()),
+        }
+    }
+}
+
+impl Builder {
+    pub fn name(self) -> &'static str {
+        match self {
+            Builder::Median => "median",
+            Builder::SahSweep => "sah-sweep",
+            Builder::SahBinned => "sah-binned",
+        }
+    }
+}
+
+/// How a tree wider than two is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WideMethod {
+    /// Build a binary tree, then collapse it: each wide node opens the binary descendant of
+    /// largest surface area until it has N children (Embree's BVHN builders; Dammertz et al.
+    /// 2008's QBVH).
+    Collapse,
+    /// 001's own N-ary builders: object median straight into N equal-count groups (001 §1.4),
+    /// or the binary SAH split re-applied to each half on the first split's axis (001 §1.5).
+    Direct,
+}
+
+impl FromStr for WideMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "collapse" => Ok(WideMethod::Collapse),
+            "direct" | "001" => Ok(WideMethod::Direct),
+            _ => Err("expected collapse or direct".into()),
+        }
+    }
+}
+
+/// `on` / `off`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OnOff(pub bool);
+
+impl FromStr for OnOff {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "on" | "true" | "1" | "yes" => Ok(OnOff(true)),
+            "off" | "false" | "0" | "no" => Ok(OnOff(false)),
+            _ => Err("expected on or off".into()),
+        }
+    }
+}
+
+/// The SAH's cost constants (001 §1.5, Eq. 3.4, writes the binary split cost as
+/// `2·T_AABB + Σ (A_i/A)·N_i·T_tri`; the thesis gives no values). One box test and one
+/// primitive test cost the same here, as in Wald, Boulos and Shirley 2007.
+pub const T_AABB: f32 = 1.0;
+pub const T_TRI: f32 = 1.0;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    pub width: usize,
+    pub builder: Builder,
+    pub wide: WideMethod,
+    pub leaf: usize,
+    pub simd: bool,
+    pub triangle: TriangleTest,
+    pub bins: usize,
+}
+
+impl Config {
+    /// Reads this engine's keys from `settings` and rejects unknown ones.
+    pub fn parse(width: usize, mut settings: Settings) -> Result<Config, EngineError> {
+        let engine = format!("bvh{width}");
+        let bad = |key: &str, value: String, reason: &str| EngineError::BadValue {
+            engine: engine.clone(),
+            key: key.into(),
+            value,
+            reason: reason.into(),
+        };
+        let builder = settings.get("builder", Builder::SahBinned)?;
+        let wide = settings.get("wide", WideMethod::Collapse)?;
+        let leaf = settings.get("leaf", if width == 2 { 1usize } else { 4 })?;
+        let simd = settings.get("simd", OnOff(width > 2))?.0;
+        let triangle = settings.get("triangle", TriangleTest::default())?;
+        let bins = settings.get("bins", 32usize)?;
+        settings.finish()?;
+        if !(1..=MAX_LEAF_PRIMS).contains(&leaf) {
+            return Err(bad(
+                "leaf",
+                leaf.to_string(),
+                &format!("must be from 1 to {MAX_LEAF_PRIMS}"),
+            ));
+        }
+        if !(2..=256).contains(&bins) {
+            return Err(bad("bins", bins.to_string(), "must be from 2 to 256"));
+        }
+        if simd && width == 2 {
+            return Err(bad(
+                "simd",
+                "on".into(),
+                "bvh2 has no SIMD traversal (its nodes hold two boxes); use bvh4 or bvh8",
+            ));
+        }
+        Ok(Config {
+            width,
+            builder,
+            wide,
+            leaf,
+            simd,
+            triangle,
+            bins,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(width: usize, kv: &[(&str, &str)]) -> Result<Config, EngineError> {
+        let pairs = kv
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        Config::parse(width, Settings::new("bvh", pairs))
+    }
+
+    #[test]
+    fn defaults_and_keys() {
+        let c = parse(4, &[]).unwrap();
+        assert_eq!(c.builder, Builder::SahBinned);
+        assert!(c.simd);
+        assert_eq!(c.leaf, 4);
+        let c = parse(2, &[]).unwrap();
+        assert!(!c.simd);
+        assert_eq!(c.leaf, 1);
+        let c = parse(8, &[("builder", "median"), ("leaf", "1"), ("simd", "off")]).unwrap();
+        assert_eq!((c.builder, c.leaf, c.simd), (Builder::Median, 1, false));
+        assert!(parse(8, &[("leaf", "0")]).is_err());
+        assert!(parse(8, &[("leaf", "17")]).is_err());
+        assert!(parse(8, &[("builder", "kd")]).is_err());
+        assert!(parse(2, &[("simd", "on")]).is_err());
+        assert!(matches!(
+            parse(4, &[("colour", "red")]),
+            Err(EngineError::UnknownKey { .. })
+        ));
+    }
+}

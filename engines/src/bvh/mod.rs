@@ -1,0 +1,224 @@
+//! `bvh2`, `bvh4`, `bvh8`: bounding volume hierarchies of seed 001 (Kimura 2007), binary and
+//! N-wide, with the children's boxes stored side by side and a SIMD ray–N-box test.
+//!
+//! Pipeline: primitive boxes ([`tree::BuildPrims`]) → a builder (object median, full-sweep
+//! SAH, binned SAH; [`config::Builder`]) → a binary tree collapsed to N-wide
+//! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
+//! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
+//! ([`simd`]). Leaves hold up to `leaf` primitives of the shared [`Geometry`], copied in
+//! leaf order, and test them with the shared kernels (`Prim::intersect`).
+//!
+//! Settings: see [`config`].
+
+pub mod build_median;
+pub mod build_sah;
+pub mod collapse;
+pub mod config;
+pub mod node;
+pub mod simd;
+pub mod stats;
+pub mod traverse;
+pub mod tree;
+
+#[cfg(test)]
+mod tests;
+
+use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::geometry::Geometry;
+use crate::ray::{Hit, Ray};
+use config::{Builder, Config, WideMethod};
+use node::{flatten, WideNode, MAX_PRIMS};
+use simd::Kernels;
+use std::collections::BTreeMap;
+use std::time::Instant;
+use traverse::Bvh;
+use tree::{BuildPrims, BuildTree};
+
+pub fn info2() -> EngineInfo {
+    EngineInfo {
+        name: "bvh2",
+        description: "binary BVH (seed 001): object median, full-sweep or binned SAH; scalar traversal",
+        available: || Ok(()),
+        build: |input, settings| build_engine::<2>(input, settings, || None),
+    }
+}
+
+pub fn info4() -> EngineInfo {
+    EngineInfo {
+        name: "bvh4",
+        description: "4-wide BVH (seed 001), children's boxes side by side, SSE ray-4-box test",
+        available: || Ok(()),
+        build: |input, settings| build_engine::<4>(input, settings, simd::sse4),
+    }
+}
+
+pub fn info8() -> EngineInfo {
+    EngineInfo {
+        name: "bvh8",
+        description: "8-wide BVH, children's boxes side by side, AVX2 ray-8-box test",
+        available: || Ok(()),
+        build: |input, settings| build_engine::<8>(input, settings, simd::avx8),
+    }
+}
+
+/// A built N-wide BVH engine.
+pub struct BvhEngine<const N: usize> {
+    bvh: Bvh<N>,
+    config: Config,
+    kernels: Kernels<N>,
+    stats: BTreeMap<String, f64>,
+}
+
+/// Builds the tree of `config` over `geometry`: a build tree with at most `config.width`
+/// children per node.
+pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
+    let prims = BuildPrims::new(geometry);
+    let n = prims.len();
+    let (width, leaf) = (config.width, config.leaf);
+    let direct = config.wide == WideMethod::Direct && width > 2;
+    match (config.builder, direct) {
+        (Builder::Median, false) => collapse::collapse(&build_median::binary(&prims, leaf), width),
+        (Builder::Median, true) => build_median::nway(&prims, leaf, width),
+        (Builder::SahSweep, false) => collapse::collapse(
+            &build_sah::binary(build_sah::Sweep::new(&prims), n, leaf),
+            width,
+        ),
+        (Builder::SahSweep, true) => {
+            build_sah::wide_same_axis(build_sah::Sweep::new(&prims), n, leaf, width)
+        }
+        (Builder::SahBinned, false) => collapse::collapse(
+            &build_sah::binary(build_sah::Binned::new(&prims, config.bins), n, leaf),
+            width,
+        ),
+        (Builder::SahBinned, true) => build_sah::wide_same_axis(
+            build_sah::Binned::new(&prims, config.bins),
+            n,
+            leaf,
+            width,
+        ),
+    }
+}
+
+/// Builds a [`Bvh`] and its statistics from geometry and a parsed configuration.
+pub fn build_bvh<const N: usize>(
+    geometry: &Geometry,
+    config: &Config,
+) -> Result<(Bvh<N>, stats::TreeStats), EngineError> {
+    let n = geometry.prims.len();
+    if n >= MAX_PRIMS {
+        return Err(EngineError::Build {
+            engine: format!("bvh{N}"),
+            reason: format!("{n} primitives: at most {} fit a leaf reference", MAX_PRIMS - 1),
+        });
+    }
+    if n == 0 {
+        // One node with every slot empty: every ray misses.
+        let flat = flatten::<N>(&BuildTree {
+            nodes: vec![tree::BuildNode {
+                bounds: crate::geometry::aabb::Aabb::EMPTY,
+                kind: tree::BuildKind::Inner {
+                    children: [0; tree::MAX_WIDTH],
+                    len: 0,
+                },
+            }],
+            order: Vec::new(),
+        });
+        let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
+        let bvh = Bvh {
+            nodes: flat.nodes,
+            root: flat.root,
+            prims: Vec::new(),
+            objects: Vec::new(),
+        };
+        return Ok((bvh, s));
+    }
+    let tree = build_tree(geometry, config);
+    debug_assert_eq!(
+        tree.validate(&BuildPrims::new(geometry), N),
+        Ok(()),
+        "builder broke an invariant"
+    );
+    let flat = flatten::<N>(&tree);
+    let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
+    let prims = tree
+        .order
+        .iter()
+        .map(|&i| geometry.prims[i as usize])
+        .collect();
+    let objects = tree
+        .order
+        .iter()
+        .map(|&i| geometry.prim_object[i as usize])
+        .collect();
+    Ok((
+        Bvh {
+            nodes: flat.nodes,
+            root: flat.root,
+            prims,
+            objects,
+        },
+        s,
+    ))
+}
+
+fn build_engine<const N: usize>(
+    input: &BuildInput,
+    settings: Settings,
+    simd_kernels: fn() -> Option<Kernels<N>>,
+) -> Result<Box<dyn Engine>, EngineError> {
+    let config = Config::parse(N, settings)?;
+    let start = Instant::now();
+    let (bvh, tree_stats) = build_bvh::<N>(&input.geometry, &config)?;
+    let build_s = start.elapsed().as_secs_f64();
+    // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
+    let kernels = if config.simd {
+        simd_kernels().unwrap_or_else(simd::scalar::<N>)
+    } else {
+        simd::scalar::<N>()
+    };
+    let mut stats = BTreeMap::new();
+    tree_stats.insert_into(&mut stats);
+    stats.insert("build_s".into(), build_s);
+    stats.insert("leaf_size".into(), config.leaf as f64);
+    stats.insert("simd_lanes".into(), kernels.lanes as f64);
+    let mut engine = BvhEngine {
+        bvh,
+        config,
+        kernels,
+        stats,
+    };
+    let bytes = engine.structure_bytes() as f64;
+    engine.stats.insert("actual_bytes".into(), bytes);
+    Ok(Box::new(engine))
+}
+
+impl<const N: usize> BvhEngine<N> {
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    pub fn kernel_name(&self) -> &'static str {
+        self.kernels.name
+    }
+}
+
+impl<const N: usize> Engine for BvhEngine<N> {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], counters: &mut Counters) {
+        (self.kernels.closest)(&self.bvh, rays, hits, self.config.triangle, counters);
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], counters: &mut Counters) {
+        (self.kernels.any)(&self.bvh, rays, occluded, self.config.triangle, counters);
+    }
+
+    /// Nodes, plus the primitives and their object indices copied in leaf order.
+    fn structure_bytes(&self) -> u64 {
+        (std::mem::size_of::<WideNode<N>>() * self.bvh.nodes.len()
+            + std::mem::size_of::<crate::geometry::Prim>() * self.bvh.prims.len()
+            + 4 * self.bvh.objects.len()) as u64
+    }
+
+    fn build_stats(&self) -> BTreeMap<String, f64> {
+        self.stats.clone()
+    }
+}

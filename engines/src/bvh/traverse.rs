@@ -1,0 +1,277 @@
+//! Single-ray traversal of an N-wide BVH: closest hit and any hit, generic over the slab test
+//! ([`ChildTest`]: scalar, SSE or AVX2), with an explicit fixed-size stack (no allocation per
+//! ray; 001 §1.9 recursed instead).
+//!
+//! Order: 001 §1.9 visits children front to back by the sign of the ray direction on the
+//! node's split axis (Wald, Boulos and Shirley 2007). Children of a collapsed wide node lie on
+//! no single axis, so here, as in Embree's `BVHNNodeTraverser1Hit`, the children a ray hits
+//! are ordered by their entry distance: one hit is visited at once, two are compared, more are
+//! pushed and sorted so the nearest is popped first. Each stack entry keeps its entry distance,
+//! and entries farther than the closest hit found so far are dropped when popped.
+//!
+//! Any-hit queries (shadow rays) need no order and stop at the first hit (Embree's separate
+//! `occluded` kernel does the same).
+
+use super::node::{is_leaf, leaf_range, WideNode};
+use super::simd::ChildTest;
+use super::tree::{MAX_DEPTH, MAX_WIDTH};
+use crate::engine::{Counters, TriangleTest};
+use crate::geometry::aabb::SlabRay;
+use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::Prim;
+use crate::ray::{Hit, Ray};
+
+/// A traversal holds at most N − 1 pending siblings per level of the tree.
+pub const STACK_SIZE: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
+
+/// A built BVH as traversal reads it: flat node array, root reference, and the primitives in
+/// leaf order (leaves index `prims` directly) with their scene objects.
+pub struct Bvh<const N: usize> {
+    pub nodes: Vec<WideNode<N>>,
+    pub root: u32,
+    pub prims: Vec<Prim>,
+    pub objects: Vec<u32>,
+}
+
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    node: u32,
+    dist: f32,
+}
+
+/// Counts kept in registers during a batch and added to `Counters` once.
+#[derive(Default)]
+struct Tally {
+    nodes: u64,
+    boxes: u64,
+    prims: u64,
+    prim_hits: u64,
+}
+
+impl Tally {
+    fn add_to(&self, c: &mut Counters, rays: usize) {
+        c.rays += rays as u64;
+        c.nodes_visited += self.nodes;
+        c.box_tests += self.boxes;
+        c.primitive_tests += self.prims;
+        c.primitive_hits += self.prim_hits;
+    }
+}
+
+/// The per-ray set-up of the triangle test, made only for the watertight one.
+#[inline(always)]
+fn triangle_setup<const W: bool>(dir: glam::Vec3) -> WatertightRay {
+    if W {
+        WatertightRay::new(dir)
+    } else {
+        WatertightRay {
+            kx: 0,
+            ky: 1,
+            kz: 2,
+            sx: 0.0,
+            sy: 0.0,
+            sz: 0.0,
+        }
+    }
+}
+
+#[inline(always)]
+fn triangle_test<const W: bool>() -> TriangleTest {
+    if W {
+        TriangleTest::Watertight
+    } else {
+        TriangleTest::Moller
+    }
+}
+
+/// Closest hits of a batch of rays.
+#[inline(always)]
+pub fn closest_batch<const N: usize, T: ChildTest<N>>(
+    bvh: &Bvh<N>,
+    rays: &[Ray],
+    hits: &mut [Hit],
+    test: TriangleTest,
+    counters: &mut Counters,
+) {
+    let mut stack = [Entry::default(); STACK_SIZE];
+    let mut tally = Tally::default();
+    for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        *hit = match test {
+            TriangleTest::Watertight => closest::<N, T, true>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Moller => closest::<N, T, false>(bvh, ray, &mut stack, &mut tally),
+        };
+    }
+    tally.add_to(counters, rays.len());
+}
+
+/// Any-hit answers of a batch of rays.
+#[inline(always)]
+pub fn any_batch<const N: usize, T: ChildTest<N>>(
+    bvh: &Bvh<N>,
+    rays: &[Ray],
+    out: &mut [bool],
+    test: TriangleTest,
+    counters: &mut Counters,
+) {
+    let mut stack = [0u32; STACK_SIZE];
+    let mut tally = Tally::default();
+    for (ray, o) in rays.iter().zip(out.iter_mut()) {
+        *o = match test {
+            TriangleTest::Watertight => any::<N, T, true>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Moller => any::<N, T, false>(bvh, ray, &mut stack, &mut tally),
+        };
+    }
+    tally.add_to(counters, rays.len());
+}
+
+#[inline(always)]
+fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
+    bvh: &Bvh<N>,
+    ray: &Ray,
+    stack: &mut [Entry; STACK_SIZE],
+    tally: &mut Tally,
+) -> Hit {
+    let tr = T::prepare(&SlabRay::new(ray));
+    let wt = triangle_setup::<W>(ray.dir);
+    let mut r = *ray;
+    let mut best = Hit::MISS;
+    let mut dist = [0.0f32; N];
+    let mut sp = 0usize;
+    let mut cur = bvh.root;
+    loop {
+        if !is_leaf(cur) {
+            let node = &bvh.nodes[cur as usize];
+            tally.nodes += 1;
+            tally.boxes += node.len as u64;
+            let mut mask = T::test(node, &tr, r.tmin, r.tmax, &mut dist);
+            if mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    cur = node.child[i];
+                    continue;
+                }
+                let j = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    let (near, far) = if dist[j] < dist[i] { (j, i) } else { (i, j) };
+                    stack[sp] = Entry {
+                        node: node.child[far],
+                        dist: dist[far],
+                    };
+                    sp += 1;
+                    cur = node.child[near];
+                    continue;
+                }
+                // Three or more: push all, then insertion-sort the new entries farthest first.
+                let base = sp;
+                for k in [i, j] {
+                    stack[sp] = Entry {
+                        node: node.child[k],
+                        dist: dist[k],
+                    };
+                    sp += 1;
+                }
+                while mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[sp] = Entry {
+                        node: node.child[k],
+                        dist: dist[k],
+                    };
+                    sp += 1;
+                }
+                for a in base + 1..sp {
+                    let e = stack[a];
+                    let mut b = a;
+                    while b > base && stack[b - 1].dist < e.dist {
+                        stack[b] = stack[b - 1];
+                        b -= 1;
+                    }
+                    stack[b] = e;
+                }
+                sp -= 1;
+                cur = stack[sp].node;
+                continue;
+            }
+        } else {
+            let (first, count) = leaf_range(cur);
+            for k in first..first + count {
+                tally.prims += 1;
+                if let Some((t, u, v)) = bvh.prims[k].intersect(&r, triangle_test::<W>(), &wt) {
+                    tally.prim_hits += 1;
+                    r.tmax = t;
+                    best = Hit {
+                        t,
+                        object: bvh.objects[k],
+                        u,
+                        v,
+                    };
+                }
+            }
+        }
+        // Next: the nearest pending entry not beyond the closest hit so far.
+        loop {
+            if sp == 0 {
+                return best;
+            }
+            sp -= 1;
+            let e = stack[sp];
+            if e.dist <= r.tmax {
+                cur = e.node;
+                break;
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn any<const N: usize, T: ChildTest<N>, const W: bool>(
+    bvh: &Bvh<N>,
+    ray: &Ray,
+    stack: &mut [u32; STACK_SIZE],
+    tally: &mut Tally,
+) -> bool {
+    let tr = T::prepare(&SlabRay::new(ray));
+    let wt = triangle_setup::<W>(ray.dir);
+    let mut dist = [0.0f32; N];
+    let mut sp = 0usize;
+    let mut cur = bvh.root;
+    loop {
+        if !is_leaf(cur) {
+            let node = &bvh.nodes[cur as usize];
+            tally.nodes += 1;
+            tally.boxes += node.len as u64;
+            let mut mask = T::test(node, &tr, ray.tmin, ray.tmax, &mut dist);
+            if mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                while mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[sp] = node.child[k];
+                    sp += 1;
+                }
+                cur = node.child[i];
+                continue;
+            }
+        } else {
+            let (first, count) = leaf_range(cur);
+            for k in first..first + count {
+                tally.prims += 1;
+                if bvh.prims[k]
+                    .intersect(ray, triangle_test::<W>(), &wt)
+                    .is_some()
+                {
+                    tally.prim_hits += 1;
+                    return true;
+                }
+            }
+        }
+        if sp == 0 {
+            return false;
+        }
+        sp -= 1;
+        cur = stack[sp];
+    }
+}

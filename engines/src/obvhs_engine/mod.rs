@@ -1,0 +1,354 @@
+//! `obvhs`: the obvhs crate's BVHs as a peer of our own: its PLOC builder (Meister and
+//! Bittner 2018) with reinsertion, as a BVH2 or collapsed into a compressed wide BVH8 (CWBVH,
+//! Ylitie, Karras and Laine 2017), traversed by its own CPU code. Its leaves call our shared
+//! kernels through its intersection callback, so it differs from `bvh2`/`bvh8` only in how it
+//! finds candidates.
+//!
+//! | key | values | default |
+//! |---|---|---|
+//! | `layout` | `bvh2`, `cwbvh` | `cwbvh` |
+//! | `preset` | obvhs's build presets: `fastest`, `very-fast`, `fast`, `medium`, `slow`, `very-slow` | `medium` |
+//! | `leaf` | most primitives per leaf (0: the preset's; CWBVH caps it at 3) | 0 |
+//! | `triangle` | `watertight`, `moller` | `watertight` |
+//!
+//! obvhs counts no nodes; the counters give primitive tests and hits only.
+
+use crate::engine::{
+    BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest,
+};
+use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::Prim;
+use crate::ray::{Hit, Ray};
+use obvhs::aabb::Aabb as OAabb;
+use obvhs::bvh2::Bvh2;
+use obvhs::cwbvh::CwBvh;
+use obvhs::ray::{Ray as ORay, RayHit};
+use obvhs::BvhBuildParams;
+use std::collections::BTreeMap;
+use std::str::FromStr;
+use std::time::{Duration, Instant};
+
+pub fn info() -> EngineInfo {
+    EngineInfo {
+        name: "obvhs",
+        description: "the obvhs crate (0.4): PLOC-built BVH2 or compressed wide BVH8, its CPU traversal",
+        available: || Ok(()),
+        build,
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    Bvh2,
+    Cwbvh,
+}
+
+impl FromStr for Layout {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "bvh2" => Ok(Layout::Bvh2),
+            "cwbvh" => Ok(Layout::Cwbvh),
+            _ => Err("expected bvh2 or cwbvh".into()),
+        }
+    }
+}
+
+/// obvhs's named build quality presets (`BvhBuildParams::*_build`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Preset(&'static str);
+
+impl FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        const NAMES: [&str; 6] = ["fastest", "very-fast", "fast", "medium", "slow", "very-slow"];
+        NAMES
+            .iter()
+            .find(|&&n| n == s)
+            .map(|&n| Preset(n))
+            .ok_or_else(|| format!("expected one of {}", NAMES.join(", ")))
+    }
+}
+
+impl Preset {
+    fn params(self) -> BvhBuildParams {
+        match self.0 {
+            "fastest" => BvhBuildParams::fastest_build(),
+            "very-fast" => BvhBuildParams::very_fast_build(),
+            "fast" => BvhBuildParams::fast_build(),
+            "slow" => BvhBuildParams::slow_build(),
+            "very-slow" => BvhBuildParams::very_slow_build(),
+            _ => BvhBuildParams::medium_build(),
+        }
+    }
+}
+
+/// A primitive as obvhs's builder sees it: its box.
+struct PrimBox {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl obvhs::Boundable for PrimBox {
+    fn aabb(&self) -> OAabb {
+        OAabb::new(self.lo.into(), self.hi.into())
+    }
+}
+
+enum Tree {
+    Bvh2(Bvh2),
+    Cwbvh(CwBvh),
+}
+
+pub struct Obvhs {
+    tree: Tree,
+    /// Primitives reordered by obvhs's `primitive_indices`, so its ids index them directly.
+    prims: Vec<Prim>,
+    objects: Vec<u32>,
+    triangle: TriangleTest,
+    stats: BTreeMap<String, f64>,
+}
+
+fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
+    let layout = settings.get("layout", Layout::Cwbvh)?;
+    let preset = settings.get("preset", Preset("medium"))?;
+    let leaf = settings.get("leaf", 0u32)?;
+    let triangle = settings.get("triangle", TriangleTest::default())?;
+    settings.finish()?;
+    let g = &input.geometry;
+    let start = Instant::now();
+    let boxes: Vec<PrimBox> = g
+        .prims
+        .iter()
+        .map(|p| {
+            let (lo, hi) = p.bounds();
+            PrimBox {
+                lo: lo.to_array(),
+                hi: hi.to_array(),
+            }
+        })
+        .collect();
+    let mut params = preset.params();
+    if leaf > 0 {
+        params.max_prims_per_leaf = leaf;
+    }
+    let mut core = Duration::default();
+    let (tree, indices, node_bytes, nodes) = if g.prims.is_empty() {
+        (Tree::Bvh2(Bvh2::default()), Vec::new(), 0, 0)
+    } else {
+        match layout {
+            Layout::Bvh2 => {
+                let t = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut core);
+                let idx = t.primitive_indices.clone();
+                let nb = std::mem::size_of_val(t.nodes.as_slice());
+                let n = t.nodes.len();
+                (Tree::Bvh2(t), idx, nb, n)
+            }
+            Layout::Cwbvh => {
+                let t = obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut core);
+                let idx = t.primitive_indices.clone();
+                let nb = std::mem::size_of_val(t.nodes.as_slice());
+                let n = t.nodes.len();
+                (Tree::Cwbvh(t), idx, nb, n)
+            }
+        }
+    };
+    let prims: Vec<Prim> = indices.iter().map(|&i| g.prims[i as usize]).collect();
+    let objects: Vec<u32> = indices.iter().map(|&i| g.prim_object[i as usize]).collect();
+    let build_s = start.elapsed().as_secs_f64();
+    let mut stats = BTreeMap::new();
+    stats.insert("build_s".into(), build_s);
+    stats.insert("core_build_s".into(), core.as_secs_f64());
+    stats.insert("nodes".into(), nodes as f64);
+    stats.insert("node_bytes".into(), node_bytes as f64);
+    stats.insert("max_prims_per_leaf".into(), params.max_prims_per_leaf as f64);
+    Ok(Box::new(Obvhs {
+        tree,
+        prims,
+        objects,
+        triangle,
+        stats,
+    }))
+}
+
+/// Our ray in obvhs's form.
+fn to_oray(r: &Ray) -> ORay {
+    ORay::new(r.origin.to_array().into(), r.dir.to_array().into(), r.tmin, r.tmax)
+}
+
+impl Obvhs {
+    /// The leaf test obvhs calls: our shared kernel on primitive `id` within obvhs's current
+    /// segment; the t of a hit, or +∞. `last` keeps (id, u, v) of the latest hit, which obvhs
+    /// always accepts (the kernel only reports t < tmax).
+    #[inline]
+    fn test(
+        &self,
+        ray: &Ray,
+        oray: &ORay,
+        id: usize,
+        wt: &WatertightRay,
+        last: &mut (usize, f32, f32),
+        c: &mut Counters,
+    ) -> f32 {
+        let mut r = *ray;
+        r.tmax = oray.tmax;
+        c.primitive_tests += 1;
+        match self.prims[id].intersect(&r, self.triangle, wt) {
+            Some((t, u, v)) => {
+                c.primitive_hits += 1;
+                *last = (id, u, v);
+                t
+            }
+            None => f32::INFINITY,
+        }
+    }
+
+    fn closest(&self, ray: &Ray, c: &mut Counters) -> Hit {
+        let wt = WatertightRay::new(ray.dir);
+        let mut last = (usize::MAX, 0.0, 0.0);
+        let mut hit = RayHit::none();
+        let oray = to_oray(ray);
+        let found = match &self.tree {
+            Tree::Bvh2(t) if !t.nodes.is_empty() => t.ray_traverse(oray, &mut hit, |o, id| {
+                self.test(ray, o, id, &wt, &mut last, c)
+            }),
+            Tree::Bvh2(_) => false,
+            Tree::Cwbvh(t) => t.ray_traverse(oray, &mut hit, |o, id| {
+                self.test(ray, o, id, &wt, &mut last, c)
+            }),
+        };
+        if !found {
+            return Hit::MISS;
+        }
+        let id = hit.primitive_id as usize;
+        debug_assert_eq!(id, last.0);
+        Hit {
+            t: hit.t,
+            object: self.objects[id],
+            u: last.1,
+            v: last.2,
+        }
+    }
+
+    fn any(&self, ray: &Ray, c: &mut Counters) -> bool {
+        let wt = WatertightRay::new(ray.dir);
+        let mut last = (usize::MAX, 0.0, 0.0);
+        let oray = to_oray(ray);
+        let miss = match &self.tree {
+            Tree::Bvh2(t) if !t.nodes.is_empty() => t.ray_traverse_miss(oray, |o, id| {
+                self.test(ray, o, id, &wt, &mut last, c)
+            }),
+            Tree::Bvh2(_) => true,
+            Tree::Cwbvh(t) => t.ray_traverse_miss(oray, |o, id| {
+                self.test(ray, o, id, &wt, &mut last, c)
+            }),
+        };
+        !miss
+    }
+}
+
+impl Engine for Obvhs {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], counters: &mut Counters) {
+        let mut c = Counters::default();
+        for (r, h) in rays.iter().zip(hits.iter_mut()) {
+            *h = self.closest(r, &mut c);
+        }
+        c.rays = rays.len() as u64;
+        counters.add(&c);
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], counters: &mut Counters) {
+        let mut c = Counters::default();
+        for (r, o) in rays.iter().zip(occluded.iter_mut()) {
+            *o = self.any(r, &mut c);
+        }
+        c.rays = rays.len() as u64;
+        counters.add(&c);
+    }
+
+    /// obvhs's nodes and index list, plus the primitives copied in its order.
+    fn structure_bytes(&self) -> u64 {
+        let idx = match &self.tree {
+            Tree::Bvh2(t) => t.primitive_indices.len(),
+            Tree::Cwbvh(t) => t.primitive_indices.len(),
+        };
+        (self.stats["node_bytes"] as usize
+            + 4 * idx
+            + std::mem::size_of::<Prim>() * self.prims.len()
+            + 4 * self.objects.len()) as u64
+    }
+
+    fn build_stats(&self) -> BTreeMap<String, f64> {
+        self.stats.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Geometry;
+    use glam::Vec3;
+    use rtbench_scenes::generate_scene;
+    use rtbench_scenes::spd::{Options, Program};
+    use std::sync::Arc;
+
+    #[test]
+    fn both_layouts_agree_with_reference() {
+        for (program, sf) in [(Program::Tree, 3), (Program::Gears, 1)] {
+            let scene = Arc::new(
+                generate_scene(program, &Options { size_factor: sf, ..Options::standard(program) })
+                    .unwrap(),
+            );
+            let input = BuildInput {
+                geometry: Arc::new(Geometry::from_scene(&scene)),
+                scene,
+            };
+            let g = &input.geometry;
+            let c = (g.bounds_min + g.bounds_max) * 0.5;
+            let r = (g.bounds_max - g.bounds_min).length();
+            // A fan of rays from outside through the scene, and shadow-like segments.
+            let mut rays = Vec::new();
+            for i in 0..200 {
+                let a = i as f32 * 0.137;
+                let o = c + Vec3::new(a.cos(), 0.3 + 0.2 * (a * 3.0).sin(), a.sin()) * r;
+                let target = c + Vec3::new((a * 7.0).sin(), (a * 5.0).cos(), (a * 3.0).sin()) * 0.3 * r;
+                let d = (target - o).normalize();
+                let tmax = if i % 2 == 0 { f32::INFINITY } else { r };
+                rays.push(Ray::new(o, d, 0.0, tmax));
+            }
+            let refe = (crate::reference::info().build)(&input, Settings::new("reference", vec![]))
+                .unwrap();
+            let mut want = vec![Hit::MISS; rays.len()];
+            refe.intersect(&rays, &mut want, &mut Counters::default());
+            assert!(want.iter().filter(|h| h.is_hit()).count() > 20);
+            for layout in ["bvh2", "cwbvh"] {
+                let e = build(
+                    &input,
+                    Settings::new("obvhs", vec![("layout".into(), layout.into())]),
+                )
+                .unwrap();
+                let mut got = vec![Hit::MISS; rays.len()];
+                let mut cnt = Counters::default();
+                e.intersect(&rays, &mut got, &mut cnt);
+                let mut occ = vec![false; rays.len()];
+                e.occluded(&rays, &mut occ, &mut Counters::default());
+                let ok = got
+                    .iter()
+                    .zip(&want)
+                    .filter(|(a, b)| {
+                        a.is_hit() == b.is_hit()
+                            && (!a.is_hit()
+                                || a.object == b.object
+                                || (a.t - b.t).abs() <= 1e-5 * b.t)
+                    })
+                    .count();
+                assert!(ok + 2 >= rays.len(), "{layout} on {program}{sf}: {ok} agree");
+                for (o, h) in occ.iter().zip(&got) {
+                    assert_eq!(*o, h.is_hit(), "{layout}");
+                }
+                assert_eq!(cnt.rays, rays.len() as u64);
+                assert!(e.structure_bytes() > 0);
+            }
+        }
+    }
+}
