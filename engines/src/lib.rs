@@ -17,6 +17,7 @@
 pub mod bvh;
 pub mod engine;
 pub mod geometry;
+pub mod grid;
 pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
@@ -28,6 +29,7 @@ pub use ray::{Hit, Ray};
 pub fn registry() -> Vec<EngineInfo> {
     vec![
         reference::info(),
+        grid::info(),
         bvh::info2(),
         bvh::info4(),
         bvh::info8(),

@@ -29,6 +29,27 @@ pub enum Command {
     Render(RenderArgs),
     /// Cross-check an engine's hits against Embree or the reference engine on the same rays.
     Check(CheckArgs),
+    /// Remeasure a published table: `reproduce list`, `reproduce <id> --out DIR`.
+    Reproduce(ReproduceArgs),
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct ReproduceArgs {
+    /// A table id (see `rtbench reproduce list`), or `list`.
+    pub id: String,
+    /// A scaled-down run for nightly jobs.
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder (DIR/<id>.md, DIR/<id>.json).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Engines, comma-separated (default: every available engine but `reference`).
+    #[arg(long)]
+    pub engines: Option<String>,
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Subcommand, Debug)]

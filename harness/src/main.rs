@@ -28,6 +28,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Engines { json } => commands::engines::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),
+        Command::Reproduce(a) if a.id == "list" => commands::reproduce::list(a.json),
+        Command::Reproduce(a) => {
+            let out = a.out.as_deref().ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            commands::reproduce::run(&a.id, a.quick, out, a.engines.as_deref(), a.threads, a.json)
+        }
     }
 }
 

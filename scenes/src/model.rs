@@ -129,6 +129,11 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// Axis-aligned bounds (see [`ShapeRef::bounds`]).
+    pub fn bounds(&self) -> Bounds {
+        self.as_ref().bounds()
+    }
+
     pub fn as_ref(&self) -> ShapeRef<'_> {
         match self {
             Shape::Sphere { center, radius } => ShapeRef::Sphere {

@@ -31,11 +31,14 @@ pub trait Splitter {
     fn into_order(self) -> Vec<u32>;
 }
 
-/// Eq. 3.4 from the half areas and counts of both sides and the parent's half area.
-#[inline]
-fn split_cost(area_l: f32, n_l: usize, area_r: f32, n_r: usize, area: f32) -> f32 {
-    let inv = if area > 0.0 { 1.0 / area } else { 0.0 };
-    2.0 * T_AABB + (area_l * n_l as f32 + area_r * n_r as f32) * inv * T_TRI
+/// Eq. 3.4 from `A(S1)·N(S1) + A(S2)·N(S2)` (what the searches minimise) and `A(S)`.
+fn split_cost(weighted_area: f32, parent_area: f32) -> f32 {
+    let inv = if parent_area > 0.0 {
+        1.0 / parent_area
+    } else {
+        0.0
+    };
+    2.0 * T_AABB + weighted_area * inv * T_TRI
 }
 
 /// Axes to search: the one given, or all three.
@@ -114,7 +117,7 @@ impl Splitter for Sweep<'_> {
         debug_assert!(n >= 2);
         let (axis, mid, cost) = if median {
             let cb = self.prims.centroid_bounds_of(&self.sorted[0][start..end]);
-            let a = axis.unwrap_or_else(|| cb.extent().max_position());
+            let a = axis.unwrap_or_else(|| cb.largest_axis());
             (a, n / 2, f32::INFINITY)
         } else {
             let mut best = (0, 1, f32::INFINITY);
@@ -139,8 +142,7 @@ impl Splitter for Sweep<'_> {
                     }
                 }
             }
-            let inv = if parent > 0.0 { 1.0 / parent } else { 0.0 };
-            (best.0, best.1, 2.0 * T_AABB + best.2 * inv * T_TRI)
+            (best.0, best.1, split_cost(best.2, parent))
         };
         self.partition(start, start + mid, end, axis);
         Split {
@@ -218,7 +220,7 @@ impl Splitter for Binned<'_> {
             }
         };
         if median {
-            return median_split(ids, axis.unwrap_or_else(|| ext.max_position()));
+            return median_split(ids, axis.unwrap_or_else(|| cb.largest_axis()));
         }
         let nb = self.bins.len();
         let (bins, right_area, right_count) =
@@ -261,7 +263,7 @@ impl Splitter for Binned<'_> {
         }
         let Some((a, k, c)) = best else {
             // All centres coincide (on the allowed axis): any equal-count split.
-            return median_split(ids, axis.unwrap_or_else(|| ext.max_position()));
+            return median_split(ids, axis.unwrap_or_else(|| cb.largest_axis()));
         };
         let scale = nb as f32 * (1.0 - 1e-6) / ext[a];
         let lo = cb.lo[a];
@@ -278,11 +280,10 @@ impl Splitter for Binned<'_> {
                 ids.swap(i, j);
             }
         }
-        let inv = if parent > 0.0 { 1.0 / parent } else { 0.0 };
         Split {
             mid: start + i,
             axis: a,
-            cost: 2.0 * T_AABB + c * inv * T_TRI,
+            cost: split_cost(c, parent),
         }
     }
 

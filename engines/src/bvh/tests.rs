@@ -242,7 +242,8 @@ fn node_counts_are_consistent() {
 /// depth 2, 5 internal nodes, no empty node.
 #[test]
 fn nway_median_of_16_primitives() {
-    let mut inp = input(Program::Tetra, 1, None);
+    let mut inp = input(Program::Tetra, 2, None);
+    assert!(inp.geometry.prims.len() >= 16);
     let mut g = (*inp.geometry).clone();
     g.prims.truncate(16);
     g.prim_object.truncate(16);

@@ -41,7 +41,10 @@ unsafe impl Send for EmbreeEngine {}
 unsafe impl Sync for EmbreeEngine {}
 
 fn build_err(reason: String) -> EngineError {
-    EngineError::Build { engine: "embree".into(), reason }
+    EngineError::Build {
+        engine: "embree".into(),
+        reason,
+    }
 }
 
 impl EmbreeEngine {
@@ -54,9 +57,15 @@ impl EmbreeEngine {
         let mut tri_object = Vec::new();
         let mut user_object = Vec::new();
         let mut user_prims = Vec::new();
-        let ntri = geo.prims.iter().filter(|p| matches!(p, Prim::Triangle(_))).count();
-        if ntri.checked_mul(3).map_or(true, |v| v > u32::MAX as usize) {
-            return Err(build_err(format!("{ntri} triangles: more than Embree's 32-bit indices can address")));
+        let ntri = geo
+            .prims
+            .iter()
+            .filter(|p| matches!(p, Prim::Triangle(_)))
+            .count();
+        if ntri > (u32::MAX / 3) as usize {
+            return Err(build_err(format!(
+                "{ntri} triangles: more than Embree's 32-bit indices can address"
+            )));
         }
         tri_object.reserve_exact(ntri);
 
@@ -85,8 +94,12 @@ impl EmbreeEngine {
         let mut buffer_bytes = 0u64;
         if ntri > 0 {
             // SAFETY: `device.handle` is a live device.
-            let g = Geometry(unsafe { sys::rtcNewGeometry(device.handle, sys::RTCGeometryType::TRIANGLE) });
-            device.check("rtcNewGeometry(TRIANGLE)").map_err(build_err)?;
+            let g = Geometry(unsafe {
+                sys::rtcNewGeometry(device.handle, sys::RTCGeometryType::TRIANGLE)
+            });
+            device
+                .check("rtcNewGeometry(TRIANGLE)")
+                .map_err(build_err)?;
             // SAFETY: `g.0` is a live geometry; Embree returns buffers of the requested item count
             // and stride (or null on failure, checked before use).
             let (vb, ib) = unsafe {
@@ -98,8 +111,14 @@ impl EmbreeEngine {
                     12,
                     3 * ntri,
                 ) as *mut f32;
-                let ib = sys::rtcSetNewGeometryBuffer(g.0, sys::RTCBufferType::INDEX, 0, sys::RTCFormat::UINT3, 12, ntri)
-                    as *mut u32;
+                let ib = sys::rtcSetNewGeometryBuffer(
+                    g.0,
+                    sys::RTCBufferType::INDEX,
+                    0,
+                    sys::RTCFormat::UINT3,
+                    12,
+                    ntri,
+                ) as *mut u32;
                 (vb, ib)
             };
             device.check("rtcSetNewGeometryBuffer").map_err(build_err)?;
@@ -109,7 +128,10 @@ impl EmbreeEngine {
             // SAFETY: non-null buffers of 3·ntri FLOAT3 vertices and ntri UINT3 triangles, 4-byte
             // aligned (Embree aligns to 16), owned by the geometry and written only here.
             let (verts, idx) = unsafe {
-                (std::slice::from_raw_parts_mut(vb, 9 * ntri), std::slice::from_raw_parts_mut(ib, 3 * ntri))
+                (
+                    std::slice::from_raw_parts_mut(vb, 9 * ntri),
+                    std::slice::from_raw_parts_mut(ib, 3 * ntri),
+                )
             };
             let mut t = 0usize;
             for (p, &obj) in geo.prims.iter().zip(&geo.prim_object) {
@@ -143,7 +165,10 @@ impl EmbreeEngine {
             // SAFETY: `device.handle` is live. `ptr` points into a Box the engine keeps, unchanged,
             // until after the scene is released (field order); the callbacks only read it.
             unsafe {
-                let g = Geometry(sys::rtcNewGeometry(device.handle, sys::RTCGeometryType::USER));
+                let g = Geometry(sys::rtcNewGeometry(
+                    device.handle,
+                    sys::RTCGeometryType::USER,
+                ));
                 device.check("rtcNewGeometry(USER)").map_err(build_err)?;
                 sys::rtcSetGeometryUserPrimitiveCount(g.0, user.prims.len() as u32);
                 sys::rtcSetGeometryUserData(g.0, ptr);
@@ -177,7 +202,10 @@ impl EmbreeEngine {
         stats.insert("embree_buffer_bytes".into(), buffer_bytes as f64);
         stats.insert("own_bytes".into(), own_bytes as f64);
         stats.insert("threads".into(), config.threads as f64);
-        stats.insert("embree_version".into(), device.property(sys::RTCDeviceProperty::VERSION) as f64);
+        stats.insert(
+            "embree_version".into(),
+            device.property(sys::RTCDeviceProperty::VERSION) as f64,
+        );
         Ok(EmbreeEngine {
             scene,
             _user: user,
@@ -193,8 +221,14 @@ impl EmbreeEngine {
         let tests = user::TESTS.with(|c| c.replace(0));
         let hits = user::HITS.with(|c| c.replace(0));
         if tests > 0 {
-            *counters.extra.entry("user_primitive_tests".into()).or_insert(0) += tests;
-            *counters.extra.entry("user_primitive_hits".into()).or_insert(0) += hits;
+            *counters
+                .extra
+                .entry("user_primitive_tests".into())
+                .or_insert(0) += tests;
+            *counters
+                .extra
+                .entry("user_primitive_hits".into())
+                .or_insert(0) += hits;
         }
     }
 }
@@ -211,8 +245,17 @@ impl Engine for EmbreeEngine {
             // arguments select Embree's defaults.
             unsafe { sys::rtcIntersect1(self.scene.0, &mut rh.rh, null_mut()) };
             let hit = &rh.rh.hit;
-            *h = match self.objects.get(hit.geomID as usize).and_then(|m| m.get(hit.primID as usize)) {
-                Some(&object) => Hit { t: rh.rh.ray.tfar, object, u: hit.u, v: hit.v },
+            *h = match self
+                .objects
+                .get(hit.geomID as usize)
+                .and_then(|m| m.get(hit.primID as usize))
+            {
+                Some(&object) => Hit {
+                    t: rh.rh.ray.tfar,
+                    object,
+                    u: hit.u,
+                    v: hit.v,
+                },
                 None => Hit::MISS,
             };
         }

@@ -60,7 +60,14 @@ pub struct EmbreeConfig {
 
 impl Default for EmbreeConfig {
     fn default() -> Self {
-        EmbreeConfig { threads: 1, quality: Quality::Medium, robust: false, compact: false, isa: None, verbose: 0 }
+        EmbreeConfig {
+            threads: 1,
+            quality: Quality::Medium,
+            robust: false,
+            compact: false,
+            isa: None,
+            verbose: 0,
+        }
     }
 }
 
@@ -110,7 +117,14 @@ impl EmbreeConfig {
                 reason: format!("expected one of {}", ISAS.join(", ")),
             });
         };
-        Ok(EmbreeConfig { threads, quality, robust, compact, isa, verbose })
+        Ok(EmbreeConfig {
+            threads,
+            quality,
+            robust,
+            compact,
+            isa,
+            verbose,
+        })
     }
 
     /// The device configuration string handed to `rtcNewDevice`.
@@ -127,7 +141,9 @@ impl EmbreeConfig {
 #[cfg(feature = "embree")]
 fn available() -> Result<(), String> {
     static AVAILABLE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
-    AVAILABLE.get_or_init(|| raw::Device::new("verbose=0").map(|_| ())).clone()
+    AVAILABLE
+        .get_or_init(|| raw::Device::new("verbose=0").map(|_| ()))
+        .clone()
 }
 
 #[cfg(not(feature = "embree"))]
@@ -144,7 +160,10 @@ fn build(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, Engi
 #[cfg(not(feature = "embree"))]
 fn build(_input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
     EmbreeConfig::from_settings(settings)?;
-    Err(EngineError::Unavailable { engine: "embree".into(), reason: "built without the embree feature".into() })
+    Err(EngineError::Unavailable {
+        engine: "embree".into(),
+        reason: "built without the embree feature".into(),
+    })
 }
 
 /// Embree's version as `major.minor.patch` (for the results' environment), or why there is none.

@@ -40,7 +40,9 @@ unsafe extern "C" fn error_callback(ptr: *mut c_void, code: sys::RTCError, msg: 
         String::new()
     } else {
         // SAFETY: Embree passes a NUL-terminated string valid for the duration of the call.
-        unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()
+        unsafe { CStr::from_ptr(msg) }
+            .to_string_lossy()
+            .into_owned()
     };
     if let Ok(mut e) = state.last_error.lock() {
         *e = Some(format!("{code:?}: {text}"));
@@ -60,7 +62,8 @@ impl Device {
     /// A device with configuration `config` (e.g. `threads=1,verbose=0`), with a memory monitor
     /// and an error callback installed.
     pub fn new(config: &str) -> Result<Device, String> {
-        let c = CString::new(config).map_err(|_| "the Embree configuration contains a NUL byte".to_string())?;
+        let c = CString::new(config)
+            .map_err(|_| "the Embree configuration contains a NUL byte".to_string())?;
         // SAFETY: `c` is a valid NUL-terminated string that outlives the call; Embree copies
         // what it needs from it.
         let handle = unsafe { sys::rtcNewDevice(c.as_ptr()) };
@@ -88,7 +91,13 @@ impl Device {
         if code == sys::RTCError::NONE {
             return Ok(());
         }
-        let msg = self.state.last_error.lock().ok().and_then(|mut e| e.take()).unwrap_or_default();
+        let msg = self
+            .state
+            .last_error
+            .lock()
+            .ok()
+            .and_then(|mut e| e.take())
+            .unwrap_or_default();
         Err(format!("{what} failed: {code:?} ({msg})"))
     }
 
@@ -108,7 +117,10 @@ impl Device {
 
     /// Bytes Embree holds on this device now, and their peak so far.
     pub fn memory(&self) -> (i64, i64) {
-        (self.state.bytes.load(Ordering::Relaxed), self.state.peak_bytes.load(Ordering::Relaxed))
+        (
+            self.state.bytes.load(Ordering::Relaxed),
+            self.state.peak_bytes.load(Ordering::Relaxed),
+        )
     }
 }
 

@@ -8,10 +8,18 @@ fn config_defaults_and_device_string() {
     let kv = |k: &str, v: &str| (k.to_string(), v.to_string());
     let c = EmbreeConfig::from_settings(Settings::new(
         "embree",
-        vec![kv("threads", "0"), kv("quality", "high"), kv("robust", "true"), kv("isa", "avx2")],
+        vec![
+            kv("threads", "0"),
+            kv("quality", "high"),
+            kv("robust", "true"),
+            kv("isa", "avx2"),
+        ],
     ))
     .unwrap();
-    assert_eq!((c.threads, c.quality, c.robust, c.compact), (0, Quality::High, true, false));
+    assert_eq!(
+        (c.threads, c.quality, c.robust, c.compact),
+        (0, Quality::High, true, false)
+    );
     assert_eq!(c.device_config(), "threads=0,verbose=0,isa=avx2");
 }
 
@@ -19,16 +27,31 @@ fn config_defaults_and_device_string() {
 fn config_rejects_unknown_keys_and_values() {
     let kv = |k: &str, v: &str| vec![(k.to_string(), v.to_string())];
     let err = |s| EmbreeConfig::from_settings(Settings::new("embree", s)).unwrap_err();
-    assert!(matches!(err(kv("leaf", "4")), EngineError::UnknownKey { .. }));
-    assert!(matches!(err(kv("quality", "best")), EngineError::BadValue { .. }));
-    assert!(matches!(err(kv("isa", "avx2,threads=8")), EngineError::BadValue { .. }));
-    assert!(matches!(err(kv("threads", "-1")), EngineError::BadValue { .. }));
+    assert!(matches!(
+        err(kv("leaf", "4")),
+        EngineError::UnknownKey { .. }
+    ));
+    assert!(matches!(
+        err(kv("quality", "best")),
+        EngineError::BadValue { .. }
+    ));
+    assert!(matches!(
+        err(kv("isa", "avx2,threads=8")),
+        EngineError::BadValue { .. }
+    ));
+    assert!(matches!(
+        err(kv("threads", "-1")),
+        EngineError::BadValue { .. }
+    ));
 }
 
 #[cfg(not(feature = "embree"))]
 #[test]
 fn unavailable_without_the_feature() {
-    assert_eq!((info().available)(), Err("built without the embree feature".to_string()));
+    assert_eq!(
+        (info().available)(),
+        Err("built without the embree feature".to_string())
+    );
     assert!(version().is_err());
 }
 
@@ -44,19 +67,39 @@ mod with_embree {
 
     fn input(shapes: Vec<Shape>) -> BuildInput {
         let scene = Scene {
-            objects: shapes.into_iter().map(|shape| Object { material: 0, shape }).collect(),
+            objects: shapes
+                .into_iter()
+                .map(|shape| Object { material: 0, shape })
+                .collect(),
             ..Default::default()
         };
-        BuildInput { geometry: Arc::new(Geometry::from_scene(&scene)), scene: Arc::new(scene) }
+        BuildInput {
+            geometry: Arc::new(Geometry::from_scene(&scene)),
+            scene: Arc::new(scene),
+        }
+    }
+
+    /// Builds through the registry entry itself (whether or not `registry()` lists it).
+    fn build_embree(
+        input: &BuildInput,
+        settings: Vec<(String, String)>,
+    ) -> Result<Box<dyn Engine>, EngineError> {
+        (info().build)(input, Settings::new("embree", settings))
     }
 
     fn engine(shapes: Vec<Shape>, settings: &[(&str, &str)]) -> Box<dyn Engine> {
-        let settings = settings.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
-        crate::build_engine("embree", &input(shapes), settings).unwrap()
+        let settings = settings
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        build_embree(&input(shapes), settings).unwrap()
     }
 
     fn tri(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Shape {
-        Shape::Patch { vertices: vec![a.into(), b.into(), c.into()], normals: vec![DVec3::Z; 3] }
+        Shape::Patch {
+            vertices: vec![a.into(), b.into(), c.into()],
+            normals: vec![DVec3::Z; 3],
+        }
     }
 
     fn trace(e: &dyn Engine, r: Ray) -> (Hit, bool, Counters) {
@@ -77,18 +120,33 @@ mod with_embree {
 
     #[test]
     fn one_ray_one_triangle() {
-        let e = engine(vec![tri([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])], &[]);
-        let (h, occ, c) = trace(&*e, Ray::new(Vec3::new(0.25, 0.5, -1.0), Vec3::Z, 0.0, f32::INFINITY));
+        let e = engine(
+            vec![tri([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])],
+            &[],
+        );
+        let (h, occ, c) = trace(
+            &*e,
+            Ray::new(Vec3::new(0.25, 0.5, -1.0), Vec3::Z, 0.0, f32::INFINITY),
+        );
         assert_eq!(h.object, 0);
         assert!((h.t - 1.0).abs() < 1e-6, "{h:?}");
         // u, v weigh vertices 1 and 2, as the shared kernels do.
-        assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6, "{h:?}");
+        assert!(
+            (h.u - 0.25).abs() < 1e-6 && (h.v - 0.5).abs() < 1e-6,
+            "{h:?}"
+        );
         assert!(occ);
         assert_eq!(c.rays, 2);
         // Miss beside it, and a segment that ends before it.
-        let (h, occ, _) = trace(&*e, Ray::new(Vec3::new(0.75, 0.75, -1.0), Vec3::Z, 0.0, f32::INFINITY));
+        let (h, occ, _) = trace(
+            &*e,
+            Ray::new(Vec3::new(0.75, 0.75, -1.0), Vec3::Z, 0.0, f32::INFINITY),
+        );
         assert!(!h.is_hit() && !occ);
-        let (h, occ, _) = trace(&*e, Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::Z, 0.0, 0.5));
+        let (h, occ, _) = trace(
+            &*e,
+            Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::Z, 0.0, 0.5),
+        );
         assert!(!h.is_hit() && !occ);
     }
 
@@ -97,30 +155,53 @@ mod with_embree {
         let e = engine(
             vec![
                 tri([-10.0, -10.0, 10.0], [10.0, -10.0, 10.0], [0.0, 10.0, 10.0]),
-                Shape::Sphere { center: DVec3::new(0.0, 0.0, 0.0), radius: 1.0 },
-                Shape::Cone { base: DVec3::new(5.0, 0.0, -1.0), base_radius: 1.0, apex: DVec3::new(5.0, 0.0, 1.0), apex_radius: 0.0 },
+                Shape::Sphere {
+                    center: DVec3::new(0.0, 0.0, 0.0),
+                    radius: 1.0,
+                },
+                Shape::Cone {
+                    base: DVec3::new(5.0, 0.0, -1.0),
+                    base_radius: 1.0,
+                    apex: DVec3::new(5.0, 0.0, 1.0),
+                    apex_radius: 0.0,
+                },
             ],
             &[],
         );
         // Sphere from outside, then from inside (a refraction ray): the far side.
-        let (h, occ, c) = trace(&*e, Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 0.0, f32::INFINITY));
+        let (h, occ, c) = trace(
+            &*e,
+            Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 0.0, f32::INFINITY),
+        );
         assert_eq!(h.object, 1);
         assert!((h.t - 4.0).abs() < 1e-5 && occ, "{h:?}");
         // The occlusion query may stop at the triangle behind without testing the sphere.
-        assert!(c.extra["user_primitive_tests"] >= 1 && c.extra["user_primitive_hits"] >= 1, "{c:?}");
+        assert!(
+            c.extra["user_primitive_tests"] >= 1 && c.extra["user_primitive_hits"] >= 1,
+            "{c:?}"
+        );
         let (h, _, _) = trace(&*e, Ray::new(Vec3::ZERO, Vec3::Z, 1e-4, f32::INFINITY));
         assert_eq!(h.object, 1);
         assert!((h.t - 1.0).abs() < 1e-5, "{h:?}");
         // Cone: radius 0.5 at z = 0, so a ray along x at z = 0 hits at x = 4.5.
-        let (h, occ, _) = trace(&*e, Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::X, 0.0, f32::INFINITY));
+        let (h, occ, _) = trace(
+            &*e,
+            Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::X, 0.0, f32::INFINITY),
+        );
         assert_eq!(h.object, 2);
         assert!((h.t - 2.5).abs() < 1e-5 && occ, "{h:?}");
         // Open: in through the missing base cap, onto the inside wall where the radius is 0.5.
-        let (h, _, _) = trace(&*e, Ray::new(Vec3::new(5.0, 0.5, -5.0), Vec3::Z, 0.0, f32::INFINITY));
+        let (h, _, _) = trace(
+            &*e,
+            Ray::new(Vec3::new(5.0, 0.5, -5.0), Vec3::Z, 0.0, f32::INFINITY),
+        );
         assert_eq!(h.object, 2, "{h:?}");
         assert!((h.t - 5.0).abs() < 1e-4, "{h:?}");
         // Past the cone, onto the triangle.
-        let (h, _, _) = trace(&*e, Ray::new(Vec3::new(5.0, -5.0, -5.0), Vec3::Z, 0.0, f32::INFINITY));
+        let (h, _, _) = trace(
+            &*e,
+            Ray::new(Vec3::new(5.0, -5.0, -5.0), Vec3::Z, 0.0, f32::INFINITY),
+        );
         assert_eq!(h.object, 0, "{h:?}");
         assert!((h.t - 15.0).abs() < 1e-4, "{h:?}");
     }
@@ -128,11 +209,24 @@ mod with_embree {
     #[test]
     fn concave_polygon_hits_name_the_polygon() {
         // An L-shaped polygon (object 1) behind a small triangle (object 0) off to the side.
-        let l: Vec<DVec3> = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
-            .iter()
-            .map(|&(x, y)| DVec3::new(x, y, 0.0))
-            .collect();
-        let e = engine(vec![tri([5.0, 5.0, 0.0], [6.0, 5.0, 0.0], [5.0, 6.0, 0.0]), Shape::Polygon(l)], &[]);
+        let l: Vec<DVec3> = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .collect();
+        let e = engine(
+            vec![
+                tri([5.0, 5.0, 0.0], [6.0, 5.0, 0.0], [5.0, 6.0, 0.0]),
+                Shape::Polygon(l),
+            ],
+            &[],
+        );
         let at = |x: f32, y: f32| trace(&*e, Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z, 0.0, 10.0)).0;
         assert_eq!(at(0.5, 0.5).object, 1);
         assert_eq!(at(0.5, 1.5).object, 1);
@@ -167,9 +261,21 @@ mod with_embree {
         for i in 0..300 {
             let c = rng.v(-10.0, 10.0);
             shapes.push(match i % 4 {
-                0 => Shape::Sphere { center: c, radius: 0.2 + rng.f() },
-                1 => Shape::Cone { base: c, base_radius: 0.2 + 0.5 * rng.f(), apex: c + rng.v(-1.5, 1.5), apex_radius: 0.5 * rng.f() },
-                2 => tri((c + rng.v(-1.0, 1.0)).into(), (c + rng.v(-1.0, 1.0)).into(), (c + rng.v(-1.0, 1.0)).into()),
+                0 => Shape::Sphere {
+                    center: c,
+                    radius: 0.2 + rng.f(),
+                },
+                1 => Shape::Cone {
+                    base: c,
+                    base_radius: 0.2 + 0.5 * rng.f(),
+                    apex: c + rng.v(-1.5, 1.5),
+                    apex_radius: 0.5 * rng.f(),
+                },
+                2 => tri(
+                    (c + rng.v(-1.0, 1.0)).into(),
+                    (c + rng.v(-1.0, 1.0)).into(),
+                    (c + rng.v(-1.0, 1.0)).into(),
+                ),
                 _ => {
                     let (a, b) = (rng.v(-1.0, 1.0), rng.v(-1.0, 1.0));
                     Shape::Polygon(vec![c, c + a, c + a + b, c + b])
@@ -186,7 +292,7 @@ mod with_embree {
         let inp = input(shapes);
         let reference = crate::build_engine("reference", &inp, vec![]).unwrap();
         for settings in [vec![], vec![("robust".to_string(), "true".to_string())]] {
-            let embree = crate::build_engine("embree", &inp, settings).unwrap();
+            let embree = build_embree(&inp, settings).unwrap();
             let rays: Vec<Ray> = (0..4000)
                 .map(|_| {
                     let o = rng.v(-15.0, 15.0).as_vec3();
@@ -213,8 +319,15 @@ mod with_embree {
             }
             let occ_disagree = oe.iter().zip(&or).filter(|(a, b)| a != b).count();
             // f32 against f64 disagrees only on grazing rays and shared edges: a handful at most.
-            assert!(disagree <= rays.len() / 500, "{disagree} of {} rays disagree", rays.len());
-            assert!(occ_disagree <= rays.len() / 500, "{occ_disagree} occlusion answers disagree");
+            assert!(
+                disagree <= rays.len() / 500,
+                "{disagree} of {} rays disagree",
+                rays.len()
+            );
+            assert!(
+                occ_disagree <= rays.len() / 500,
+                "{occ_disagree} occlusion answers disagree"
+            );
             assert_eq!(c.rays, 4 * rays.len() as u64);
         }
     }
@@ -223,12 +336,22 @@ mod with_embree {
     fn memory_and_stats_are_reported() {
         let mut rng = Rng(7);
         let inp = input(random_scene(&mut rng));
-        let e = crate::build_engine("embree", &inp, vec![]).unwrap();
+        let e = build_embree(&inp, vec![]).unwrap();
         let s = e.build_stats();
-        assert!(s["embree_bytes"] > 0.0 && s["embree_peak_bytes"] >= s["embree_bytes"], "{s:?}");
+        assert!(
+            s["embree_bytes"] > 0.0 && s["embree_peak_bytes"] >= s["embree_bytes"],
+            "{s:?}"
+        );
         assert!(s["embree_bytes"] >= s["embree_buffer_bytes"], "{s:?}");
         assert!(e.structure_bytes() as f64 >= s["embree_bytes"] + s["own_bytes"] - 0.5);
-        assert_eq!(s["triangles"] as usize, inp.geometry.prims.iter().filter(|p| matches!(p, crate::geometry::Prim::Triangle(_))).count());
+        assert_eq!(
+            s["triangles"] as usize,
+            inp.geometry
+                .prims
+                .iter()
+                .filter(|p| matches!(p, crate::geometry::Prim::Triangle(_)))
+                .count()
+        );
         assert_eq!(s["user_primitives"], 150.0);
         assert!(s["embree_version"] >= 40000.0);
     }
@@ -237,9 +360,17 @@ mod with_embree {
     fn answers_from_several_threads_at_once() {
         let mut rng = Rng(11);
         let inp = input(random_scene(&mut rng));
-        let e = crate::build_engine("embree", &inp, vec![("threads".into(), "2".into())]).unwrap();
-        let rays: Vec<Ray> =
-            (0..2000).map(|_| Ray::new(rng.v(-15.0, 15.0).as_vec3(), rng.v(-1.0, 1.0).as_vec3(), 0.0, f32::INFINITY)).collect();
+        let e = build_embree(&inp, vec![("threads".into(), "2".into())]).unwrap();
+        let rays: Vec<Ray> = (0..2000)
+            .map(|_| {
+                Ray::new(
+                    rng.v(-15.0, 15.0).as_vec3(),
+                    rng.v(-1.0, 1.0).as_vec3(),
+                    0.0,
+                    f32::INFINITY,
+                )
+            })
+            .collect();
         let run = || {
             let mut h = vec![Hit::MISS; rays.len()];
             e.intersect(&rays, &mut h, &mut Counters::default());

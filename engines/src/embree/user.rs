@@ -28,9 +28,12 @@ fn test(p: &Prim, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<f32> {
     TESTS.with(|c| c.set(c.get() + 1));
     let t = match *p {
         Prim::Sphere { center, radius } => k::sphere(o, d, tmin, tmax, center, radius),
-        Prim::Cone { base, base_radius, apex, apex_radius } => {
-            k::cone(o, d, tmin, tmax, base, base_radius, apex, apex_radius)
-        }
+        Prim::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+        } => k::cone(o, d, tmin, tmax, base, base_radius, apex, apex_radius),
         // Triangles go to Embree's own triangle geometry, never here.
         Prim::Triangle(_) => None,
     };
@@ -48,7 +51,9 @@ pub unsafe extern "C" fn bounds(args: *const sys::RTCBoundsFunctionArguments) {
         let a = &*args;
         (a, &*(a.geometryUserPtr as *const UserPrims))
     };
-    let Some(p) = data.prims.get(args.primID as usize) else { return };
+    let Some(p) = data.prims.get(args.primID as usize) else {
+        return;
+    };
     let (lo, hi) = p.bounds();
     // SAFETY: `bounds_o` points to one writable `RTCBounds` (Embree's contract).
     unsafe {
@@ -71,7 +76,9 @@ pub unsafe extern "C" fn intersect(args: *const sys::RTCIntersectFunctionNArgume
         let a = &*args;
         (a, &*(a.geometryUserPtr as *const UserPrims))
     };
-    let Some(p) = data.prims.get(a.primID as usize) else { return };
+    let Some(p) = data.prims.get(a.primID as usize) else {
+        return;
+    };
     let n = a.N as usize;
     let f = a.rayhit as *mut f32;
     for i in 0..n {
@@ -106,7 +113,9 @@ pub unsafe extern "C" fn occluded(args: *const sys::RTCOccludedFunctionNArgument
         let a = &*args;
         (a, &*(a.geometryUserPtr as *const UserPrims))
     };
-    let Some(p) = data.prims.get(a.primID as usize) else { return };
+    let Some(p) = data.prims.get(a.primID as usize) else {
+        return;
+    };
     let n = a.N as usize;
     let f = a.ray as *mut f32;
     for i in 0..n {

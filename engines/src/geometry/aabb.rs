@@ -67,6 +67,18 @@ impl Aabb {
         (self.hi - self.lo).max(Vec3::ZERO)
     }
 
+    /// The axis (0, 1, 2) along which the box is longest (the first of equals).
+    pub fn largest_axis(&self) -> usize {
+        let e = self.extent();
+        if e.x >= e.y && e.x >= e.z {
+            0
+        } else if e.y >= e.z {
+            1
+        } else {
+            2
+        }
+    }
+
     /// Half the surface area (xy + yz + zx): what the surface area heuristic compares (the
     /// factor 2 cancels in every ratio). Zero for an empty box.
     #[inline]

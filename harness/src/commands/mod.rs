@@ -3,4 +3,5 @@
 pub mod check;
 pub mod engines;
 pub mod render;
+pub mod reproduce;
 pub mod scene;

@@ -56,6 +56,8 @@ pub struct GenerationStats {
     pub shadow_blocked: u64,
     pub reflect: u64,
     pub refract: u64,
+    /// Hits on transmitting surfaces that spawned no refraction ray: total internal reflection.
+    pub total_internal_reflections: u64,
 }
 
 /// Ray statistics of a whole render (the columns of the SPD table).
@@ -283,7 +285,8 @@ pub fn render(
             }
             if kt > 0.0 {
                 let ior = m.ior as f32;
-                let eta = if path.inside { ior } else { 1.0 / ior };
+                let inside = path.inside;
+                let eta = if inside { ior } else { 1.0 / ior };
                 let cos_i = -d.dot(ns);
                 let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
                 if k >= 0.0 {
@@ -293,9 +296,11 @@ pub fn render(
                         corner: path.corner,
                         weight: path.weight * kt * color,
                         depth: path.depth + 1,
-                        inside: !path.inside,
+                        inside: !inside,
                     });
                     g.refract += 1;
+                } else {
+                    g.total_internal_reflections += 1;
                 }
             }
         }

@@ -1,0 +1,356 @@
+//! Tracing rays through the grid: 3D-DDA (Amanatides and Woo 1987; seed 000 §1.1, seed 002 §1.5)
+//! over the cells the ray crosses, near to far, testing the primitives registered in each.
+//!
+//! Closest hit. Seed 002 §1.6: a hit counts only once traversal has reached the cell that holds
+//! it, because a primitive spanning several cells may be hit in a later cell, beyond another
+//! primitive's nearer hit there. With mailboxes a primitive is tested once, in the first cell
+//! that lists it, so its hit cannot wait to be found again later: instead the nearest hit so far
+//! is kept across cells (it shortens the ray, so later tests only accept nearer hits), and
+//! traversal stops at the end of the first cell whose exit lies beyond it. Both give the nearest
+//! hit; this one never tests a primitive twice.
+//!
+//! Any hit stops at the first primitive that blocks the segment, wherever it lies: an occlusion
+//! query needs no order.
+//!
+//! Rayshade's extras (seed 000 §3.4), each a switch:
+//! - per-voxel ray–box culling (Snyder and Barr 1987; Rayshade's `CheckVoxel`): before testing a
+//!   primitive in a cell, the bounding box of the ray's piece inside that cell is compared with
+//!   the primitive's bounding box. A primitive culled so is not marked in the mailbox, since a
+//!   later piece of the ray may still reach it (as in Rayshade).
+//! - the shadow cache ([`super::shadow_cache`]), for any-hit queries.
+//!
+//! Per ray nothing is allocated: the inverse direction and the watertight set-up are computed
+//! once, the mailbox and shadow cache belong to the calling batch.
+
+use super::mailbox::Mailbox;
+use super::shadow_cache::{Key, ShadowCache};
+use super::Grid;
+use crate::engine::Counters;
+use crate::geometry::kernels::f32::WatertightRay;
+use crate::ray::{Hit, Ray};
+use glam::Vec3;
+
+/// Per-ray set-up shared by every primitive test and by the walk.
+struct RaySetup {
+    /// 1/d per axis, or 0 along an axis the ray does not move on.
+    inv: [f32; 3],
+    /// Whether the ray moves along each axis (1/d is finite).
+    moves: [bool; 3],
+    wt: WatertightRay,
+}
+
+impl RaySetup {
+    #[inline]
+    fn new(ray: &Ray) -> RaySetup {
+        let d = ray.dir.to_array();
+        let mut inv = [0.0; 3];
+        let mut moves = [false; 3];
+        for i in 0..3 {
+            let v = 1.0 / d[i];
+            if v.is_finite() {
+                inv[i] = v;
+                moves[i] = true;
+            }
+        }
+        RaySetup {
+            inv,
+            moves,
+            wt: WatertightRay::new(ray.dir),
+        }
+    }
+}
+
+/// Counts kept in locals during a batch and added to `Counters` once at its end.
+#[derive(Default)]
+pub struct Local {
+    culled: u64,
+    cache_misses: u64,
+}
+
+impl Local {
+    pub fn flush(&self, c: &mut Counters, cull: bool, cache: bool) {
+        if cull {
+            *c.extra.entry("voxel_culled".into()).or_insert(0) += self.culled;
+        }
+        if cache {
+            *c.extra.entry("shadow_cache_misses".into()).or_insert(0) += self.cache_misses;
+        }
+    }
+}
+
+impl Grid {
+    /// Walks the cells `ray` crosses within `[ray.tmin, ray.tmax]`, near to far, calling
+    /// `visit(cell, t_enter, t_exit)` for each until it returns true or the ray leaves the grid
+    /// or ends. Amanatides–Woo: per axis the next wall's t, stepping the axis whose wall comes
+    /// first. The wall's t is recomputed from its plane at each step instead of accumulated, so
+    /// rounding does not drift along long rays.
+    #[inline(always)]
+    fn walk(&self, ray: &Ray, s: &RaySetup, mut visit: impl FnMut(usize, f32, f32) -> bool) {
+        let g = &self.cells;
+        let o = ray.origin.to_array();
+        let lo = g.lo.to_array();
+        let hi = g.hi.to_array();
+        let cell = g.cell.to_array();
+        // Clip the segment to the grid's box (slab test).
+        let (mut t0, mut t1) = (ray.tmin, ray.tmax);
+        for i in 0..3 {
+            if s.moves[i] {
+                let ta = (lo[i] - o[i]) * s.inv[i];
+                let tb = (hi[i] - o[i]) * s.inv[i];
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            } else if o[i] < lo[i] || o[i] > hi[i] {
+                return;
+            }
+        }
+        if !(t0 <= t1) {
+            return;
+        }
+        let start = g.cell_of(ray.at(t0));
+        let res = g.res;
+        let stride = [1i64, res[0] as i64, res[0] as i64 * res[1] as i64];
+        let mut idx = [start[0] as i64, start[1] as i64, start[2] as i64];
+        let mut step = [0i64; 3];
+        let mut out = [0i64; 3];
+        let mut next = [f32::INFINITY; 3];
+        for i in 0..3 {
+            if !s.moves[i] {
+                continue;
+            }
+            if s.inv[i] > 0.0 {
+                step[i] = 1;
+                out[i] = res[i] as i64;
+            } else {
+                step[i] = -1;
+                out[i] = -1;
+            }
+            next[i] = wall(lo[i], cell[i], idx[i], step[i], o[i], s.inv[i]);
+        }
+        let mut id = idx[0] + stride[1] * idx[1] + stride[2] * idx[2];
+        let mut t_enter = t0;
+        loop {
+            // The axis whose wall comes first (ties: x, then y, then z; the next step takes
+            // the other, so a ray through an edge visits both cells' neighbours in turn).
+            let a = if next[0] <= next[1] && next[0] <= next[2] {
+                0
+            } else if next[1] <= next[2] {
+                1
+            } else {
+                2
+            };
+            let t_exit = next[a];
+            if visit(id as usize, t_enter, t_exit.min(t1)) || t_exit >= t1 {
+                return;
+            }
+            idx[a] += step[a];
+            if idx[a] == out[a] {
+                return;
+            }
+            id += step[a] * stride[a];
+            t_enter = t_exit;
+            next[a] = wall(lo[a], cell[a], idx[a], step[a], o[a], s.inv[a]);
+        }
+    }
+
+    /// The nearest hit of one ray.
+    #[inline]
+    pub(super) fn closest(&self, ray: &Ray, mb: &mut Option<Mailbox>, c: &mut Counters, l: &mut Local) -> Hit {
+        c.rays += 1;
+        let s = RaySetup::new(ray);
+        let prims = &self.geometry.prims;
+        let test = self.config.triangle;
+        let mut r = *ray;
+        let mut best = u32::MAX;
+        let (mut bu, mut bv) = (0.0, 0.0);
+        // Primitives kept out of the grid (the floor) first: a near floor hit shortens the walk.
+        for &p in &self.floor {
+            c.primitive_tests += 1;
+            if let Some((t, u, v)) = prims[p as usize].intersect(&r, test, &s.wt) {
+                c.primitive_hits += 1;
+                (r.tmax, best, bu, bv) = (t, p, u, v);
+            }
+        }
+        if !self.cells.refs.is_empty() {
+            if let Some(m) = mb.as_mut() {
+                m.next_ray();
+            }
+            let cull = !self.prim_bounds.is_empty();
+            let g = &self.cells;
+            self.walk(ray, &s, |cell, t_enter, t_exit| {
+                c.cells_visited += 1;
+                let list = g.prims_in(cell);
+                if list.is_empty() {
+                    c.empty_cells_visited += 1;
+                    return r.tmax <= t_exit;
+                }
+                let piece = if cull {
+                    segment_box(&r, t_enter, t_exit.min(r.tmax), g.pad)
+                } else {
+                    (Vec3::ZERO, Vec3::ZERO)
+                };
+                for &p in list {
+                    if let Some(m) = mb.as_ref() {
+                        if m.tested(p) {
+                            c.mailbox_skips += 1;
+                            continue;
+                        }
+                    }
+                    if cull {
+                        c.box_tests += 1;
+                        let [blo, bhi] = self.prim_bounds[p as usize];
+                        if blo.cmpgt(piece.1).any() || bhi.cmplt(piece.0).any() {
+                            l.culled += 1;
+                            continue;
+                        }
+                    }
+                    if let Some(m) = mb.as_mut() {
+                        m.mark(p);
+                    }
+                    c.primitive_tests += 1;
+                    if let Some((t, u, v)) = prims[p as usize].intersect(&r, test, &s.wt) {
+                        c.primitive_hits += 1;
+                        (r.tmax, best, bu, bv) = (t, p, u, v);
+                    }
+                }
+                // Seed 002 §1.6: stop once the nearest hit lies within the cells walked.
+                r.tmax <= t_exit
+            });
+        }
+        if best == u32::MAX {
+            Hit::MISS
+        } else {
+            Hit {
+                t: r.tmax,
+                object: self.geometry.prim_object[best as usize],
+                u: bu,
+                v: bv,
+            }
+        }
+    }
+
+    /// Whether anything blocks one ray's segment.
+    #[inline]
+    pub(super) fn any(
+        &self,
+        ray: &Ray,
+        mb: &mut Option<Mailbox>,
+        cache: Option<&mut ShadowCache>,
+        c: &mut Counters,
+        l: &mut Local,
+    ) -> bool {
+        c.rays += 1;
+        let s = RaySetup::new(ray);
+        let prims = &self.geometry.prims;
+        let test = self.config.triangle;
+        if let Some(m) = mb.as_mut() {
+            m.next_ray();
+        }
+        // The shadow cache: try the light's last blocker first.
+        let key = cache.as_ref().and_then(|_| Key::of(ray));
+        if let (Some(cache), Some(key)) = (cache.as_deref(), key.as_ref()) {
+            if let Some(p) = cache.blocker(key) {
+                c.primitive_tests += 1;
+                if prims[p as usize].intersect(ray, test, &s.wt).is_some() {
+                    c.primitive_hits += 1;
+                    c.shadow_cache_hits += 1;
+                    return true;
+                }
+                l.cache_misses += 1;
+                // Tested and missed: the walk need not test it again.
+                if let Some(m) = mb.as_mut() {
+                    m.mark(p);
+                }
+            }
+        }
+        let mut blocker = u32::MAX;
+        for &p in &self.floor {
+            c.primitive_tests += 1;
+            if prims[p as usize].intersect(ray, test, &s.wt).is_some() {
+                c.primitive_hits += 1;
+                blocker = p;
+                break;
+            }
+        }
+        if blocker == u32::MAX && !self.cells.refs.is_empty() {
+            let cull = !self.prim_bounds.is_empty();
+            let g = &self.cells;
+            self.walk(ray, &s, |cell, t_enter, t_exit| {
+                c.cells_visited += 1;
+                let list = g.prims_in(cell);
+                if list.is_empty() {
+                    c.empty_cells_visited += 1;
+                    return false;
+                }
+                let piece = if cull {
+                    segment_box(ray, t_enter, t_exit, g.pad)
+                } else {
+                    (Vec3::ZERO, Vec3::ZERO)
+                };
+                for &p in list {
+                    if let Some(m) = mb.as_ref() {
+                        if m.tested(p) {
+                            c.mailbox_skips += 1;
+                            continue;
+                        }
+                    }
+                    if cull {
+                        c.box_tests += 1;
+                        let [blo, bhi] = self.prim_bounds[p as usize];
+                        if blo.cmpgt(piece.1).any() || bhi.cmplt(piece.0).any() {
+                            l.culled += 1;
+                            continue;
+                        }
+                    }
+                    if let Some(m) = mb.as_mut() {
+                        m.mark(p);
+                    }
+                    c.primitive_tests += 1;
+                    if prims[p as usize].intersect(ray, test, &s.wt).is_some() {
+                        c.primitive_hits += 1;
+                        blocker = p;
+                        return true;
+                    }
+                }
+                false
+            });
+        }
+        if blocker == u32::MAX {
+            return false;
+        }
+        if let (Some(cache), Some(key)) = (cache, key.as_ref()) {
+            cache.remember(key, blocker);
+        }
+        true
+    }
+}
+
+/// The t of the next wall along one axis from cell `idx`, moving by `step`: the wall is the
+/// cell's upper plane when moving up, its lower plane when moving down.
+#[inline(always)]
+fn wall(lo: f32, cell: f32, idx: i64, step: i64, o: f32, inv: f32) -> f32 {
+    let k = if step > 0 { idx + 1 } else { idx };
+    (lo + k as f32 * cell - o) * inv
+}
+
+/// The bounding box of the ray's piece from `t0` to `t1`, grown by `pad` against rounding.
+#[inline(always)]
+fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3, Vec3) {
+    let a = ray.at(t0);
+    let b = ray.at(t1);
+    (a.min(b) - pad, a.max(b) + pad)
+}
+
+/// The cells a ray visits, in order, as (x, y, z): for tests and debugging (seed 002 §1.7's
+/// "cells visited by this pixel's ray").
+#[cfg(test)]
+pub fn cells_along(grid: &Grid, ray: &Ray) -> Vec<[u32; 3]> {
+    let s = RaySetup::new(ray);
+    let r = grid.cells.res;
+    let mut out = Vec::new();
+    grid.walk(ray, &s, |c, _, _| {
+        let c = c as u32;
+        out.push([c % r[0], (c / r[0]) % r[1], c / (r[0] * r[1])]);
+        false
+    });
+    out
+}
