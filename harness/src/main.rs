@@ -30,13 +30,22 @@ fn run(cli: Cli) -> Result<()> {
         Command::Check(a) => commands::check::run(&a),
         Command::Reproduce(a) if a.id == "list" => commands::reproduce::list(a.json),
         Command::Reproduce(a) => {
-            let out = a.out.as_deref().ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            let out = a
+                .out
+                .as_deref()
+                .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
             commands::reproduce::run(&a.id, a.quick, out, a.engines.as_deref(), a.threads, a.json)
         }
     }
 }
 
 fn main() {
+    // Rust ignores SIGPIPE, so `rtbench … | head` would panic in println!. Restore the default:
+    // the process ends quietly when its reader goes away, as other Unix tools do.
+    // SAFETY: signal() with SIG_DFL touches no Rust state; it runs before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

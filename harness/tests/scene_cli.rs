@@ -5,7 +5,10 @@ use serde_json::Value;
 use std::process::{Command, Output};
 
 fn rtbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbench")).args(args).output().expect("rtbench runs")
+    Command::new(env!("CARGO_BIN_EXE_rtbench"))
+        .args(args)
+        .output()
+        .expect("rtbench runs")
 }
 
 fn stats(program: &str, sf: u32, extra: &[&str]) -> Value {
@@ -13,7 +16,11 @@ fn stats(program: &str, sf: u32, extra: &[&str]) -> Value {
     let mut args = vec!["scene", "stats", program, "--sf", &sf, "--json"];
     args.extend_from_slice(extra);
     let out = rtbench(&args);
-    assert!(out.status.success(), "{program} {sf}: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{program} {sf}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("one JSON document on stdout")
 }
 
@@ -47,8 +54,15 @@ fn counts_equal_the_spd_formulas_by_streaming() {
         for sf in sfs.clone() {
             let v = stats(program, sf, &[]);
             let c = &v["counts"];
-            let objects: u64 = ["sphere", "cone", "polygon", "patch"].iter().map(|k| c[k].as_u64().unwrap()).sum();
-            assert_eq!(objects as u128, formula(program, sf), "{program} sf {sf}: {v}");
+            let objects: u64 = ["sphere", "cone", "polygon", "patch"]
+                .iter()
+                .map(|k| c[k].as_u64().unwrap())
+                .sum();
+            assert_eq!(
+                objects as u128,
+                formula(program, sf),
+                "{program} sf {sf}: {v}"
+            );
             assert_eq!(v["objects"].as_u64().unwrap(), objects);
             assert_eq!(v["sf"].as_u64().unwrap(), sf as u64);
         }
@@ -61,9 +75,17 @@ fn counts_equal_the_spd_formulas_by_streaming() {
 
 #[test]
 fn spd_tessellated_triangle_counts() {
-    for (program, sf, want) in [("balls", 4, 797_150u64), ("gears", 4, 36_610), ("tree", 10, 270_206)] {
+    for (program, sf, want) in [
+        ("balls", 4, 797_150u64),
+        ("gears", 4, 36_610),
+        ("tree", 10, 270_206),
+    ] {
         let v = stats(program, sf, &["--tessellate"]);
-        assert_eq!(v["counts"]["triangles"].as_u64().unwrap(), want, "{program}{sf} tessellated");
+        assert_eq!(
+            v["counts"]["triangles"].as_u64().unwrap(),
+            want,
+            "{program}{sf} tessellated"
+        );
     }
 }
 
@@ -83,9 +105,21 @@ fn stats_json_has_the_contract_fields() {
 fn expect_input_error(args: &[&str], needle: &str) {
     let out = rtbench(args);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: status {:?}, stderr {err}", out.status);
-    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: not one line: {err}");
-    assert!(err.contains(needle), "{args:?}: '{err}' does not mention '{needle}'");
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{args:?}: status {:?}, stderr {err}",
+        out.status
+    );
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    assert!(
+        err.contains(needle),
+        "{args:?}: '{err}' does not mention '{needle}'"
+    );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
     assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout");
 }
@@ -95,31 +129,58 @@ fn bad_input_exits_2_with_one_line() {
     let dir = std::env::temp_dir().join(format!("rtbench-badnff-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let cases = [
-        ("truncated.nff", "s 0 0 0 1\np 4\n0 0 0\n1 0 0\n1 1 0\n", "truncated.nff:5"),
+        (
+            "truncated.nff",
+            "s 0 0 0 1\np 4\n0 0 0\n1 0 0\n1 1 0\n",
+            "truncated.nff:5",
+        ),
         ("word.nff", "s 0 0 zero 1\n", "'zero'"),
         ("nan.nff", "s 0 0 0 1\ns 0 NaN 0 1\n", "word.nff"),
         ("inf.nff", "s 0 0 0 1\n\ns inf 0 0 1\n", "inf.nff:3"),
-        ("directive.nff", "s 0 0 0 1\nsphere 0 0 0 1\n", "unknown directive 'sphere'"),
+        (
+            "directive.nff",
+            "s 0 0 0 1\nsphere 0 0 0 1\n",
+            "unknown directive 'sphere'",
+        ),
     ];
     for (name, text, needle) in cases {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         let p = path.to_str().unwrap();
-        let needle = if name == "nan.nff" { "nan.nff:2" } else { needle };
+        let needle = if name == "nan.nff" {
+            "nan.nff:2"
+        } else {
+            needle
+        };
         expect_input_error(&["scene", "stats", p], needle);
     }
     let missing = dir.join("missing.nff");
-    expect_input_error(&["scene", "stats", missing.to_str().unwrap()], "missing.nff");
+    expect_input_error(
+        &["scene", "stats", missing.to_str().unwrap()],
+        "missing.nff",
+    );
     expect_input_error(&["scene", "stats", "ballz"], "unknown SPD program 'ballz'");
-    expect_input_error(&["scene", "gen", "balls", "--sf", "0"], "size factor must be at least 1");
-    expect_input_error(&["scene", "stats", "tetra", "--sf", "40"], "more than 2^64 objects");
+    expect_input_error(
+        &["scene", "gen", "balls", "--sf", "0"],
+        "size factor must be at least 1",
+    );
+    expect_input_error(
+        &["scene", "stats", "tetra", "--sf", "40"],
+        "more than 2^64 objects",
+    );
     expect_input_error(&["scene", "stats", "balls", "--sf", "-3"], "--sf");
     expect_input_error(&["scene", "stats", "balls", "--sf", "many"], "--sf");
-    expect_input_error(&["scene", "gen", "tetra", "--hash", "jenkins"], "mount only");
+    expect_input_error(
+        &["scene", "gen", "tetra", "--hash", "jenkins"],
+        "mount only",
+    );
     expect_input_error(&["scene", "gen", "mount", "--hash", "md5"], "md5");
     // A failed write leaves no file behind.
     let out = dir.join("no-such-dir").join("x.nff");
-    expect_input_error(&["scene", "gen", "tetra", "-o", out.to_str().unwrap()], "cannot write");
+    expect_input_error(
+        &["scene", "gen", "tetra", "-o", out.to_str().unwrap()],
+        "cannot write",
+    );
     assert!(!out.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -129,8 +190,20 @@ fn gen_writes_what_stats_reads_back() {
     let dir = std::env::temp_dir().join(format!("rtbench-gen-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("rings3.nff");
-    let out = rtbench(&["scene", "gen", "rings", "--sf", "3", "-o", f.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = rtbench(&[
+        "scene",
+        "gen",
+        "rings",
+        "--sf",
+        "3",
+        "-o",
+        f.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let from_file = rtbench(&["scene", "stats", f.to_str().unwrap(), "--json"]);
     let a: Value = serde_json::from_slice(&from_file.stdout).unwrap();
     let b = stats("rings", 3, &[]);

@@ -114,7 +114,12 @@ mod tests {
     /// `n` unit boxes along x at 0, 1, 2, …
     fn row(n: usize) -> BuildPrims {
         let bounds: Vec<Aabb> = (0..n)
-            .map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 1.0, 1.0, 1.0)))
+            .map(|i| {
+                Aabb::new(
+                    Vec3::new(i as f32, 0.0, 0.0),
+                    Vec3::new(i as f32 + 1.0, 1.0, 1.0),
+                )
+            })
             .collect();
         let centroid = bounds.iter().map(|b| b.centre()).collect();
         BuildPrims { bounds, centroid }
@@ -126,7 +131,11 @@ mod tests {
         let p = row(16);
         let t = binary(&p, 1);
         t.validate(&p, 2).unwrap();
-        let inner = t.nodes.iter().filter(|n| matches!(n.kind, BuildKind::Inner { .. })).count();
+        let inner = t
+            .nodes
+            .iter()
+            .filter(|n| matches!(n.kind, BuildKind::Inner { .. }))
+            .count();
         assert_eq!(inner, 15);
         assert_eq!(t.nodes.len() - inner, 16);
         // The root's left half is primitives 0..8 (sorted on x at depth 0).
@@ -140,7 +149,11 @@ mod tests {
         let p = row(16);
         let t = nway(&p, 1, 4);
         t.validate(&p, 4).unwrap();
-        let inner: Vec<_> = t.nodes.iter().filter(|n| matches!(n.kind, BuildKind::Inner { .. })).collect();
+        let inner: Vec<_> = t
+            .nodes
+            .iter()
+            .filter(|n| matches!(n.kind, BuildKind::Inner { .. }))
+            .collect();
         assert_eq!(inner.len(), 5);
         // 5 primitives in 4 groups: 1, 1, 1, 2 (truncated cuts 0, 1, 2, 3, 5).
         let p = row(5);

@@ -9,25 +9,47 @@
 use super::config::{T_AABB, T_TRI};
 use super::tree::{BuildKind, BuildPrims, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
 use crate::geometry::aabb::Aabb;
+use glam::Vec3;
 
-/// A chosen split of a primitive range: `[start, mid)` left, `[mid, end)` right.
+/// A range `[start, end)` of the splitter's primitive order, with the bounds of its
+/// primitives and of their centres (passed down so no level recomputes them).
+#[derive(Clone, Copy, Debug)]
+pub struct Range {
+    pub start: usize,
+    pub end: usize,
+    pub bounds: Aabb,
+    pub centroids: Aabb,
+}
+
+impl Range {
+    pub fn len(&self) -> usize {
+        self.end - self.start
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.end == self.start
+    }
+}
+
+/// A chosen split of a range into two non-empty ranges.
 #[derive(Clone, Copy, Debug)]
 pub struct Split {
-    pub mid: usize,
+    pub left: Range,
+    pub right: Range,
     pub axis: usize,
-    /// Eq. 3.4's cost of the split.
+    /// Eq. 3.4's cost of the split (+∞ for a median split, which is not costed).
     pub cost: f32,
 }
 
 /// Finds and applies splits of primitive ranges. Ranges are of one order of the primitives
 /// that the splitter keeps (and hands over with [`Splitter::into_order`]).
 pub trait Splitter {
-    /// Bounds of the primitives of `[start, end)`.
-    fn bounds(&self, start: usize, end: usize) -> Aabb;
-    /// Best split of `[start, end)` (`end − start ≥ 2`), on `axis` only when given; with
-    /// `median`, the object median on the axis of greatest centroid extent instead. The range
-    /// is reordered to match.
-    fn split(&mut self, start: usize, end: usize, axis: Option<usize>, median: bool) -> Split;
+    /// The range of all primitives.
+    fn root(&self) -> Range;
+    /// Best split of `r` (`r.len() ≥ 2`), on `axis` only when given; with `median`, the object
+    /// median on the axis of greatest centroid extent (or `axis`) instead. The range is
+    /// reordered to match.
+    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split;
     fn into_order(self) -> Vec<u32>;
 }
 
@@ -46,6 +68,22 @@ fn axes(axis: Option<usize>) -> std::ops::Range<usize> {
     match axis {
         Some(a) => a..a + 1,
         None => 0..3,
+    }
+}
+
+/// The range `[start, end)` of `ids` with its bounds, in one pass.
+fn range_of(prims: &BuildPrims, ids: &[u32], start: usize, end: usize) -> Range {
+    let mut bounds = Aabb::EMPTY;
+    let mut centroids = Aabb::EMPTY;
+    for &i in &ids[start..end] {
+        bounds.grow(&prims.bounds[i as usize]);
+        centroids.grow_point(prims.centroid[i as usize]);
+    }
+    Range {
+        start,
+        end,
+        bounds,
+        centroids,
     }
 }
 
@@ -108,20 +146,18 @@ impl<'a> Sweep<'a> {
 }
 
 impl Splitter for Sweep<'_> {
-    fn bounds(&self, start: usize, end: usize) -> Aabb {
-        self.prims.bounds_of(&self.sorted[0][start..end])
+    fn root(&self) -> Range {
+        range_of(self.prims, &self.sorted[0], 0, self.prims.len())
     }
 
-    fn split(&mut self, start: usize, end: usize, axis: Option<usize>, median: bool) -> Split {
-        let n = end - start;
+    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
+        let (start, end, n) = (r.start, r.end, r.len());
         debug_assert!(n >= 2);
         let (axis, mid, cost) = if median {
-            let cb = self.prims.centroid_bounds_of(&self.sorted[0][start..end]);
-            let a = axis.unwrap_or_else(|| cb.largest_axis());
+            let a = axis.unwrap_or_else(|| r.centroids.largest_axis());
             (a, n / 2, f32::INFINITY)
         } else {
             let mut best = (0, 1, f32::INFINITY);
-            let mut parent = 0.0;
             for a in axes(axis) {
                 let s = &self.sorted[a][start..end];
                 let mut b = Aabb::EMPTY;
@@ -129,8 +165,6 @@ impl Splitter for Sweep<'_> {
                     b.grow(&self.prims.bounds[s[i] as usize]);
                     self.right_area[i] = b.half_area();
                 }
-                b.grow(&self.prims.bounds[s[0] as usize]);
-                parent = b.half_area();
                 let mut l = Aabb::EMPTY;
                 for i in 1..n {
                     l.grow(&self.prims.bounds[s[i - 1] as usize]);
@@ -142,11 +176,12 @@ impl Splitter for Sweep<'_> {
                     }
                 }
             }
-            (best.0, best.1, split_cost(best.2, parent))
+            (best.0, best.1, split_cost(best.2, r.bounds.half_area()))
         };
         self.partition(start, start + mid, end, axis);
         Split {
-            mid: start + mid,
+            left: range_of(self.prims, &self.sorted[0], start, start + mid),
+            right: range_of(self.prims, &self.sorted[0], start + mid, end),
             axis,
             cost,
         }
@@ -161,29 +196,38 @@ impl Splitter for Sweep<'_> {
 // ---------------------------------------------------------------------------------------------
 // Binned (Wald 2007)
 
-/// Wald 2007's binned SAH: the centroid bounds of the range are cut into `bins` equal bins per
-/// axis; primitives are counted and bounded per bin in one pass, and the `bins − 1` planes
-/// between bins are evaluated with a prefix/suffix sweep over the bins. The range is then
-/// partitioned in place.
-pub struct Binned<'a> {
-    prims: &'a BuildPrims,
-    order: Vec<u32>,
-    bins: Vec<Bin>,
-    right_area: Vec<f32>,
-    right_count: Vec<usize>,
+/// A primitive as the binned builder moves it: its box and index, contiguous, so binning and
+/// partitioning stream through memory (Embree's `PrimRef`).
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    lo: Vec3,
+    id: u32,
+    hi: Vec3,
 }
 
-impl<'a> Binned<'a> {
-    pub fn new(prims: &'a BuildPrims, bins: usize) -> Binned<'a> {
-        let nb = bins.clamp(2, 256);
-        Binned {
-            prims,
-            order: (0..prims.len() as u32).collect(),
-            bins: vec![Bin::EMPTY; nb],
-            right_area: vec![0.0; nb],
-            right_count: vec![0; nb],
-        }
+impl PrimRef {
+    /// The box centre, computed as `BuildPrims` does (`Aabb::centre`).
+    #[inline]
+    fn centre(&self) -> Vec3 {
+        (self.lo + self.hi) * 0.5
     }
+
+    #[inline]
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.lo, self.hi)
+    }
+}
+
+/// Wald 2007's binned SAH: the centroid bounds of the range are cut into `bins` equal bins per
+/// axis; one pass over the primitives counts and bounds them per bin on all three axes, and the
+/// `bins − 1` planes between bins are evaluated with a prefix/suffix sweep over the bins. The
+/// range is then partitioned in place, which also gives both sides' bounds.
+pub struct Binned {
+    refs: Vec<PrimRef>,
+    nb: usize,
+    bins: Vec<[Bin; 3]>,
+    right_area: Vec<f32>,
+    right_count: Vec<usize>,
 }
 
 #[derive(Clone, Copy)]
@@ -199,96 +243,165 @@ impl Bin {
     };
 }
 
-impl Splitter for Binned<'_> {
-    fn bounds(&self, start: usize, end: usize) -> Aabb {
-        self.prims.bounds_of(&self.order[start..end])
+impl Binned {
+    pub fn new(prims: &BuildPrims, bins: usize) -> Binned {
+        let nb = bins.clamp(2, 256);
+        Binned {
+            refs: prims
+                .bounds
+                .iter()
+                .enumerate()
+                .map(|(i, b)| PrimRef {
+                    lo: b.lo,
+                    id: i as u32,
+                    hi: b.hi,
+                })
+                .collect(),
+            nb,
+            bins: vec![[Bin::EMPTY; 3]; nb],
+            right_area: vec![0.0; nb],
+            right_count: vec![0; nb],
+        }
     }
 
-    fn split(&mut self, start: usize, end: usize, axis: Option<usize>, median: bool) -> Split {
-        let n = end - start;
-        debug_assert!(n >= 2);
-        let ids = &mut self.order[start..end];
-        let cb = self.prims.centroid_bounds_of(ids);
-        let ext = cb.extent();
-        let median_split = |ids: &mut [u32], a: usize| {
-            let prims = self.prims;
-            ids.select_nth_unstable_by(n / 2, |&x, &y| prims.cmp(x, y, a));
-            Split {
-                mid: start + n / 2,
-                axis: a,
-                cost: f32::INFINITY,
-            }
-        };
-        if median {
-            return median_split(ids, axis.unwrap_or_else(|| cb.largest_axis()));
+    fn range(&self, start: usize, end: usize) -> Range {
+        let mut bounds = Aabb::EMPTY;
+        let mut centroids = Aabb::EMPTY;
+        for p in &self.refs[start..end] {
+            bounds.grow(&p.aabb());
+            centroids.grow_point(p.centre());
         }
-        let nb = self.bins.len();
-        let (bins, right_area, right_count) =
-            (&mut self.bins, &mut self.right_area, &mut self.right_count);
-        let mut best: Option<(usize, usize, f32)> = None; // (axis, plane, cost)
-        let mut parent = 0.0;
+        Range {
+            start,
+            end,
+            bounds,
+            centroids,
+        }
+    }
+
+    fn median(&mut self, r: &Range, axis: usize) -> Split {
+        let k = r.len() / 2;
+        self.refs[r.start..r.end].select_nth_unstable_by(k, |x, y| {
+            x.centre()[axis]
+                .total_cmp(&y.centre()[axis])
+                .then(x.id.cmp(&y.id))
+        });
+        let mid = r.start + k;
+        Split {
+            left: self.range(r.start, mid),
+            right: self.range(mid, r.end),
+            axis,
+            cost: f32::INFINITY,
+        }
+    }
+}
+
+impl Splitter for Binned {
+    fn root(&self) -> Range {
+        self.range(0, self.refs.len())
+    }
+
+    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
+        debug_assert!(r.len() >= 2);
+        let cb = r.centroids;
+        if median {
+            return self.median(r, axis.unwrap_or_else(|| cb.largest_axis()));
+        }
+        let nb = self.nb;
+        let ext = cb.extent();
+        // Bins per unit length on each axis; 0 on a flat axis puts everything in bin 0, where
+        // no plane has primitives on both sides.
+        let scale = Vec3::select(
+            ext.cmpgt(Vec3::ZERO),
+            Vec3::splat(nb as f32 * (1.0 - 1e-6)) / ext,
+            Vec3::ZERO,
+        );
+        let bin_of = |c: Vec3| {
+            let k = ((c - cb.lo) * scale).max(Vec3::ZERO);
+            [
+                (k.x as usize).min(nb - 1),
+                (k.y as usize).min(nb - 1),
+                (k.z as usize).min(nb - 1),
+            ]
+        };
+        self.bins.fill([Bin::EMPTY; 3]);
+        for p in &self.refs[r.start..r.end] {
+            let k = bin_of(p.centre());
+            let b = p.aabb();
+            for a in 0..3 {
+                let bin = &mut self.bins[k[a]][a];
+                bin.bounds.grow(&b);
+                bin.count += 1;
+            }
+        }
+        let mut best: Option<(usize, usize, f32)> = None; // (axis, plane, Σ A·N)
         for a in axes(axis) {
-            if ext[a] <= 0.0 {
-                continue;
-            }
-            let scale = nb as f32 * (1.0 - 1e-6) / ext[a];
-            let lo = cb.lo[a];
-            bins.fill(Bin::EMPTY);
-            for &p in ids.iter() {
-                let k = (((self.prims.centroid[p as usize][a] - lo) * scale) as usize).min(nb - 1);
-                bins[k].bounds.grow(&self.prims.bounds[p as usize]);
-                bins[k].count += 1;
-            }
-            let mut r = Aabb::EMPTY;
-            let mut rc = 0;
+            let mut acc = Aabb::EMPTY;
+            let mut count = 0;
             for k in (1..nb).rev() {
-                r.grow(&bins[k].bounds);
-                rc += bins[k].count;
-                right_area[k] = r.half_area();
-                right_count[k] = rc;
+                acc.grow(&self.bins[k][a].bounds);
+                count += self.bins[k][a].count;
+                self.right_area[k] = acc.half_area();
+                self.right_count[k] = count;
             }
-            let mut l = bins[0].bounds;
-            let mut lc = bins[0].count;
-            parent = l.union(&r).half_area();
+            let mut l = Aabb::EMPTY;
+            let mut lc = 0;
             for k in 1..nb {
-                if lc > 0 && right_count[k] > 0 {
-                    let c = l.half_area() * lc as f32 + right_area[k] * right_count[k] as f32;
+                l.grow(&self.bins[k - 1][a].bounds);
+                lc += self.bins[k - 1][a].count;
+                let rc = self.right_count[k];
+                if lc > 0 && rc > 0 {
+                    let c = l.half_area() * lc as f32 + self.right_area[k] * rc as f32;
                     if best.map_or(true, |b| c < b.2) {
                         best = Some((a, k, c));
                     }
                 }
-                l.grow(&bins[k].bounds);
-                lc += bins[k].count;
             }
         }
-        let Some((a, k, c)) = best else {
-            // All centres coincide (on the allowed axis): any equal-count split.
-            return median_split(ids, axis.unwrap_or_else(|| cb.largest_axis()));
+        let Some((a, plane, c)) = best else {
+            // All centres coincide (on the allowed axes): any equal-count split.
+            return self.median(r, axis.unwrap_or_else(|| cb.largest_axis()));
         };
-        let scale = nb as f32 * (1.0 - 1e-6) / ext[a];
-        let lo = cb.lo[a];
-        let centroid = &self.prims.centroid;
-        let goes_left =
-            |p: u32| (((centroid[p as usize][a] - lo) * scale) as usize).min(nb - 1) < k;
-        let mut i = 0;
-        let mut j = ids.len();
+        // Partition in place, bounding both sides on the way.
+        let refs = &mut self.refs[r.start..r.end];
+        let (mut i, mut j) = (0, refs.len());
+        let (mut lb, mut lcb, mut rb, mut rcb) =
+            (Aabb::EMPTY, Aabb::EMPTY, Aabb::EMPTY, Aabb::EMPTY);
         while i < j {
-            if goes_left(ids[i]) {
+            let p = refs[i];
+            let centre = p.centre();
+            if bin_of(centre)[a] < plane {
+                lb.grow(&p.aabb());
+                lcb.grow_point(centre);
                 i += 1;
             } else {
+                rb.grow(&p.aabb());
+                rcb.grow_point(centre);
                 j -= 1;
-                ids.swap(i, j);
+                refs.swap(i, j);
             }
         }
+        let mid = r.start + i;
         Split {
-            mid: start + i,
+            left: Range {
+                start: r.start,
+                end: mid,
+                bounds: lb,
+                centroids: lcb,
+            },
+            right: Range {
+                start: mid,
+                end: r.end,
+                bounds: rb,
+                centroids: rcb,
+            },
             axis: a,
-            cost: split_cost(c, parent),
+            cost: split_cost(c, r.bounds.half_area()),
         }
     }
 
     fn into_order(self) -> Vec<u32> {
-        self.order
+        self.refs.iter().map(|p| p.id).collect()
     }
 }
 
@@ -300,13 +413,21 @@ fn make_leaf(n: usize, leaf: usize, split_cost: f32) -> bool {
     n == 1 || (n <= leaf && n as f32 * T_TRI <= split_cost)
 }
 
+fn leaf_kind(r: &Range) -> BuildKind {
+    BuildKind::Leaf {
+        first: r.start as u32,
+        count: r.len() as u32,
+    }
+}
+
 /// Binary SAH tree (001 with B = 2; Wald, Boulos and Shirley 2007).
-pub fn binary<S: Splitter>(mut s: S, n_prims: usize, leaf: usize) -> BuildTree {
+pub fn binary<S: Splitter>(mut s: S, leaf: usize) -> BuildTree {
+    let root = s.root();
     let mut tree = BuildTree {
-        nodes: Vec::with_capacity(2 * n_prims + 1),
+        nodes: Vec::with_capacity(2 * root.len() + 1),
         order: Vec::new(),
     };
-    binary_node(&mut s, &mut tree, 0, n_prims, 0, leaf);
+    binary_node(&mut s, &mut tree, &root, 0, leaf);
     tree.order = s.into_order();
     tree
 }
@@ -314,34 +435,23 @@ pub fn binary<S: Splitter>(mut s: S, n_prims: usize, leaf: usize) -> BuildTree {
 fn binary_node<S: Splitter>(
     s: &mut S,
     tree: &mut BuildTree,
-    start: usize,
-    end: usize,
+    r: &Range,
     depth: usize,
     leaf: usize,
 ) -> u32 {
-    let bounds = s.bounds(start, end);
-    let n = end - start;
-    let leaf_kind = BuildKind::Leaf {
-        first: start as u32,
-        count: n as u32,
-    };
-    if n == 1 {
-        return tree.push(bounds, leaf_kind);
-    }
+    let n = r.len();
     let median = depth >= SAH_MEDIAN_DEPTH;
-    if median && n <= leaf {
-        return tree.push(bounds, leaf_kind);
+    if n == 1 || (median && n <= leaf) {
+        return tree.push(r.bounds, leaf_kind(r));
     }
-    let split = s.split(start, end, None, median);
+    let split = s.split(r, None, median);
     if make_leaf(n, leaf, split.cost) {
-        return tree.push(bounds, leaf_kind);
+        return tree.push(r.bounds, leaf_kind(r));
     }
-    let me = tree.push(bounds, leaf_kind);
-    let l = binary_node(s, tree, start, split.mid, depth + 1, leaf);
-    let r = binary_node(s, tree, split.mid, end, depth + 1, leaf);
+    let me = tree.push(r.bounds, leaf_kind(r));
     let mut children = [0; MAX_WIDTH];
-    children[0] = l;
-    children[1] = r;
+    children[0] = binary_node(s, tree, &split.left, depth + 1, leaf);
+    children[1] = binary_node(s, tree, &split.right, depth + 1, leaf);
     tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
     me
 }
@@ -351,18 +461,14 @@ fn binary_node<S: Splitter>(
 /// with the SAH on that first split's axis only, log2(N) times; the groups become the children
 /// in axis order. A group that would become a leaf is not split further (its slot stays
 /// empty, 001's empty nodes).
-pub fn wide_same_axis<S: Splitter>(
-    mut s: S,
-    n_prims: usize,
-    leaf: usize,
-    width: usize,
-) -> BuildTree {
+pub fn wide_same_axis<S: Splitter>(mut s: S, leaf: usize, width: usize) -> BuildTree {
     assert!(width.is_power_of_two() && (2..=MAX_WIDTH).contains(&width));
+    let root = s.root();
     let mut tree = BuildTree {
-        nodes: Vec::with_capacity(2 * n_prims + 1),
+        nodes: Vec::with_capacity(2 * root.len() + 1),
         order: Vec::new(),
     };
-    wide_node(&mut s, &mut tree, 0, n_prims, 0, leaf, width);
+    wide_node(&mut s, &mut tree, &root, 0, leaf, width);
     tree.order = s.into_order();
     tree
 }
@@ -370,56 +476,47 @@ pub fn wide_same_axis<S: Splitter>(
 fn wide_node<S: Splitter>(
     s: &mut S,
     tree: &mut BuildTree,
-    start: usize,
-    end: usize,
+    r: &Range,
     depth: usize,
     leaf: usize,
     width: usize,
 ) -> u32 {
-    let bounds = s.bounds(start, end);
-    let n = end - start;
-    let leaf_kind = BuildKind::Leaf {
-        first: start as u32,
-        count: n as u32,
-    };
-    if n == 1 {
-        return tree.push(bounds, leaf_kind);
-    }
+    let n = r.len();
     // `depth` counts binary levels, so the median fallback bounds the depth as in `binary`.
     let median = depth >= SAH_MEDIAN_DEPTH;
-    if median && n <= leaf {
-        return tree.push(bounds, leaf_kind);
+    if n == 1 || (median && n <= leaf) {
+        return tree.push(r.bounds, leaf_kind(r));
     }
-    let first = s.split(start, end, None, median);
+    let first = s.split(r, None, median);
     if make_leaf(n, leaf, first.cost) {
-        return tree.push(bounds, leaf_kind);
+        return tree.push(r.bounds, leaf_kind(r));
     }
     let axis = Some(first.axis);
-    // Groups as (start, end, still splittable).
-    let mut groups: Vec<(usize, usize, bool)> = vec![(start, first.mid, true), (first.mid, end, true)];
+    // Groups, each with whether it may still be split.
+    let mut groups: Vec<(Range, bool)> = vec![(first.left, true), (first.right, true)];
     let levels = width.trailing_zeros() as usize;
     for _ in 1..levels {
         let mut next = Vec::with_capacity(2 * groups.len());
-        for &(a, b, open) in &groups {
-            let m = b - a;
+        for &(g, open) in &groups {
+            let m = g.len();
             if !open || m == 1 || (median && m <= leaf) {
-                next.push((a, b, false));
+                next.push((g, false));
                 continue;
             }
-            let sp = s.split(a, b, axis, median);
+            let sp = s.split(&g, axis, median);
             if make_leaf(m, leaf, sp.cost) {
-                next.push((a, b, false));
+                next.push((g, false));
             } else {
-                next.push((a, sp.mid, true));
-                next.push((sp.mid, b, true));
+                next.push((sp.left, true));
+                next.push((sp.right, true));
             }
         }
         groups = next;
     }
-    let me = tree.push(bounds, leaf_kind);
+    let me = tree.push(r.bounds, leaf_kind(r));
     let mut children = [0; MAX_WIDTH];
-    for (slot, &(a, b, _)) in groups.iter().enumerate() {
-        children[slot] = wide_node(s, tree, a, b, depth + levels, leaf, width);
+    for (slot, (g, _)) in groups.iter().enumerate() {
+        children[slot] = wide_node(s, tree, g, depth + levels, leaf, width);
     }
     tree.nodes[me as usize].kind = BuildKind::Inner {
         children,
@@ -453,10 +550,7 @@ mod tests {
     #[test]
     fn sweep_and_binned_separate_clusters() {
         let p = clusters();
-        for t in [
-            binary(Sweep::new(&p), p.len(), 1),
-            binary(Binned::new(&p, 16), p.len(), 1),
-        ] {
+        for t in [binary(Sweep::new(&p), 1), binary(Binned::new(&p, 16), 1)] {
             t.validate(&p, 2).unwrap();
             let c = t.children(0);
             assert_eq!(c.len(), 2);
@@ -472,10 +566,13 @@ mod tests {
     #[test]
     fn sweep_finds_the_exact_optimum() {
         // Four unit boxes at x = 0, 1, 2 and 10: the best cut is before the far one.
-        let p = prims(&[0.0, 1.0, 2.0, 10.0].map(|x| (Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))));
+        let p = prims(
+            &[0.0, 1.0, 2.0, 10.0].map(|x| (Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))),
+        );
         let mut s = Sweep::new(&p);
-        let sp = s.split(0, 4, None, false);
-        assert_eq!((sp.mid, sp.axis), (3, 0));
+        let root = s.root();
+        let sp = s.split(&root, None, false);
+        assert_eq!((sp.left.end, sp.axis), (3, 0));
         // Eq. 3.4 by hand: left box 3×1×1 (half area 7), right 1×1×1 (3), parent 11×1×1 (23).
         let want = 2.0 + (7.0 * 3.0 + 3.0 * 1.0) / 23.0;
         assert!((sp.cost - want).abs() < 1e-5, "{} vs {want}", sp.cost);
@@ -484,7 +581,7 @@ mod tests {
     #[test]
     fn leaves_grow_up_to_leaf_size_when_cheaper() {
         let p = clusters();
-        let t = binary(Binned::new(&p, 32), p.len(), 4);
+        let t = binary(Binned::new(&p, 32), 4);
         t.validate(&p, 2).unwrap();
         let max_leaf = t
             .nodes
@@ -500,13 +597,17 @@ mod tests {
 
     #[test]
     fn same_axis_wide_children_are_ordered_on_one_axis() {
-        let p = prims(&(0..64).map(|i| {
-            let x = (i % 8) as f32 * 2.0;
-            let y = (i / 8) as f32 * 2.0;
-            (Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y + 1.0, 1.0))
-        }).collect::<Vec<_>>());
+        let p = prims(
+            &(0..64)
+                .map(|i| {
+                    let x = (i % 8) as f32 * 2.0;
+                    let y = (i / 8) as f32 * 2.0;
+                    (Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y + 1.0, 1.0))
+                })
+                .collect::<Vec<_>>(),
+        );
         for width in [4, 8] {
-            let t = wide_same_axis(Sweep::new(&p), p.len(), 1, width);
+            let t = wide_same_axis(Sweep::new(&p), 1, width);
             t.validate(&p, width).unwrap();
             let c = t.children(0);
             assert_eq!(c.len(), width);

@@ -65,7 +65,12 @@ mod tests {
         // 16 primitives, one per leaf: binary depth 4 → 4-wide depth 2 with 5 inner nodes and
         // no empty slot; 8-wide: 9 inner nodes (the root's 8 children hold 2 leaves each).
         let bounds: Vec<Aabb> = (0..16)
-            .map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 0.5, 1.0, 1.0)))
+            .map(|i| {
+                Aabb::new(
+                    Vec3::new(i as f32, 0.0, 0.0),
+                    Vec3::new(i as f32 + 0.5, 1.0, 1.0),
+                )
+            })
             .collect();
         let p = BuildPrims {
             centroid: bounds.iter().map(|b| b.centre()).collect(),

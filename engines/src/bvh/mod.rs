@@ -37,7 +37,8 @@ use tree::{BuildPrims, BuildTree};
 pub fn info2() -> EngineInfo {
     EngineInfo {
         name: "bvh2",
-        description: "binary BVH (seed 001): object median, full-sweep or binned SAH; scalar traversal",
+        description:
+            "binary BVH (seed 001): object median, full-sweep or binned SAH; scalar traversal",
         available: || Ok(()),
         build: |input, settings| build_engine::<2>(input, settings, || None),
     }
@@ -73,29 +74,25 @@ pub struct BvhEngine<const N: usize> {
 /// children per node.
 pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     let prims = BuildPrims::new(geometry);
-    let n = prims.len();
     let (width, leaf) = (config.width, config.leaf);
     let direct = config.wide == WideMethod::Direct && width > 2;
     match (config.builder, direct) {
         (Builder::Median, false) => collapse::collapse(&build_median::binary(&prims, leaf), width),
         (Builder::Median, true) => build_median::nway(&prims, leaf, width),
         (Builder::SahSweep, false) => collapse::collapse(
-            &build_sah::binary(build_sah::Sweep::new(&prims), n, leaf),
+            &build_sah::binary(build_sah::Sweep::new(&prims), leaf),
             width,
         ),
         (Builder::SahSweep, true) => {
-            build_sah::wide_same_axis(build_sah::Sweep::new(&prims), n, leaf, width)
+            build_sah::wide_same_axis(build_sah::Sweep::new(&prims), leaf, width)
         }
         (Builder::SahBinned, false) => collapse::collapse(
-            &build_sah::binary(build_sah::Binned::new(&prims, config.bins), n, leaf),
+            &build_sah::binary(build_sah::Binned::new(&prims, config.bins), leaf),
             width,
         ),
-        (Builder::SahBinned, true) => build_sah::wide_same_axis(
-            build_sah::Binned::new(&prims, config.bins),
-            n,
-            leaf,
-            width,
-        ),
+        (Builder::SahBinned, true) => {
+            build_sah::wide_same_axis(build_sah::Binned::new(&prims, config.bins), leaf, width)
+        }
     }
 }
 
@@ -108,7 +105,10 @@ pub fn build_bvh<const N: usize>(
     if n >= MAX_PRIMS {
         return Err(EngineError::Build {
             engine: format!("bvh{N}"),
-            reason: format!("{n} primitives: at most {} fit a leaf reference", MAX_PRIMS - 1),
+            reason: format!(
+                "{n} primitives: at most {} fit a leaf reference",
+                MAX_PRIMS - 1
+            ),
         });
     }
     if n == 0 {

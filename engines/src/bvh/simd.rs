@@ -102,8 +102,8 @@ impl<const N: usize> ChildTest<N> for Scalar {
         ScalarRay {
             rdir: r.rdir.to_array(),
             org_rdir: r.org_rdir.to_array(),
-            near: [0, 1, 2].map(|a| r.near_plane(a)),
-            far: [0, 1, 2].map(|a| r.far_plane(a)),
+            near: [r.near_plane(0), r.near_plane(1), r.near_plane(2)],
+            far: [r.far_plane(0), r.far_plane(1), r.far_plane(2)],
         }
     }
 
@@ -144,8 +144,12 @@ mod x86 {
     /// Offsets (in floats) of the near and far plane rows of a node of width `n`; each is
     /// `row · n` with `row < PLANES`, so a load of `n` floats from there stays in the node.
     fn plane_offsets(r: &SlabRay, n: usize) -> ([usize; 3], [usize; 3]) {
-        let near = [0, 1, 2].map(|a| r.near_plane(a) * n);
-        let far = [0, 1, 2].map(|a| r.far_plane(a) * n);
+        let near = [
+            r.near_plane(0) * n,
+            r.near_plane(1) * n,
+            r.near_plane(2) * n,
+        ];
+        let far = [r.far_plane(0) * n, r.far_plane(1) * n, r.far_plane(2) * n];
         debug_assert!(near.iter().chain(&far).all(|&o| o + n <= PLANES * n));
         (near, far)
     }
@@ -172,17 +176,18 @@ mod x86 {
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Sse4Ray {
             let (near, far) = plane_offsets(r, 4);
-            let rd = [r.rdir.x, r.rdir.y, r.rdir.z].map(|v| [v; 4]);
-            let od = [r.org_rdir.x, r.org_rdir.y, r.org_rdir.z].map(|v| [v; 4]);
-            // SAFETY: SSE is part of the x86-64 baseline; each load reads the 4 floats of a
-            // local `[f32; 4]`.
-            unsafe {
-                Sse4Ray {
-                    rdir: [0, 1, 2].map(|a| _mm_loadu_ps(rd[a].as_ptr())),
-                    org_rdir: [0, 1, 2].map(|a| _mm_loadu_ps(od[a].as_ptr())),
-                    near,
-                    far,
-                }
+            let splat = |v: f32| {
+                let lanes = [v; 4];
+                // SAFETY: SSE is part of the x86-64 baseline; the load reads the 4 floats of
+                // the local `lanes`.
+                unsafe { _mm_loadu_ps(lanes.as_ptr()) }
+            };
+            let (d, o) = (r.rdir, r.org_rdir);
+            Sse4Ray {
+                rdir: [splat(d.x), splat(d.y), splat(d.z)],
+                org_rdir: [splat(o.x), splat(o.y), splat(o.z)],
+                near,
+                far,
             }
         }
 
@@ -195,7 +200,10 @@ mod x86 {
             // store writes exactly the 4 floats of `dist`.
             unsafe {
                 let plane = |off: usize, a: usize| {
-                    _mm_sub_ps(_mm_mul_ps(_mm_loadu_ps(base.add(off)), r.rdir[a]), r.org_rdir[a])
+                    _mm_sub_ps(
+                        _mm_mul_ps(_mm_loadu_ps(base.add(off)), r.rdir[a]),
+                        r.org_rdir[a],
+                    )
                 };
                 let t_near = _mm_max_ps(
                     _mm_max_ps(plane(r.near[0], 0), plane(r.near[1], 1)),
@@ -229,15 +237,22 @@ mod x86 {
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Avx8Ray {
             let (near, far) = plane_offsets(r, 8);
-            let rd = [r.rdir.x, r.rdir.y, r.rdir.z].map(|v| [v; 8]);
-            let od = [r.org_rdir.x, r.org_rdir.y, r.org_rdir.z].map(|v| [v; 8]);
+            let (d, o) = (r.rdir, r.org_rdir);
             // SAFETY: only reached from `avx8_closest_impl` / `avx8_any_impl`, which are
             // compiled for and called only on CPUs with AVX2 and FMA (checked in
-            // `avx8_closest` / `avx8_any`); each load reads the 8 floats of a local `[f32; 8]`.
+            // `avx8_closest` / `avx8_any`); `set1` only broadcasts a value.
             unsafe {
                 Avx8Ray {
-                    rdir: [0, 1, 2].map(|a| _mm256_loadu_ps(rd[a].as_ptr())),
-                    org_rdir: [0, 1, 2].map(|a| _mm256_loadu_ps(od[a].as_ptr())),
+                    rdir: [
+                        _mm256_set1_ps(d.x),
+                        _mm256_set1_ps(d.y),
+                        _mm256_set1_ps(d.z),
+                    ],
+                    org_rdir: [
+                        _mm256_set1_ps(o.x),
+                        _mm256_set1_ps(o.y),
+                        _mm256_set1_ps(o.z),
+                    ],
                     near,
                     far,
                 }
@@ -270,13 +285,25 @@ mod x86 {
         }
     }
 
-    pub fn avx8_closest(bvh: &Bvh<8>, rays: &[Ray], hits: &mut [Hit], t: TriangleTest, c: &mut Counters) {
+    pub fn avx8_closest(
+        bvh: &Bvh<8>,
+        rays: &[Ray],
+        hits: &mut [Hit],
+        t: TriangleTest,
+        c: &mut Counters,
+    ) {
         assert!(has_avx2_fma(), "the AVX2 kernel needs AVX2 and FMA");
         // SAFETY: the CPU has AVX2 and FMA (asserted above), all `avx8_closest_impl` requires.
         unsafe { avx8_closest_impl(bvh, rays, hits, t, c) }
     }
 
-    pub fn avx8_any(bvh: &Bvh<8>, rays: &[Ray], out: &mut [bool], t: TriangleTest, c: &mut Counters) {
+    pub fn avx8_any(
+        bvh: &Bvh<8>,
+        rays: &[Ray],
+        out: &mut [bool],
+        t: TriangleTest,
+        c: &mut Counters,
+    ) {
         assert!(has_avx2_fma(), "the AVX2 kernel needs AVX2 and FMA");
         // SAFETY: the CPU has AVX2 and FMA (asserted above), all `avx8_any_impl` requires.
         unsafe { avx8_any_impl(bvh, rays, out, t, c) }
@@ -284,12 +311,24 @@ mod x86 {
 
     /// The whole batch loop compiled with AVX2 and FMA, so `Avx8`'s intrinsics inline into it.
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn avx8_closest_impl(bvh: &Bvh<8>, rays: &[Ray], hits: &mut [Hit], t: TriangleTest, c: &mut Counters) {
+    unsafe fn avx8_closest_impl(
+        bvh: &Bvh<8>,
+        rays: &[Ray],
+        hits: &mut [Hit],
+        t: TriangleTest,
+        c: &mut Counters,
+    ) {
         traverse::closest_batch::<8, Avx8>(bvh, rays, hits, t, c)
     }
 
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn avx8_any_impl(bvh: &Bvh<8>, rays: &[Ray], out: &mut [bool], t: TriangleTest, c: &mut Counters) {
+    unsafe fn avx8_any_impl(
+        bvh: &Bvh<8>,
+        rays: &[Ray],
+        out: &mut [bool],
+        t: TriangleTest,
+        c: &mut Counters,
+    ) {
         traverse::any_batch::<8, Avx8>(bvh, rays, out, t, c)
     }
 }

@@ -69,13 +69,20 @@ impl TreeStats {
         put("max_leaf_depth", self.max_leaf_depth as f64);
         put("sah_cost", self.sah_cost);
         put("model_bytes", self.model_bytes() as f64);
-        put("model_bytes_with_empty", self.model_bytes_with_empty() as f64);
+        put(
+            "model_bytes_with_empty",
+            self.model_bytes_with_empty() as f64,
+        );
         put("node_bytes", self.node_bytes as f64);
     }
 }
 
 /// Statistics of a flattened tree whose root is `root` (box `root_bounds`).
-pub fn tree_stats<const N: usize>(nodes: &[WideNode<N>], root: u32, root_bounds: &Aabb) -> TreeStats {
+pub fn tree_stats<const N: usize>(
+    nodes: &[WideNode<N>],
+    root: u32,
+    root_bounds: &Aabb,
+) -> TreeStats {
     let mut s = TreeStats {
         width: N,
         node_bytes: std::mem::size_of_val(nodes) as u64,
@@ -133,7 +140,9 @@ mod tests {
     #[test]
     fn table_3_3_internal_node_bytes() {
         // 001 Table 3.3: 36, 44, 52, 60, 68, 76, 84, 92 bytes for B = 2 … 16.
-        let got: Vec<u64> = (1..=8).map(|k| TreeStats::internal_node_model_bytes(2 * k)).collect();
+        let got: Vec<u64> = (1..=8)
+            .map(|k| TreeStats::internal_node_model_bytes(2 * k))
+            .collect();
         assert_eq!(got, vec![36, 44, 52, 60, 68, 76, 84, 92]);
     }
 }

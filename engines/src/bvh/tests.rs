@@ -64,7 +64,9 @@ fn rays(g: &Geometry, n: usize, seed: u64) -> Vec<Ray> {
             }
             1 => {
                 let o = rng.in_box(lo, hi);
-                let d = rng.in_box(Vec3::splat(-1.0), Vec3::ONE).normalize_or(Vec3::Z);
+                let d = rng
+                    .in_box(Vec3::splat(-1.0), Vec3::ONE)
+                    .normalize_or(Vec3::Z);
                 Ray::new(o, d, 0.0, f32::INFINITY)
             }
             _ => {
@@ -143,7 +145,8 @@ fn all_configurations_agree_with_reference() {
     for (si, &(program, sf, tess)) in scenes.iter().enumerate() {
         let inp = input(program, sf, tess);
         let rays = rays(&inp.geometry, 300, 17 + si as u64);
-        let refe = (crate::reference::info().build)(&inp, Settings::new("reference", vec![])).unwrap();
+        let refe =
+            (crate::reference::info().build)(&inp, Settings::new("reference", vec![])).unwrap();
         let (want, _) = closest(refe.as_ref(), &rays);
         let want_any = occluded(refe.as_ref(), &rays);
         let brute: Vec<Hit> = rays.iter().map(|r| brute_force(&inp.geometry, r)).collect();
@@ -160,7 +163,12 @@ fn all_configurations_agree_with_reference() {
                             if width == 2 && simd == "on" {
                                 continue;
                             }
-                            let kv = [("builder", builder), ("wide", wide), ("leaf", leaf), ("simd", simd)];
+                            let kv = [
+                                ("builder", builder),
+                                ("wide", wide),
+                                ("leaf", leaf),
+                                ("simd", simd),
+                            ];
                             let label = format!("bvh{width} {kv:?} on {program}{sf}");
                             let e = engine(&inp, width, &kv);
                             let (got, c) = closest(e.as_ref(), &rays);
@@ -171,7 +179,10 @@ fn all_configurations_agree_with_reference() {
                                 rays.len()
                             );
                             for (i, (g, b)) in got.iter().zip(&brute).enumerate() {
-                                assert!(agree(g, b), "{label}: ray {i}: {g:?} vs brute force {b:?}");
+                                assert!(
+                                    agree(g, b),
+                                    "{label}: ray {i}: {g:?} vs brute force {b:?}"
+                                );
                             }
                             let any = occluded(e.as_ref(), &rays);
                             let any_ok = any.iter().zip(&want_any).filter(|(a, b)| a == b).count();
@@ -182,7 +193,10 @@ fn all_configurations_agree_with_reference() {
                             }
                             assert_eq!(c.rays, rays.len() as u64);
                             assert!(c.nodes_visited > 0 && c.box_tests >= c.nodes_visited);
-                            assert!(c.primitive_tests < rays.len() as u64 * inp.geometry.prims.len() as u64);
+                            assert!(
+                                c.primitive_tests
+                                    < rays.len() as u64 * inp.geometry.prims.len() as u64
+                            );
                         }
                     }
                 }
@@ -206,12 +220,24 @@ fn node_counts_are_consistent() {
         for builder in ["median", "sah-sweep", "sah-binned"] {
             for wide in ["collapse", "direct"] {
                 for leaf in ["1", "4"] {
-                    let e = engine(&inp, width, &[("builder", builder), ("wide", wide), ("leaf", leaf)]);
+                    let e = engine(
+                        &inp,
+                        width,
+                        &[("builder", builder), ("wide", wide), ("leaf", leaf)],
+                    );
                     let s = stats_of(e.as_ref());
-                    let (inner, leaves, empty) = (s["internal_nodes"], s["leaf_nodes"], s["empty_nodes"]);
+                    let (inner, leaves, empty) =
+                        (s["internal_nodes"], s["leaf_nodes"], s["empty_nodes"]);
                     let label = format!("bvh{width} {builder} {wide} leaf {leaf}: {s:?}");
-                    assert_eq!(leaves + inner - 1.0 + empty, width as f64 * inner, "{label}");
-                    assert!((s["avg_leaf_prims"] * leaves - n).abs() < 1e-6 * n, "{label}");
+                    assert_eq!(
+                        leaves + inner - 1.0 + empty,
+                        width as f64 * inner,
+                        "{label}"
+                    );
+                    assert!(
+                        (s["avg_leaf_prims"] * leaves - n).abs() < 1e-6 * n,
+                        "{label}"
+                    );
                     if leaf == "1" {
                         assert_eq!(leaves, n, "{label}");
                     }
@@ -222,7 +248,8 @@ fn node_counts_are_consistent() {
                         // Equal-count halving stops at ≤ 4: leaves hold 2–4 primitives.
                         assert!(leaves >= n / 4.0 && leaves <= n / 2.0, "{label}");
                     }
-                    let model = inner * TreeStats::internal_node_model_bytes(width) as f64 + leaves * 32.0;
+                    let model =
+                        inner * TreeStats::internal_node_model_bytes(width) as f64 + leaves * 32.0;
                     assert_eq!(s["model_bytes"], model, "{label}");
                     assert_eq!(s["model_bytes_with_empty"], model + empty * 32.0, "{label}");
                     assert!(s["avg_leaf_depth"] <= s["max_leaf_depth"], "{label}");
@@ -233,7 +260,10 @@ fn node_counts_are_consistent() {
         }
     }
     // Wider trees are shallower (001 §2.2: from B = 2 to 4 the average leaf depth about halves).
-    let depth = |w: usize| stats_of(engine(&inp, w, &[("builder", "median"), ("leaf", "1")]).as_ref())["avg_leaf_depth"];
+    let depth = |w: usize| {
+        stats_of(engine(&inp, w, &[("builder", "median"), ("leaf", "1")]).as_ref())
+            ["avg_leaf_depth"]
+    };
     let (d2, d4, d8) = (depth(2), depth(4), depth(8));
     assert!(d4 < 0.6 * d2 && d8 < d4, "{d2} {d4} {d8}");
 }
@@ -248,9 +278,16 @@ fn nway_median_of_16_primitives() {
     g.prims.truncate(16);
     g.prim_object.truncate(16);
     inp.geometry = Arc::new(g);
-    let e = engine(&inp, 4, &[("builder", "median"), ("wide", "direct"), ("leaf", "1")]);
+    let e = engine(
+        &inp,
+        4,
+        &[("builder", "median"), ("wide", "direct"), ("leaf", "1")],
+    );
     let s = stats_of(e.as_ref());
-    assert_eq!((s["internal_nodes"], s["leaf_nodes"], s["empty_nodes"]), (5.0, 16.0, 0.0));
+    assert_eq!(
+        (s["internal_nodes"], s["leaf_nodes"], s["empty_nodes"]),
+        (5.0, 16.0, 0.0)
+    );
     assert_eq!((s["avg_leaf_depth"], s["max_leaf_depth"]), (2.0, 2.0));
 }
 
@@ -281,11 +318,21 @@ fn simd_and_scalar_kernels_give_the_same_hits_and_counts() {
         let (a, ca) = closest(engine(&inp, w, &[("simd", "on")]).as_ref(), &rays);
         let (b, cb) = closest(engine(&inp, w, &[("simd", "off")]).as_ref(), &rays);
         let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
-        assert!(same + 2 >= rays.len(), "bvh{w}: {same} of {} identical", rays.len());
+        assert!(
+            same + 2 >= rays.len(),
+            "bvh{w}: {same} of {} identical",
+            rays.len()
+        );
         // The kernels only differ in rounding of box entry distances, not in what they visit
         // (up to those few grazing rays).
-        let rel = (ca.nodes_visited as f64 - cb.nodes_visited as f64).abs() / cb.nodes_visited as f64;
-        assert!(rel < 0.01, "bvh{w}: {} vs {} nodes", ca.nodes_visited, cb.nodes_visited);
+        let rel =
+            (ca.nodes_visited as f64 - cb.nodes_visited as f64).abs() / cb.nodes_visited as f64;
+        assert!(
+            rel < 0.01,
+            "bvh{w}: {} vs {} nodes",
+            ca.nodes_visited,
+            cb.nodes_visited
+        );
     }
 }
 
@@ -308,6 +355,9 @@ fn config_is_reported() {
     assert!(s["build_s"] >= 0.0 && s["sah_cost"] > 0.0);
     assert_eq!(s["leaf_size"], 4.0);
     let c = Config::parse(8, Settings::new("bvh8", vec![])).unwrap();
-    assert_eq!((c.builder, c.wide), (Builder::SahBinned, WideMethod::Collapse));
+    assert_eq!(
+        (c.builder, c.wide),
+        (Builder::SahBinned, WideMethod::Collapse)
+    );
     assert!(e.structure_bytes() > 0);
 }

@@ -21,10 +21,7 @@ pub enum BuildKind {
     /// `count` primitives: `order[first..first + count]`.
     Leaf { first: u32, count: u32 },
     /// Children, by index into `BuildTree::nodes`, in the first `len` slots.
-    Inner {
-        children: [u32; MAX_WIDTH],
-        len: u8,
-    },
+    Inner { children: [u32; MAX_WIDTH], len: u8 },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

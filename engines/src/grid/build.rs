@@ -23,7 +23,9 @@ use glam::{DVec3, Vec3};
 use rtbench_scenes::{Scene, Shape};
 
 /// A floor polygon spans at least this fraction of the scene's bounds along two axes.
-pub const FLOOR_SPAN: f64 = 0.5;
+pub const FLOOR_SPAN: f64 = 0.9;
+/// ... and is flat across the third: thinner than this fraction of its own width.
+pub const FLOOR_FLAT: f64 = 0.01;
 
 /// Relative padding of cells against `f32` rounding, per unit of the largest coordinate.
 const PAD_COORD: f32 = 4e-6;
@@ -68,7 +70,8 @@ impl Cells {
 
     /// Linear index of cell (x, y, z).
     pub fn index(&self, c: [u32; 3]) -> usize {
-        c[0] as usize + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
+        c[0] as usize
+            + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
     }
 
     /// Primitives registered in cell `c`.
@@ -94,9 +97,11 @@ fn build_err(reason: String) -> EngineError {
     }
 }
 
-/// Scene objects that are floor or backdrop polygons: a polygon whose bounding box spans at
-/// least [`FLOOR_SPAN`] of the scene's bounds along two axes (balls' and gears' floors, rings'
-/// wall, tree's field). Teapot's checkerboard is many small squares, none of which qualifies.
+/// Scene objects that are floor or backdrop polygons: a polygon lying across one axis (flat to
+/// [`FLOOR_FLAT`] of its width) whose bounding box spans at least [`FLOOR_SPAN`] of the scene's
+/// bounds along the two others. In the SPD these are balls', gears' and tree's ground and rings'
+/// wall, each spanning the whole scene; teapot's checkerboard is many small squares and tetra's
+/// faces are slanted, so neither qualifies.
 pub fn floor_objects(scene: &Scene, geometry: &Geometry) -> Vec<bool> {
     let extent = (geometry.bounds_max - geometry.bounds_min).as_dvec3();
     scene
@@ -105,10 +110,11 @@ pub fn floor_objects(scene: &Scene, geometry: &Geometry) -> Vec<bool> {
         .map(|o| match &o.shape {
             Shape::Polygon(_) => {
                 let e = o.shape.bounds().extent();
-                (0..3)
+                let (thin, wide) = (e.min_element(), e.max_element());
+                let spans = (0..3)
                     .filter(|&i| extent[i] > 0.0 && e[i] >= FLOOR_SPAN * extent[i])
-                    .count()
-                    >= 2
+                    .count();
+                spans >= 2 && thin <= FLOOR_FLAT * wide
             }
             _ => false,
         })
@@ -315,7 +321,7 @@ struct BitList {
 
 impl BitList {
     fn push(&mut self, b: bool) {
-        if self.len % 64 == 0 {
+        if self.len & 63 == 0 {
             self.words.push(0);
         }
         if b {

@@ -12,9 +12,7 @@ use glam::DVec3;
 /// Whether `prim` may touch the box `[lo, hi]`.
 pub fn prim_box(prim: &Prim, lo: DVec3, hi: DVec3) -> bool {
     match *prim {
-        Prim::Triangle([a, b, c]) => {
-            triangle_box(a.as_dvec3(), b.as_dvec3(), c.as_dvec3(), lo, hi)
-        }
+        Prim::Triangle([a, b, c]) => triangle_box(a.as_dvec3(), b.as_dvec3(), c.as_dvec3(), lo, hi),
         Prim::Sphere { center, radius } => {
             sphere_surface_box(center.as_dvec3(), radius as f64, lo, hi)
         }

@@ -49,7 +49,7 @@ pub fn cells_per_axis(
         Resolution::Woo => shaped(extent, [1.0; 3], density * n),
         Resolution::Klimaszewski => {
             let emax = mean_prim_extent.iter().cloned().fold(0.0, f64::max);
-            if !(emax > 0.0) || !emax.is_finite() {
+            if emax <= 0.0 || !emax.is_finite() {
                 // Points only: no shape to follow, fall back to cubes.
                 shaped(extent, [1.0; 3], density * n)
             } else {

@@ -81,80 +81,108 @@ impl Local {
 impl Grid {
     /// Walks the cells `ray` crosses within `[ray.tmin, ray.tmax]`, near to far, calling
     /// `visit(cell, t_enter, t_exit)` for each until it returns true or the ray leaves the grid
-    /// or ends. Amanatides–Woo: per axis the next wall's t, stepping the axis whose wall comes
-    /// first. The wall's t is recomputed from its plane at each step instead of accumulated, so
-    /// rounding does not drift along long rays.
+    /// or ends. Amanatides–Woo: per axis the t of the next wall, stepping the axis whose wall
+    /// comes first. A wall's t is computed from its plane's index k as `base + k·delta` (base the
+    /// t of plane 0) rather than accumulated, so rounding does not drift along long rays. The
+    /// three axes are spelled out (no indexing by axis) so that the state stays in registers.
     #[inline(always)]
     fn walk(&self, ray: &Ray, s: &RaySetup, mut visit: impl FnMut(usize, f32, f32) -> bool) {
         let g = &self.cells;
-        let o = ray.origin.to_array();
-        let lo = g.lo.to_array();
-        let hi = g.hi.to_array();
-        let cell = g.cell.to_array();
-        // Clip the segment to the grid's box (slab test).
+        // Clip the segment to the grid's box (the slab test of the DDA's set-up, which also
+        // needs the exit distance and the axes the ray does not move along).
         let (mut t0, mut t1) = (ray.tmin, ray.tmax);
         for i in 0..3 {
+            let o = ray.origin[i];
             if s.moves[i] {
-                let ta = (lo[i] - o[i]) * s.inv[i];
-                let tb = (hi[i] - o[i]) * s.inv[i];
+                let ta = (g.lo[i] - o) * s.inv[i];
+                let tb = (g.hi[i] - o) * s.inv[i];
                 t0 = t0.max(ta.min(tb));
                 t1 = t1.min(ta.max(tb));
-            } else if o[i] < lo[i] || o[i] > hi[i] {
+            } else if o < g.lo[i] || o > g.hi[i] {
                 return;
             }
         }
-        if !(t0 <= t1) {
+        if t0.is_nan() || t1.is_nan() || t0 > t1 {
             return;
         }
         let start = g.cell_of(ray.at(t0));
-        let res = g.res;
+        let res = [g.res[0] as i32, g.res[1] as i32, g.res[2] as i32];
         let stride = [1i64, res[0] as i64, res[0] as i64 * res[1] as i64];
-        let mut idx = [start[0] as i64, start[1] as i64, start[2] as i64];
-        let mut step = [0i64; 3];
-        let mut out = [0i64; 3];
-        let mut next = [f32::INFINITY; 3];
-        for i in 0..3 {
+        // Per axis: cell index, its step and the index past the grid, the wall's plane index k
+        // (as f32), t of plane 0, t between planes, and t of the next wall.
+        let axis = |i: usize| {
+            let idx = start[i] as i32;
             if !s.moves[i] {
-                continue;
+                return (idx, 0, -1, 0.0f32, 0.0f32, 0.0f32, f32::INFINITY, 0i64);
             }
-            if s.inv[i] > 0.0 {
-                step[i] = 1;
-                out[i] = res[i] as i64;
+            let base = (g.lo[i] - ray.origin[i]) * s.inv[i];
+            let delta = g.cell[i] * s.inv[i];
+            let (step, out, k) = if s.inv[i] > 0.0 {
+                (1, res[i], (idx + 1) as f32)
             } else {
-                step[i] = -1;
-                out[i] = -1;
-            }
-            next[i] = wall(lo[i], cell[i], idx[i], step[i], o[i], s.inv[i]);
-        }
-        let mut id = idx[0] + stride[1] * idx[1] + stride[2] * idx[2];
+                (-1, -1, idx as f32)
+            };
+            (
+                idx,
+                step,
+                out,
+                k,
+                base,
+                delta,
+                base + k * delta,
+                step as i64 * stride[i],
+            )
+        };
+        let (mut ix, sx, ox, mut kx, bx, dx, mut tx, jx) = axis(0);
+        let (mut iy, sy, oy, mut ky, by, dy, mut ty, jy) = axis(1);
+        let (mut iz, sz, oz, mut kz, bz, dz, mut tz, jz) = axis(2);
+        let mut id = start[0] as i64 + stride[1] * start[1] as i64 + stride[2] * start[2] as i64;
         let mut t_enter = t0;
         loop {
-            // The axis whose wall comes first (ties: x, then y, then z; the next step takes
-            // the other, so a ray through an edge visits both cells' neighbours in turn).
-            let a = if next[0] <= next[1] && next[0] <= next[2] {
-                0
-            } else if next[1] <= next[2] {
-                1
-            } else {
-                2
-            };
-            let t_exit = next[a];
+            let t_exit = tx.min(ty).min(tz);
             if visit(id as usize, t_enter, t_exit.min(t1)) || t_exit >= t1 {
                 return;
             }
-            idx[a] += step[a];
-            if idx[a] == out[a] {
-                return;
-            }
-            id += step[a] * stride[a];
             t_enter = t_exit;
-            next[a] = wall(lo[a], cell[a], idx[a], step[a], o[a], s.inv[a]);
+            // Ties go to x, then y: the next step takes the other axis, so a ray through an
+            // edge visits one of the two side cells (both are padded to hold what touches it).
+            if tx <= ty && tx <= tz {
+                ix += sx;
+                if ix == ox {
+                    return;
+                }
+                id += jx;
+                kx += sx as f32;
+                tx = bx + kx * dx;
+            } else if ty <= tz {
+                iy += sy;
+                if iy == oy {
+                    return;
+                }
+                id += jy;
+                ky += sy as f32;
+                ty = by + ky * dy;
+            } else {
+                iz += sz;
+                if iz == oz {
+                    return;
+                }
+                id += jz;
+                kz += sz as f32;
+                tz = bz + kz * dz;
+            }
         }
     }
 
     /// The nearest hit of one ray.
     #[inline]
-    pub(super) fn closest(&self, ray: &Ray, mb: &mut Option<Mailbox>, c: &mut Counters, l: &mut Local) -> Hit {
+    pub(super) fn closest(
+        &self,
+        ray: &Ray,
+        mb: &mut Option<Mailbox>,
+        c: &mut Counters,
+        l: &mut Local,
+    ) -> Hit {
         c.rays += 1;
         let s = RaySetup::new(ray);
         let prims = &self.geometry.prims;
@@ -322,14 +350,6 @@ impl Grid {
         }
         true
     }
-}
-
-/// The t of the next wall along one axis from cell `idx`, moving by `step`: the wall is the
-/// cell's upper plane when moving up, its lower plane when moving down.
-#[inline(always)]
-fn wall(lo: f32, cell: f32, idx: i64, step: i64, o: f32, inv: f32) -> f32 {
-    let k = if step > 0 { idx + 1 } else { idx };
-    (lo + k as f32 * cell - o) * inv
 }
 
 /// The bounding box of the ray's piece from `t0` to `t1`, grown by `pad` against rounding.

@@ -31,7 +31,8 @@ use std::time::{Duration, Instant};
 pub fn info() -> EngineInfo {
     EngineInfo {
         name: "obvhs",
-        description: "the obvhs crate (0.4): PLOC-built BVH2 or compressed wide BVH8, its CPU traversal",
+        description:
+            "the obvhs crate (0.4): PLOC-built BVH2 or compressed wide BVH8, its CPU traversal",
         available: || Ok(()),
         build,
     }
@@ -61,7 +62,14 @@ pub struct Preset(&'static str);
 impl FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        const NAMES: [&str; 6] = ["fastest", "very-fast", "fast", "medium", "slow", "very-slow"];
+        const NAMES: [&str; 6] = [
+            "fastest",
+            "very-fast",
+            "fast",
+            "medium",
+            "slow",
+            "very-slow",
+        ];
         NAMES
             .iter()
             .find(|&&n| n == s)
@@ -161,7 +169,10 @@ fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, 
     stats.insert("core_build_s".into(), core.as_secs_f64());
     stats.insert("nodes".into(), nodes as f64);
     stats.insert("node_bytes".into(), node_bytes as f64);
-    stats.insert("max_prims_per_leaf".into(), params.max_prims_per_leaf as f64);
+    stats.insert(
+        "max_prims_per_leaf".into(),
+        params.max_prims_per_leaf as f64,
+    );
     Ok(Box::new(Obvhs {
         tree,
         prims,
@@ -173,7 +184,12 @@ fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, 
 
 /// Our ray in obvhs's form.
 fn to_oray(r: &Ray) -> ORay {
-    ORay::new(r.origin.to_array().into(), r.dir.to_array().into(), r.tmin, r.tmax)
+    ORay::new(
+        r.origin.to_array().into(),
+        r.dir.to_array().into(),
+        r.tmin,
+        r.tmax,
+    )
 }
 
 impl Obvhs {
@@ -235,13 +251,13 @@ impl Obvhs {
         let mut last = (usize::MAX, 0.0, 0.0);
         let oray = to_oray(ray);
         let miss = match &self.tree {
-            Tree::Bvh2(t) if !t.nodes.is_empty() => t.ray_traverse_miss(oray, |o, id| {
-                self.test(ray, o, id, &wt, &mut last, c)
-            }),
+            Tree::Bvh2(t) if !t.nodes.is_empty() => {
+                t.ray_traverse_miss(oray, |o, id| self.test(ray, o, id, &wt, &mut last, c))
+            }
             Tree::Bvh2(_) => true,
-            Tree::Cwbvh(t) => t.ray_traverse_miss(oray, |o, id| {
-                self.test(ray, o, id, &wt, &mut last, c)
-            }),
+            Tree::Cwbvh(t) => {
+                t.ray_traverse_miss(oray, |o, id| self.test(ray, o, id, &wt, &mut last, c))
+            }
         };
         !miss
     }
@@ -296,8 +312,14 @@ mod tests {
     fn both_layouts_agree_with_reference() {
         for (program, sf) in [(Program::Tree, 3), (Program::Gears, 1)] {
             let scene = Arc::new(
-                generate_scene(program, &Options { size_factor: sf, ..Options::standard(program) })
-                    .unwrap(),
+                generate_scene(
+                    program,
+                    &Options {
+                        size_factor: sf,
+                        ..Options::standard(program)
+                    },
+                )
+                .unwrap(),
             );
             let input = BuildInput {
                 geometry: Arc::new(Geometry::from_scene(&scene)),
@@ -311,7 +333,8 @@ mod tests {
             for i in 0..200 {
                 let a = i as f32 * 0.137;
                 let o = c + Vec3::new(a.cos(), 0.3 + 0.2 * (a * 3.0).sin(), a.sin()) * r;
-                let target = c + Vec3::new((a * 7.0).sin(), (a * 5.0).cos(), (a * 3.0).sin()) * 0.3 * r;
+                let target =
+                    c + Vec3::new((a * 7.0).sin(), (a * 5.0).cos(), (a * 3.0).sin()) * 0.3 * r;
                 let d = (target - o).normalize();
                 let tmax = if i % 2 == 0 { f32::INFINITY } else { r };
                 rays.push(Ray::new(o, d, 0.0, tmax));
@@ -342,7 +365,10 @@ mod tests {
                                 || (a.t - b.t).abs() <= 1e-5 * b.t)
                     })
                     .count();
-                assert!(ok + 2 >= rays.len(), "{layout} on {program}{sf}: {ok} agree");
+                assert!(
+                    ok + 2 >= rays.len(),
+                    "{layout} on {program}{sf}: {ok} agree"
+                );
                 for (o, h) in occ.iter().zip(&got) {
                     assert_eq!(*o, h.is_hit(), "{layout}");
                 }

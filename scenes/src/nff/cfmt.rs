@@ -81,7 +81,11 @@ fn fast_digits(x: f64) -> Option<(bool, i32, [u8; 6])> {
         if k.unsigned_abs() as usize >= POW10.len() {
             return None;
         }
-        let scaled = if k >= 0 { a * POW10[k as usize] } else { a / POW10[(-k) as usize] };
+        let scaled = if k >= 0 {
+            a * POW10[k as usize]
+        } else {
+            a / POW10[(-k) as usize]
+        };
         if scaled < 99999.5 {
             e -= 1;
             continue;
@@ -126,8 +130,15 @@ fn exact_digits(x: f64) -> (bool, i32, [u8; 6]) {
     let len = cur.position() as usize;
     let s = &buf[..len];
     let epos = s.iter().position(|&c| c == b'e').expect("exponent");
-    let exp: i32 = std::str::from_utf8(&s[epos + 1..]).expect("ascii").parse().expect("exponent");
-    let (neg, mant) = if s[0] == b'-' { (true, &s[1..epos]) } else { (false, &s[..epos]) };
+    let exp: i32 = std::str::from_utf8(&s[epos + 1..])
+        .expect("ascii")
+        .parse()
+        .expect("exponent");
+    let (neg, mant) = if s[0] == b'-' {
+        (true, &s[1..epos])
+    } else {
+        (false, &s[..epos])
+    };
     let mut digits = [0u8; 6];
     digits[0] = mant[0];
     digits[1..].copy_from_slice(&mant[2..7]);

@@ -1,0 +1,246 @@
+//! `rtbench check` and `rtbench render` as scripts use them: Embree against the f64 reference on
+//! the seven small SPD scenes, bad input → exit 2 with one line.
+
+use serde_json::Value;
+use std::process::{Command, Output};
+
+fn rtbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rtbench"))
+        .args(args)
+        .output()
+        .expect("rtbench runs")
+}
+
+fn embree_available() -> bool {
+    let out = rtbench(&["engines", "--json"]);
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    v.as_array()
+        .unwrap()
+        .iter()
+        .any(|e| e["name"] == "embree" && e["available"] == true)
+}
+
+/// Issue 3, acceptance 2: hit agreement ≥ 99.99%, relative t error p99 ≤ 1e-5. At 128×128
+/// pixels (the CLI's default is 512; the test keeps the brute-force reference quick).
+#[test]
+fn embree_agrees_with_the_reference_on_small_scenes() {
+    assert!(
+        embree_available(),
+        "the embree engine is not available: run scripts/setup.sh"
+    );
+    for (scene, sf) in [
+        ("balls", 2),
+        ("gears", 1),
+        ("mount", 3),
+        ("rings", 2),
+        ("teapot", 3),
+        ("tetra", 4),
+        ("tree", 6),
+    ] {
+        let sf = sf.to_string();
+        let out = rtbench(&[
+            "check",
+            "--scene",
+            scene,
+            "--sf",
+            &sf,
+            "--engine",
+            "embree",
+            "--against",
+            "reference",
+            "--size",
+            "128",
+            "--json",
+        ]);
+        let v: Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|_| panic!("{scene}: {}", String::from_utf8_lossy(&out.stderr)));
+        let agreement = v["hit_agreement"].as_f64().unwrap();
+        let p99 = v["t_rel_err"]["p99"].as_f64().unwrap();
+        assert!(
+            agreement >= 0.9999,
+            "{scene}{sf}: agreement {agreement}: {v}"
+        );
+        assert!(p99 <= 1e-5, "{scene}{sf}: t p99 {p99}");
+        assert!(v["rays"].as_u64().unwrap() > 16_000);
+        assert!(out.status.success());
+    }
+}
+
+#[test]
+fn render_json_has_the_contract_fields() {
+    let out = rtbench(&[
+        "render",
+        "--scene",
+        "tetra",
+        "--sf",
+        "3",
+        "--engine",
+        "reference",
+        "--size",
+        "64",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    for k in [
+        "eye",
+        "eye_hit",
+        "shadow",
+        "shadow_blocked",
+        "reflect",
+        "refract",
+        "total",
+    ] {
+        assert!(v["rays"][k].is_u64(), "rays.{k}");
+    }
+    assert_eq!(v["rays"]["eye"], 65 * 65);
+    for k in ["preprocess", "trace"] {
+        assert!(v["time_s"][k].is_f64(), "time_s.{k}");
+    }
+    assert!(v["memory"]["structure_bytes"].is_u64());
+    assert!(v["counters"].is_object());
+    assert_eq!(v["image"]["width"], 64);
+    assert_eq!(v["image"]["sha256"].as_str().unwrap().len(), 64);
+}
+
+#[test]
+fn same_image_from_two_engines_when_hits_agree() {
+    // tetra 3 is 64 triangles: the reference and a BVH give the same image bit for bit.
+    let a = rtbench(&[
+        "render",
+        "--scene",
+        "tetra",
+        "--sf",
+        "3",
+        "--engine",
+        "reference",
+        "--size",
+        "96",
+        "--json",
+    ]);
+    let b = rtbench(&[
+        "render", "--scene", "tetra", "--sf", "3", "--engine", "bvh2", "--size", "96", "--json",
+    ]);
+    let (a, b): (Value, Value) = (
+        serde_json::from_slice(&a.stdout).unwrap(),
+        serde_json::from_slice(&b.stdout).unwrap(),
+    );
+    assert_eq!(a["rays"], b["rays"]);
+    assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
+}
+
+fn expect_input_error(args: &[&str], needle: &str) {
+    let out = rtbench(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    assert!(
+        err.contains(needle),
+        "{args:?}: '{err}' does not mention '{needle}'"
+    );
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn bad_render_and_check_input_exits_2() {
+    expect_input_error(
+        &["render", "--scene", "tetra", "--engine", "warp-drive"],
+        "unknown engine 'warp-drive'",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "no/such/file.nff",
+            "--engine",
+            "reference",
+        ],
+        "no/such/file.nff",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--sf",
+            "0",
+            "--engine",
+            "reference",
+        ],
+        "size factor must be at least 1",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "reference",
+            "--size",
+            "0",
+        ],
+        "--size 0",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "reference",
+            "--set",
+            "leaf=4",
+        ],
+        "has no setting 'leaf'",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "bvh4",
+            "--set",
+            "colour=blue",
+        ],
+        "has no setting 'colour'",
+    );
+    expect_input_error(
+        &[
+            "render", "--scene", "tetra", "--engine", "bvh4", "--set", "noequals",
+        ],
+        "expected key=value",
+    );
+    expect_input_error(
+        &[
+            "check",
+            "--scene",
+            "tetra",
+            "--engine",
+            "bvh4",
+            "--against",
+            "nothing",
+        ],
+        "unknown engine 'nothing'",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "reference",
+            "--threads",
+            "0",
+        ],
+        "--threads",
+    );
+}
