@@ -15,6 +15,7 @@
 //! ```
 
 pub mod bvh;
+pub mod embree;
 pub mod engine;
 pub mod geometry;
 pub mod grid;
@@ -29,6 +30,7 @@ pub use ray::{Hit, Ray};
 pub fn registry() -> Vec<EngineInfo> {
     vec![
         reference::info(),
+        embree::info(),
         grid::info(),
         bvh::info2(),
         bvh::info4(),

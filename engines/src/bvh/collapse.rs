@@ -1,49 +1,85 @@
 //! Binary tree → N-wide tree, the common way (Embree's BVHN builders; Dammertz, Hanika and
 //! Keller 2008's QBVH; Wald, Benthin and Boulos 2008): a wide node starts with its binary
-//! node's two children and keeps replacing the inner child of largest surface area by that
-//! child's own two children until it has N children or only leaves remain. Opening the largest
-//! box first keeps the children that a ray is most likely to enter apart, which is what a
-//! greedy SAH choice does. Leaves keep their primitive ranges.
+//! node's two children and keeps replacing the child of largest surface area by that child's
+//! own two children until it has N children. Opening the largest box first keeps apart the
+//! children a ray is most likely to enter, which is what a greedy SAH choice does.
+//!
+//! Leaves follow Embree's `minLeafSize` rule: a subtree of at most `leaf` primitives becomes
+//! one leaf and is never opened (its primitives are contiguous in the binary tree's order, as
+//! every builder here keeps subtrees contiguous). With `leaf = 1` that is the binary tree's own
+//! leaves (001). So the binary tree is best built down to one primitive per leaf; merging
+//! small subtrees here, rather than stopping the binary build early, lets wide nodes fill all
+//! N slots.
 
 use super::tree::{BuildKind, BuildTree, MAX_WIDTH};
 
-pub fn collapse(bin: &BuildTree, width: usize) -> BuildTree {
-    assert!((2..=MAX_WIDTH).contains(&width));
+pub fn collapse(bin: &BuildTree, width: usize, leaf: usize) -> BuildTree {
+    assert!((2..=MAX_WIDTH).contains(&width) && leaf >= 1);
+    let mut span = vec![(0u32, 0u32); bin.nodes.len()];
+    spans(bin, 0, &mut span);
     let mut out = BuildTree {
         nodes: Vec::with_capacity(bin.nodes.len() / (width - 1) + 1),
         order: bin.order.clone(),
     };
-    node(bin, 0, width, &mut out);
+    node(bin, &span, 0, width, leaf, &mut out);
     out
 }
 
-fn node(bin: &BuildTree, i: u32, width: usize, out: &mut BuildTree) -> u32 {
-    let n = &bin.nodes[i as usize];
-    let BuildKind::Inner { children, len } = n.kind else {
-        return out.push(n.bounds, n.kind);
+/// (first, count) of the primitives under each node.
+fn spans(bin: &BuildTree, i: u32, span: &mut [(u32, u32)]) -> (u32, u32) {
+    let s = match bin.nodes[i as usize].kind {
+        BuildKind::Leaf { first, count } => (first, count),
+        BuildKind::Inner { children, len } => {
+            let (mut first, mut count) = (u32::MAX, 0);
+            for &c in &children[..len as usize] {
+                let (f, n) = spans(bin, c, span);
+                first = first.min(f);
+                count += n;
+            }
+            (first, count)
+        }
     };
-    let mut kids: Vec<u32> = children[..len as usize].to_vec();
+    span[i as usize] = s;
+    s
+}
+
+fn node(
+    bin: &BuildTree,
+    span: &[(u32, u32)],
+    i: u32,
+    width: usize,
+    leaf: usize,
+    out: &mut BuildTree,
+) -> u32 {
+    let n = &bin.nodes[i as usize];
+    let (first, count) = span[i as usize];
+    let children = match n.kind {
+        BuildKind::Inner { children, len } if count as usize > leaf => {
+            children[..len as usize].to_vec()
+        }
+        _ => return out.push(n.bounds, BuildKind::Leaf { first, count }),
+    };
+    let mut kids = children;
     while kids.len() < width {
-        // The inner child of largest area whose children still fit.
+        // The child of largest area that is not to become a leaf.
         let best = kids
             .iter()
             .enumerate()
-            .filter_map(|(slot, &k)| match bin.nodes[k as usize].kind {
-                BuildKind::Inner { len, .. } if kids.len() - 1 + len as usize <= width => {
-                    Some((slot, bin.nodes[k as usize].bounds.half_area()))
-                }
-                _ => None,
+            .filter(|&(_, &k)| {
+                span[k as usize].1 as usize > leaf
+                    && matches!(bin.nodes[k as usize].kind, BuildKind::Inner { len, .. }
+                        if kids.len() - 1 + len as usize <= width)
             })
+            .map(|(slot, &k)| (slot, bin.nodes[k as usize].bounds.half_area()))
             .max_by(|a, b| a.1.total_cmp(&b.1));
         let Some((slot, _)) = best else { break };
-        let opened = kids[slot];
-        let grand = bin.children(opened).to_vec();
+        let grand = bin.children(kids[slot]).to_vec();
         kids.splice(slot..slot + 1, grand);
     }
     let me = out.push(n.bounds, n.kind);
     let mut wide = [0u32; MAX_WIDTH];
     for (slot, &k) in kids.iter().enumerate() {
-        wide[slot] = node(bin, k, width, out);
+        wide[slot] = node(bin, span, k, width, leaf, out);
     }
     out.nodes[me as usize].kind = BuildKind::Inner {
         children: wide,
@@ -60,11 +96,8 @@ mod tests {
     use crate::geometry::aabb::Aabb;
     use glam::Vec3;
 
-    #[test]
-    fn collapsing_a_balanced_binary_tree() {
-        // 16 primitives, one per leaf: binary depth 4 → 4-wide depth 2 with 5 inner nodes and
-        // no empty slot; 8-wide: 9 inner nodes (the root's 8 children hold 2 leaves each).
-        let bounds: Vec<Aabb> = (0..16)
+    fn row(n: usize) -> BuildPrims {
+        let bounds: Vec<Aabb> = (0..n)
             .map(|i| {
                 Aabb::new(
                     Vec3::new(i as f32, 0.0, 0.0),
@@ -72,26 +105,54 @@ mod tests {
                 )
             })
             .collect();
-        let p = BuildPrims {
+        BuildPrims {
             centroid: bounds.iter().map(|b| b.centre()).collect(),
             bounds,
-        };
+        }
+    }
+
+    fn inner(t: &BuildTree) -> usize {
+        t.nodes
+            .iter()
+            .filter(|n| matches!(n.kind, BuildKind::Inner { .. }))
+            .count()
+    }
+
+    #[test]
+    fn collapsing_a_balanced_binary_tree() {
+        // 16 primitives, one per leaf: binary depth 4 → 4-wide depth 2 with 5 inner nodes and
+        // no empty slot; 8-wide: 9 inner nodes (the root's 8 children hold 2 leaves each).
+        let p = row(16);
         let bin = build_median::binary(&p, 1);
-        let inner = |t: &BuildTree| {
-            t.nodes
-                .iter()
-                .filter(|n| matches!(n.kind, BuildKind::Inner { .. }))
-                .count()
-        };
-        let w4 = collapse(&bin, 4);
+        let w4 = collapse(&bin, 4, 1);
         w4.validate(&p, 4).unwrap();
         assert_eq!(inner(&w4), 5);
-        assert!(w4.children(0).len() == 4);
-        let w8 = collapse(&bin, 8);
+        assert_eq!(w4.children(0).len(), 4);
+        let w8 = collapse(&bin, 8, 1);
         w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
         assert_eq!(w8.children(0).len(), 8);
-        let w2 = collapse(&bin, 2);
+        let w2 = collapse(&bin, 2, 1);
         assert_eq!(w2.nodes.len(), bin.nodes.len());
+    }
+
+    #[test]
+    fn small_subtrees_become_leaves() {
+        // 64 primitives, leaf 2: 32 leaves of 2; 8-wide: a root of 8 children of 4 leaves each.
+        let p = row(64);
+        let bin = build_median::binary(&p, 1);
+        let w8 = collapse(&bin, 8, 2);
+        w8.validate(&p, 8).unwrap();
+        let leaves: Vec<u32> = w8
+            .nodes
+            .iter()
+            .filter_map(|n| match n.kind {
+                BuildKind::Leaf { count, .. } => Some(count),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(leaves, vec![2; 32]);
+        assert_eq!(inner(&w8), 9);
+        assert!(w8.children(0).len() == 8);
     }
 }

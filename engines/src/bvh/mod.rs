@@ -75,24 +75,32 @@ pub struct BvhEngine<const N: usize> {
 pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     let prims = BuildPrims::new(geometry);
     let (width, leaf) = (config.width, config.leaf);
-    let direct = config.wide == WideMethod::Direct && width > 2;
-    match (config.builder, direct) {
-        (Builder::Median, false) => collapse::collapse(&build_median::binary(&prims, leaf), width),
-        (Builder::Median, true) => build_median::nway(&prims, leaf, width),
-        (Builder::SahSweep, false) => collapse::collapse(
-            &build_sah::binary(build_sah::Sweep::new(&prims), leaf),
-            width,
-        ),
-        (Builder::SahSweep, true) => {
-            build_sah::wide_same_axis(build_sah::Sweep::new(&prims), leaf, width)
+    if width > 2 && config.wide == WideMethod::Direct {
+        return match config.builder {
+            Builder::Median => build_median::nway(&prims, leaf, width),
+            Builder::SahSweep => {
+                build_sah::wide_same_axis(build_sah::Sweep::new(&prims), leaf, width)
+            }
+            Builder::SahBinned => {
+                build_sah::wide_same_axis(build_sah::Binned::new(&prims, config.bins), leaf, width)
+            }
+        };
+    }
+    // bvh2 keeps the binary tree as built (leaves of up to `leaf` where the SAH prefers them);
+    // wider trees collapse a binary tree built down to single primitives, merging subtrees of
+    // at most `leaf` primitives into leaves (collapse.rs).
+    let binary_leaf = if width == 2 { leaf } else { 1 };
+    let binary = match config.builder {
+        Builder::Median => build_median::binary(&prims, binary_leaf),
+        Builder::SahSweep => build_sah::binary(build_sah::Sweep::new(&prims), binary_leaf),
+        Builder::SahBinned => {
+            build_sah::binary(build_sah::Binned::new(&prims, config.bins), binary_leaf)
         }
-        (Builder::SahBinned, false) => collapse::collapse(
-            &build_sah::binary(build_sah::Binned::new(&prims, config.bins), leaf),
-            width,
-        ),
-        (Builder::SahBinned, true) => {
-            build_sah::wide_same_axis(build_sah::Binned::new(&prims, config.bins), leaf, width)
-        }
+    };
+    if width == 2 {
+        binary
+    } else {
+        collapse::collapse(&binary, width, leaf)
     }
 }
 

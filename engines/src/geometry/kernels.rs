@@ -51,6 +51,19 @@ macro_rules! kernels {
         /// Solves |q⊥ + t·d⊥|² = (rb + k·(q·w + t·d·w))² with w the unit axis, k the slope.
         #[inline]
         pub fn cone(o: V, d: V, tmin: T, tmax: T, base: V, rb: T, apex: V, ra: T) -> Option<T> {
+            // Solve from the ray's point nearest the cone's centre, not from its far-away origin:
+            // the quadratic's coefficients then carry no large, cancelling terms (in f32 this
+            // took the 99th percentile of the t error on rings and tree from 2e-5 to the level
+            // of the other kernels).
+            let mid = (base + apex) * 0.5;
+            let shift = (mid - o).dot(d) / d.dot(d);
+            let o = o + d * shift;
+            cone_from(o, d, tmin - shift, tmax - shift, base, rb, apex, ra).map(|t| t + shift)
+        }
+
+        #[inline]
+        #[allow(clippy::too_many_arguments)]
+        fn cone_from(o: V, d: V, tmin: T, tmax: T, base: V, rb: T, apex: V, ra: T) -> Option<T> {
             let axis = apex - base;
             let height = axis.length();
             if height == 0.0 {

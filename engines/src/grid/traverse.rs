@@ -30,11 +30,16 @@ use crate::geometry::kernels::f32::WatertightRay;
 use crate::ray::{Hit, Ray};
 use glam::Vec3;
 
+/// Direction components smaller than this count as zero (as the shared slab test's
+/// `MIN_RCP_INPUT`): the ray is taken as parallel to that axis's walls.
+const MIN_MOVE: f32 = 1e-18;
+
 /// Per-ray set-up shared by every primitive test and by the walk.
 struct RaySetup {
     /// 1/d per axis, or 0 along an axis the ray does not move on.
     inv: [f32; 3],
-    /// Whether the ray moves along each axis (1/d is finite).
+    /// Whether the ray moves along each axis: |d| at least [`MIN_MOVE`], so that 1/d and the
+    /// walls' distances stay finite.
     moves: [bool; 3],
     wt: WatertightRay,
 }
@@ -46,9 +51,8 @@ impl RaySetup {
         let mut inv = [0.0; 3];
         let mut moves = [false; 3];
         for i in 0..3 {
-            let v = 1.0 / d[i];
-            if v.is_finite() {
-                inv[i] = v;
+            if d[i].abs() >= MIN_MOVE {
+                inv[i] = 1.0 / d[i];
                 moves[i] = true;
             }
         }
@@ -204,7 +208,9 @@ impl Grid {
             }
             let cull = !self.prim_bounds.is_empty();
             let g = &self.cells;
-            self.walk(ray, &s, |cell, t_enter, t_exit| {
+            // The walk covers the segment left after the floor.
+            let segment = r;
+            self.walk(&segment, &s, |cell, t_enter, t_exit| {
                 c.cells_visited += 1;
                 let list = g.prims_in(cell);
                 if list.is_empty() {
