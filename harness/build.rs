@@ -1,9 +1,36 @@
-//! Gives this package's binaries and tests an rpath to the Embree folder that rtbench-engines linked
-//! against (engines/build.rs passes it as DEP_RTBENCH_EMBREE_LIB_DIR, only when its `embree` feature is on).
-//! A `rustc-link-arg` from a dependency's build script does not reach our binaries, hence this file.
+//! Build script of the rtbench binary.
+//!
+//! - An rpath to the Embree folder that rtbench-engines linked against (engines/build.rs passes it
+//!   as DEP_RTBENCH_EMBREE_LIB_DIR when its `embree` feature is on): a `rustc-link-arg` from a
+//!   dependency's build script does not reach our binaries.
+//! - The git commit and the rustc version, for the environment recorded with every result.
+use std::process::Command;
+
+fn output(cmd: &str, args: &[&str]) -> Option<String> {
+    let o = Command::new(cmd).args(args).output().ok()?;
+    o.status
+        .success()
+        .then(|| String::from_utf8_lossy(&o.stdout).trim().to_string())
+}
+
 fn main() {
     println!("cargo:rerun-if-env-changed=DEP_RTBENCH_EMBREE_LIB_DIR");
     if let Ok(dir) = std::env::var("DEP_RTBENCH_EMBREE_LIB_DIR") {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
     }
+    // Rebuild when HEAD moves or the index changes (a commit or a staged change).
+    for f in ["../.git/HEAD", "../.git/index"] {
+        if std::path::Path::new(f).exists() {
+            println!("cargo:rerun-if-changed={f}");
+        }
+    }
+    let commit = output("git", &["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
+    let dirty = output("git", &["status", "--porcelain", "--untracked-files=no"])
+        .map(|s| !s.is_empty())
+        .unwrap_or(false);
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let rustc_version = output(&rustc, &["--version"]).unwrap_or_else(|| "unknown".into());
+    println!("cargo:rustc-env=RTBENCH_GIT_COMMIT={commit}");
+    println!("cargo:rustc-env=RTBENCH_GIT_DIRTY={dirty}");
+    println!("cargo:rustc-env=RTBENCH_RUSTC={rustc_version}");
 }

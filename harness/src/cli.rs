@@ -31,6 +31,115 @@ pub enum Command {
     Check(CheckArgs),
     /// Remeasure a published table: `reproduce list`, `reproduce <id> --out DIR`.
     Reproduce(ReproduceArgs),
+    /// Many engines × scenes × SFs, each run in its own process, results to DIR/results.jsonl.
+    Run(RunArgs),
+    /// Raise each scene's SF until a run passes the time or memory limit.
+    Sweep(SweepArgs),
+    /// Tables and plots from a results directory.
+    Report(ReportArgs),
+    /// Compare two results directories; exit 1 on a regression.
+    Compare(CompareArgs),
+    /// One measured run, printed as one JSON line (the child process of run and sweep).
+    #[command(hide = true)]
+    RunOne(RunOneArgs),
+}
+
+/// What run and sweep share.
+#[derive(Args, Debug, Clone)]
+pub struct PlanArgs {
+    /// Engines, comma-separated, or `all` (every available engine but `reference`).
+    #[arg(long)]
+    pub engines: String,
+    /// SPD programs, comma-separated, or `standard` (the seven of the SPD tables).
+    #[arg(long)]
+    pub scenes: String,
+    /// Engine settings `engine.key=value` (repeatable).
+    #[arg(long = "set", value_name = "ENGINE.KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Repeats of each run (min, median, max are reported).
+    #[arg(long, default_value_t = 3)]
+    pub repeat: u32,
+    /// Threads: a list of counts and/or `all`, e.g. `1,all`.
+    #[arg(long, default_value = "1")]
+    pub threads: String,
+    #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
+    pub size: u32,
+    /// Skip the cross-check against Embree.
+    #[arg(long)]
+    pub no_check: bool,
+    /// A run still going after this many seconds is stopped and recorded as failed.
+    #[arg(long)]
+    pub max_seconds: Option<f64>,
+    /// A run whose resident memory passes this (bytes; K, M, G, KiB, MiB, GiB suffixes) is stopped
+    /// and recorded as failed.
+    #[arg(long)]
+    pub max_memory: Option<String>,
+    /// Skip runs the results directory already holds.
+    #[arg(long)]
+    pub resume: bool,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub plan: PlanArgs,
+    /// Size factors: `4`, `4,5,6` or `4..8` (default: each program's standard SF).
+    #[arg(long)]
+    pub sf: Option<String>,
+    /// Tessellated scenes (SPD `-t`) at resolution RES.
+    #[arg(long, num_args = 0..=1, default_missing_value = "3", value_name = "RES")]
+    pub tessellate: Option<u32>,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub plan: PlanArgs,
+    /// First size factor of every scene.
+    #[arg(long, default_value_t = 1)]
+    pub sf_start: u32,
+    /// Last size factor tried.
+    #[arg(long, default_value_t = 64)]
+    pub sf_max: u32,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct ReportArgs {
+    pub dir: PathBuf,
+    /// Formats, comma-separated: md, csv, json, svg, png, html (default: all).
+    #[arg(long, default_value = "md,csv,json,svg,png,html")]
+    pub format: String,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct CompareArgs {
+    pub a: PathBuf,
+    pub b: PathBuf,
+    /// Slowdown (percent of the ratio to Embree) below which a change is noise.
+    #[arg(long, default_value_t = 5.0)]
+    pub threshold: f64,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct RunOneArgs {
+    #[command(flatten)]
+    pub scene: SceneFlag,
+    #[arg(long)]
+    pub engine: String,
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[arg(long, default_value_t = 3)]
+    pub repeat: u32,
+    #[arg(long, default_value_t = 512)]
+    pub size: u32,
+    #[arg(long)]
+    pub no_check: bool,
 }
 
 #[derive(Args, Debug, Clone)]

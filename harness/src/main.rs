@@ -4,6 +4,7 @@ mod cli;
 mod commands;
 mod error;
 mod output;
+mod runs;
 mod source;
 mod workload;
 
@@ -28,6 +29,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Engines { json } => commands::engines::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),
+        Command::Run(a) => commands::runs::run(&a),
+        Command::Sweep(a) => commands::runs::sweep(&a),
+        Command::RunOne(a) => commands::runs::run_one_cmd(&a),
+        Command::Report(a) => commands::runs::report(&a),
+        Command::Compare(a) => commands::runs::compare(&a),
         Command::Reproduce(a) if a.id == "list" => commands::reproduce::list(a.json),
         Command::Reproduce(a) => {
             let out = a

@@ -4,12 +4,14 @@
 //! own two children until it has N children. Opening the largest box first keeps apart the
 //! children a ray is most likely to enter, which is what a greedy SAH choice does.
 //!
-//! Leaves follow Embree's `minLeafSize` rule: a subtree of at most `leaf` primitives becomes
-//! one leaf and is never opened (its primitives are contiguous in the binary tree's order, as
-//! every builder here keeps subtrees contiguous). With `leaf = 1` that is the binary tree's own
-//! leaves (001). So the binary tree is best built down to one primitive per leaf; merging
-//! small subtrees here, rather than stopping the binary build early, lets wide nodes fill all
-//! N slots.
+//! Leaves follow Embree's `minLeafSize` rule: a child subtree of at most `leaf` primitives
+//! becomes one leaf (its primitives are contiguous in the binary tree's order, as every builder
+//! here keeps subtrees contiguous). Children bigger than that are opened first; slots still
+//! free are then used to open leaf-sized subtrees too, since a SIMD node tests all N boxes for
+//! the price of one and every slot filled this way saves primitive tests. With `leaf = 1` the
+//! leaves are the binary tree's own (001). The binary tree is therefore built down to one
+//! primitive per leaf; merging small subtrees here, rather than stopping the binary build early,
+//! lets wide nodes fill their N slots.
 
 use super::tree::{BuildKind, BuildTree, MAX_WIDTH};
 
@@ -61,18 +63,22 @@ fn node(
     };
     let mut kids = children;
     while kids.len() < width {
-        // The child of largest area that is not to become a leaf.
+        // Open the child of largest area among those too big to be a leaf; when none is
+        // left, slots still free go to splitting leaf-sized subtrees, which costs no extra
+        // node and leaves fewer primitives per leaf.
         let best = kids
             .iter()
             .enumerate()
             .filter(|&(_, &k)| {
-                span[k as usize].1 as usize > leaf
-                    && matches!(bin.nodes[k as usize].kind, BuildKind::Inner { len, .. }
-                        if kids.len() - 1 + len as usize <= width)
+                matches!(bin.nodes[k as usize].kind, BuildKind::Inner { len, .. }
+                    if kids.len() - 1 + len as usize <= width)
             })
-            .map(|(slot, &k)| (slot, bin.nodes[k as usize].bounds.half_area()))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((slot, _)) = best else { break };
+            .map(|(slot, &k)| {
+                let big = span[k as usize].1 as usize > leaf;
+                (slot, big, bin.nodes[k as usize].bounds.half_area())
+            })
+            .max_by(|a, b| a.1.cmp(&b.1).then(a.2.total_cmp(&b.2)));
+        let Some((slot, _, _)) = best else { break };
         let grand = bin.children(kids[slot]).to_vec();
         kids.splice(slot..slot + 1, grand);
     }
@@ -137,13 +143,14 @@ mod tests {
     }
 
     #[test]
-    fn small_subtrees_become_leaves() {
-        // 64 primitives, leaf 2: 32 leaves of 2; 8-wide: a root of 8 children of 4 leaves each.
-        let p = row(64);
+    fn small_subtrees_become_leaves_and_free_slots_split_them() {
+        // 24 primitives, 4-wide, leaf 2: the root takes four subtrees of 6; each of those is
+        // opened into 3 + 3, then (slots still free) into 1 + 2 + 1 + 2.
+        let p = row(24);
         let bin = build_median::binary(&p, 1);
-        let w8 = collapse(&bin, 8, 2);
-        w8.validate(&p, 8).unwrap();
-        let leaves: Vec<u32> = w8
+        let w4 = collapse(&bin, 4, 2);
+        w4.validate(&p, 4).unwrap();
+        let mut leaves: Vec<u32> = w4
             .nodes
             .iter()
             .filter_map(|n| match n.kind {
@@ -151,8 +158,14 @@ mod tests {
                 _ => None,
             })
             .collect();
-        assert_eq!(leaves, vec![2; 32]);
+        leaves.sort();
+        assert_eq!(leaves, [vec![1; 8], vec![2; 8]].concat());
+        assert_eq!(inner(&w4), 5);
+        // With room to spare every leaf ends up with one primitive: 64 primitives, 8-wide.
+        let p = row(64);
+        let w8 = collapse(&build_median::binary(&p, 1), 8, 4);
+        w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
-        assert!(w8.children(0).len() == 8);
+        assert_eq!(w8.nodes.len() - inner(&w8), 64);
     }
 }

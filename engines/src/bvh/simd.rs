@@ -24,6 +24,10 @@ pub trait ChildTest<const N: usize> {
     /// Bit `i` set when child `i`'s box overlaps `[tmin, tmax]` along the ray; `dist[i]` is
     /// then its entry distance.
     fn test(node: &WideNode<N>, r: &Self::Ray, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32;
+    /// Asks for the `bytes` from `x` to be brought into the cache (a hint; nothing for the
+    /// scalar form). Embree's traversal does the same for every child the ray hits.
+    #[inline(always)]
+    fn prefetch<X>(_x: &X, _bytes: usize) {}
 }
 
 /// The batch entry points of one traversal kernel.
@@ -170,8 +174,27 @@ mod x86 {
         far: [usize; 3],
     }
 
+    /// Prefetches the cache lines of `bytes` bytes from `x`.
+    #[inline(always)]
+    fn prefetch_lines<X>(x: &X, bytes: usize) {
+        let p = x as *const X as *const i8;
+        let mut off = 0;
+        while off < bytes {
+            // SAFETY: SSE is part of the x86-64 baseline; a prefetch is only a hint and never
+            // faults, whatever the address (the offset stays within `bytes` of a live object
+            // or just past it, which `wrapping_add` computes without assuming anything).
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off)) };
+            off += 64;
+        }
+    }
+
     impl ChildTest<4> for Sse4 {
         type Ray = Sse4Ray;
+
+        #[inline(always)]
+        fn prefetch<X>(x: &X, bytes: usize) {
+            prefetch_lines(x, bytes)
+        }
 
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Sse4Ray {
@@ -233,6 +256,11 @@ mod x86 {
 
     impl ChildTest<8> for Avx8 {
         type Ray = Avx8Ray;
+
+        #[inline(always)]
+        fn prefetch<X>(x: &X, bytes: usize) {
+            prefetch_lines(x, bytes)
+        }
 
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Avx8Ray {

@@ -33,6 +33,27 @@ pub struct Bvh<const N: usize> {
     pub objects: Vec<u32>,
 }
 
+/// Prefetches every child in `mask`: a node's cache lines, or a leaf's first primitives.
+#[inline(always)]
+fn prefetch_children<const N: usize, T: ChildTest<N>>(
+    bvh: &Bvh<N>,
+    node: &WideNode<N>,
+    mut mask: u32,
+) {
+    while mask != 0 {
+        let c = node.child[mask.trailing_zeros() as usize];
+        mask &= mask - 1;
+        if is_leaf(c) {
+            let (first, count) = leaf_range(c);
+            if let Some(p) = bvh.prims.get(first) {
+                T::prefetch(p, (count * std::mem::size_of::<Prim>()).min(256));
+            }
+        } else if let Some(n) = bvh.nodes.get(c as usize) {
+            T::prefetch(n, std::mem::size_of::<WideNode<N>>());
+        }
+    }
+}
+
 #[derive(Clone, Copy, Default)]
 struct Entry {
     node: u32,
@@ -145,6 +166,7 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
             tally.boxes += node.len as u64;
             let mut mask = T::test(node, &tr, r.tmin, r.tmax, &mut dist);
             if mask != 0 {
+                prefetch_children::<N, T>(bvh, node, mask);
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if mask == 0 {
@@ -244,6 +266,7 @@ fn any<const N: usize, T: ChildTest<N>, const W: bool>(
             tally.boxes += node.len as u64;
             let mut mask = T::test(node, &tr, ray.tmin, ray.tmax, &mut dist);
             if mask != 0 {
+                prefetch_children::<N, T>(bvh, node, mask);
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 while mask != 0 {

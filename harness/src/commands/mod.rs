@@ -4,4 +4,5 @@ pub mod check;
 pub mod engines;
 pub mod render;
 pub mod reproduce;
+pub mod runs;
 pub mod scene;

@@ -1,6 +1,7 @@
 //! The SPD workload: camera, surfaces, and the wavefront tracer.
 
 pub mod camera;
+pub mod crosscheck;
 pub mod surface;
 pub mod trace;
 

@@ -1,0 +1,302 @@
+//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (../shared/CLI.md, "Runs and reports").
+
+use crate::cli::{CompareArgs, PlanArgs, ReportArgs, RunArgs, RunOneArgs, SweepArgs};
+use crate::error::{input, Failure, Result};
+use crate::output::print_json;
+use crate::runs::one::{run_one, OneSpec};
+use crate::runs::plan::{self, Common, Job, ResultsDir};
+use crate::source::Source;
+use crate::workload;
+use rtbench_scenes::spd::Program;
+
+/// `4`, `4,5,6` or `4..8`.
+pub fn parse_sf_list(s: &str) -> Result<Vec<u32>> {
+    let bad = || input(format!("--sf '{s}': expected N, N,M,… or A..B"));
+    let mut out = Vec::new();
+    for part in s.split(',') {
+        let part = part.trim();
+        if let Some((a, b)) = part.split_once("..") {
+            let (a, b): (u32, u32) = (
+                a.trim().parse().map_err(|_| bad())?,
+                b.trim().parse().map_err(|_| bad())?,
+            );
+            if a > b {
+                return Err(bad());
+            }
+            out.extend(a..=b);
+        } else {
+            out.push(part.parse().map_err(|_| bad())?);
+        }
+    }
+    if out.contains(&0) {
+        return Err(input("--sf: size factor must be at least 1, got 0"));
+    }
+    Ok(out)
+}
+
+/// `1234`, `64M`, `2GiB` … → bytes.
+pub fn parse_bytes(s: &str) -> Result<u64> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !c.is_ascii_digit() && c != '.')
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let n: f64 = num.parse().map_err(|_| {
+        input(format!(
+            "--max-memory '{s}': expected bytes, e.g. 512M or 2GiB"
+        ))
+    })?;
+    let mult = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "k" | "kb" => 1e3,
+        "m" | "mb" => 1e6,
+        "g" | "gb" => 1e9,
+        "kib" => 1024.0,
+        "mib" => 1048576.0,
+        "gib" => 1073741824.0,
+        _ => return Err(input(format!("--max-memory '{s}': unknown unit '{unit}'"))),
+    };
+    Ok((n * mult) as u64)
+}
+
+/// Engines of a plan with their settings (`engine.key=value`), checked against the registry.
+fn plan_engines(p: &PlanArgs) -> Result<Vec<(String, Vec<(String, String)>)>> {
+    let registry = rtbench_engines::registry();
+    let names: Vec<String> = if p.engines.trim() == "all" {
+        registry
+            .iter()
+            .filter(|e| e.name != "reference" && (e.available)().is_ok())
+            .map(|e| e.name.to_string())
+            .collect()
+    } else {
+        p.engines
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+            .collect()
+    };
+    if names.is_empty() {
+        return Err(input("--engines: no engine given"));
+    }
+    let mut out = Vec::new();
+    for n in &names {
+        let info = registry
+            .iter()
+            .find(|e| e.name == n)
+            .ok_or_else(|| input(format!("unknown engine '{n}' (see `rtbench engines`)")))?;
+        (info.available)().map_err(|r| input(format!("engine '{n}' is not available: {r}")))?;
+        out.push((n.clone(), Vec::new()));
+    }
+    for s in &p.set {
+        let (lhs, v) = s
+            .split_once('=')
+            .ok_or_else(|| input(format!("--set '{s}': expected engine.key=value")))?;
+        let (e, k) = lhs
+            .split_once('.')
+            .ok_or_else(|| input(format!("--set '{s}': expected engine.key=value")))?;
+        let slot = out
+            .iter_mut()
+            .find(|(n, _)| n == e)
+            .ok_or_else(|| input(format!("--set '{s}': engine '{e}' is not in --engines")))?;
+        slot.1.push((k.to_string(), v.to_string()));
+    }
+    Ok(out)
+}
+
+fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
+    if p.scenes.trim() == "standard" {
+        return Ok(Program::STANDARD.to_vec());
+    }
+    p.scenes
+        .split(',')
+        .map(|s| s.trim().parse::<Program>().map_err(input))
+        .collect()
+}
+
+fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
+    p.threads
+        .split(',')
+        .map(|t| match t.trim() {
+            "all" => Ok(None),
+            n => match n.parse::<usize>() {
+                Ok(0) | Err(_) => Err(input(format!(
+                    "--threads '{}': expected counts ≥ 1 or 'all'",
+                    p.threads
+                ))),
+                Ok(n) => Ok(Some(n)),
+            },
+        })
+        .collect()
+}
+
+fn common(p: &PlanArgs) -> Result<Common> {
+    workload::check_size(p.size)?;
+    if p.repeat == 0 {
+        return Err(input("--repeat must be at least 1"));
+    }
+    if let Some(s) = p.max_seconds {
+        if !(s > 0.0) {
+            return Err(input(format!("--max-seconds {s}: must be positive")));
+        }
+    }
+    Ok(Common {
+        repeats: p.repeat,
+        size: p.size,
+        check: !p.no_check,
+        max_seconds: p.max_seconds,
+        max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
+    })
+}
+
+pub fn run(a: &RunArgs) -> Result<()> {
+    let engines = plan_engines(&a.plan)?;
+    let programs = plan_programs(&a.plan)?;
+    let threads = plan_threads(&a.plan)?;
+    let common = common(&a.plan)?;
+    let sfs = a.sf.as_deref().map(parse_sf_list).transpose()?;
+    let mut jobs = Vec::new();
+    for p in &programs {
+        for sf in sfs.clone().unwrap_or_else(|| vec![p.standard_sf()]) {
+            let opts = rtbench_scenes::spd::Options {
+                size_factor: sf,
+                tessellate: a.tessellate,
+                ..rtbench_scenes::spd::Options::standard(*p)
+            };
+            rtbench_scenes::spd::validate(*p, &opts)?;
+            for t in &threads {
+                for (e, s) in &engines {
+                    jobs.push(Job {
+                        engine: e.clone(),
+                        settings: s.clone(),
+                        program: p.name().into(),
+                        sf,
+                        tessellate: a.tessellate,
+                        threads: *t,
+                    });
+                }
+            }
+        }
+    }
+    let mut out = ResultsDir::open(&a.plan.out, a.plan.resume)?;
+    let failures = plan::run(&jobs, &common, &mut out, a.plan.resume)?;
+    eprintln!(
+        "{} runs, {failures} failed: {}",
+        jobs.len(),
+        a.plan.out.join("results.jsonl").display()
+    );
+    if failures > 0 {
+        return Err(Failure::Check(format!(
+            "{failures} of {} runs failed (see {})",
+            jobs.len(),
+            a.plan.out.join("results.jsonl").display()
+        )));
+    }
+    Ok(())
+}
+
+pub fn sweep(a: &SweepArgs) -> Result<()> {
+    let engines = plan_engines(&a.plan)?;
+    let programs: Vec<String> = plan_programs(&a.plan)?
+        .iter()
+        .map(|p| p.name().to_string())
+        .collect();
+    let threads = plan_threads(&a.plan)?;
+    if threads.len() != 1 {
+        return Err(input("sweep: give one --threads value"));
+    }
+    let common = common(&a.plan)?;
+    if common.max_seconds.is_none() && common.max_memory.is_none() {
+        return Err(input(
+            "sweep: give --max-seconds or --max-memory (the limit that ends each scene's sweep)",
+        ));
+    }
+    if a.sf_start == 0 || a.sf_start > a.sf_max {
+        return Err(input(format!(
+            "sweep: --sf-start {} must be from 1 to --sf-max {}",
+            a.sf_start, a.sf_max
+        )));
+    }
+    let mut out = ResultsDir::open(&a.plan.out, a.plan.resume)?;
+    let n = plan::sweep(
+        &engines,
+        &programs,
+        a.sf_start,
+        a.sf_max,
+        threads[0],
+        &common,
+        &mut out,
+        a.plan.resume,
+    )?;
+    eprintln!(
+        "sweep: {n} runs: {}",
+        a.plan.out.join("results.jsonl").display()
+    );
+    Ok(())
+}
+
+pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
+    let spec = OneSpec {
+        engine: a.engine.clone(),
+        settings: workload::parse_settings(&a.set)?,
+        source: Source::resolve(
+            &a.scene.scene,
+            a.scene.opts.sf,
+            a.scene.opts.tessellate,
+            a.scene.opts.hash,
+        )?,
+        threads: a.threads,
+        repeats: a.repeat,
+        size: a.size,
+        check: !a.no_check,
+    };
+    let rec = run_one(&spec)?;
+    println!(
+        "{}",
+        serde_json::to_string(&rec).expect("record serialises")
+    );
+    Ok(())
+}
+
+pub fn report(a: &ReportArgs) -> Result<()> {
+    let formats = a
+        .format
+        .split(',')
+        .map(|f| {
+            f.trim()
+                .parse::<rtbench_reports::Format>()
+                .map_err(|e| input(format!("--format: {e}")))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    if !a.dir.join("results.jsonl").is_file() {
+        return Err(input(format!("{}: no results.jsonl here", a.dir.display())));
+    }
+    let summary =
+        rtbench_reports::write_report(&a.dir, &formats).map_err(|e| input(e.to_string()))?;
+    eprintln!("report: {summary:?}");
+    Ok(())
+}
+
+pub fn compare(a: &CompareArgs) -> Result<()> {
+    for d in [&a.a, &a.b] {
+        if !d.join("results.jsonl").is_file() {
+            return Err(input(format!("{}: no results.jsonl here", d.display())));
+        }
+    }
+    if !(a.threshold >= 0.0) {
+        return Err(input(format!(
+            "--threshold {}: must be a percentage ≥ 0",
+            a.threshold
+        )));
+    }
+    let c = rtbench_reports::compare(&a.a, &a.b, a.threshold).map_err(|e| input(e.to_string()))?;
+    if a.json {
+        print_json(&serde_json::to_value(&c).expect("comparison serialises"));
+    } else {
+        print!("{}", c.to_markdown());
+    }
+    if c.is_regression() {
+        let names: Vec<String> = c.regressions.iter().map(|f| f.message.clone()).collect();
+        return Err(Failure::Check(format!("regression: {}", names.join("; "))));
+    }
+    Ok(())
+}

@@ -1,0 +1,145 @@
+//! One measured run (`rtbench run-one`, the child process of `run` and `sweep`): generate the
+//! scene, build and trace `repeats` times, cross-check against Embree, print one [`RunRecord`].
+//! Running in its own process makes the peak RSS this run's alone, and a crash costs one run.
+
+use crate::error::Result;
+use crate::source::Source;
+use crate::workload::{self, crosscheck, trace};
+use rtbench_reports::{run_key, CheckResult, RunRecord, SceneInfo, Spread, Timings};
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct OneSpec {
+    pub engine: String,
+    pub settings: Vec<(String, String)>,
+    pub source: Source,
+    /// `None`: all cores.
+    pub threads: Option<usize>,
+    pub repeats: u32,
+    pub size: u32,
+    /// Cross-check against Embree (skipped for Embree itself, or when it is unavailable).
+    pub check: bool,
+}
+
+/// Counters as a flat name → value map (common fields and the engine's own).
+fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String, u64> {
+    let mut m = BTreeMap::new();
+    if let Ok(serde_json::Value::Object(o)) = serde_json::to_value(c) {
+        for (k, v) in o {
+            match v {
+                serde_json::Value::Number(n) => {
+                    m.insert(k, n.as_u64().unwrap_or(0));
+                }
+                serde_json::Value::Object(extra) => {
+                    for (k2, v2) in extra {
+                        m.insert(k2, v2.as_u64().unwrap_or(0));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    m
+}
+
+pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
+    let start = Instant::now();
+    workload::check_size(spec.size)?;
+    let pool = workload::pool(spec.threads)?;
+    let prepared = workload::prepare(&spec.source)?;
+    let scene = &prepared.input.scene;
+    let (mut build, mut tr, mut is, mut sh) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut last = None;
+    for _ in 0..spec.repeats.max(1) {
+        let (engine, build_s) =
+            workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
+        let r = pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
+        build.push(prepared.prepare_s + build_s);
+        tr.push(r.trace_s);
+        is.push(r.intersect_s);
+        sh.push(r.shade_s);
+        last = Some((engine, r));
+    }
+    let (engine, render) = last.expect("at least one repeat");
+    // Before the cross-check builds Embree too.
+    let peak_rss_bytes = workload::peak_rss_bytes().unwrap_or(0);
+    let check = if spec.check
+        && spec.engine != "embree"
+        && rtbench_engines::registry()
+            .iter()
+            .any(|e| e.name == "embree" && (e.available)().is_ok())
+    {
+        let (yardstick, _) = workload::build("embree", &prepared.input, vec![])?;
+        let c = pool.install(|| {
+            crosscheck::cross_check(
+                scene,
+                engine.as_ref(),
+                yardstick.as_ref(),
+                spec.size,
+                Some(&render),
+            )
+        });
+        Some(CheckResult {
+            against: "embree".into(),
+            rays: c.rays(),
+            hit_agreement: c.agreement(),
+            t_rel_err_median: c.t_rel_err.median,
+            t_rel_err_p99: c.t_rel_err.p99,
+            t_rel_err_max: c.t_rel_err.max,
+            image_psnr_db: c.image_psnr_db,
+        })
+    } else {
+        None
+    };
+    let trace = Spread::of(&tr);
+    let settings: BTreeMap<String, String> = spec.settings.iter().cloned().collect();
+    let threads = pool.current_num_threads();
+    let (program, sf, tessellate) = match &spec.source {
+        Source::Program(p, o) => (
+            Some(p.name().to_string()),
+            Some(o.size_factor),
+            o.tessellate,
+        ),
+        Source::File(_) => (None, None, None),
+    };
+    let pixels = render.pixels();
+    use sha2::Digest;
+    Ok(RunRecord {
+        key: run_key(&spec.engine, &settings, &spec.source.label(), threads),
+        status: "ok".into(),
+        reason: None,
+        engine: spec.engine.clone(),
+        settings,
+        scene: SceneInfo {
+            name: spec.source.label(),
+            program,
+            sf,
+            tessellate,
+            objects: scene.objects.len() as u64,
+            primitives: prepared.input.geometry.prims.len() as u64,
+        },
+        threads,
+        repeats: spec.repeats.max(1),
+        size: spec.size,
+        rays: serde_json::to_value(&render.stats).ok(),
+        rays_total: render.stats.total,
+        mrays_per_s: render.stats.total as f64 / trace.median.max(1e-12) / 1e6,
+        time_s: Timings {
+            generate: prepared.generate_s,
+            build: Spread::of(&build),
+            trace,
+            intersect: Spread::of(&is),
+            shade: Spread::of(&sh),
+        },
+        structure_bytes: engine.structure_bytes(),
+        peak_rss_bytes,
+        counters: flatten_counters(&render.counters),
+        build_stats: engine.build_stats(),
+        check,
+        image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(&pixels))),
+        wall_s: start.elapsed().as_secs_f64(),
+        finished_at: super::env::now_utc(),
+    })
+}

@@ -1,0 +1,438 @@
+//! `rtbench run` and `rtbench sweep`: many (engine, scene, SF, settings, threads) runs, each in its
+//! own child process (`rtbench run-one`), so that peak RSS is that run's alone and a crash, an
+//! out-of-memory or a time-out costs one run, recorded as failed with its reason.
+//!
+//! Results go to `DIR/results.jsonl`, rewritten atomically (temp file, then rename) after every
+//! run: killing `rtbench run` at any moment leaves a whole file, and `--resume` skips the runs it
+//! already holds. `DIR/env.json` records the environment.
+
+use crate::error::{input, Result};
+use crate::output::write_atomic;
+use rtbench_reports::{read_results, run_key, RunRecord, SceneInfo};
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// One planned run.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub engine: String,
+    pub settings: Vec<(String, String)>,
+    pub program: String,
+    pub sf: u32,
+    pub tessellate: Option<u32>,
+    /// `None`: all cores.
+    pub threads: Option<usize>,
+}
+
+impl Job {
+    fn scene_label(&self) -> String {
+        let mut s = format!("{}{}", self.program, self.sf);
+        if let Some(r) = self.tessellate {
+            s.push_str(&format!("-tess{r}"));
+        }
+        s
+    }
+
+    fn threads_count(&self) -> usize {
+        self.threads.unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        })
+    }
+
+    pub fn key(&self) -> String {
+        let settings: BTreeMap<String, String> = self.settings.iter().cloned().collect();
+        run_key(
+            &self.engine,
+            &settings,
+            &self.scene_label(),
+            self.threads_count(),
+        )
+    }
+}
+
+/// What every run of a plan shares.
+#[derive(Clone, Debug)]
+pub struct Common {
+    pub repeats: u32,
+    pub size: u32,
+    pub check: bool,
+    pub max_seconds: Option<f64>,
+    pub max_memory: Option<u64>,
+}
+
+/// The results directory: `results.jsonl` kept whole.
+pub struct ResultsDir {
+    pub dir: PathBuf,
+    pub records: Vec<RunRecord>,
+}
+
+impl ResultsDir {
+    pub fn open(dir: &Path, resume: bool) -> Result<ResultsDir> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| input(format!("{}: cannot create: {e}", dir.display())))?;
+        let records = read_results(dir).map_err(|e| input(e.to_string()))?;
+        if !resume && !records.is_empty() {
+            eprintln!(
+                "rtbench: {} holds {} runs; runs with the same key are replaced (use --resume to skip them)",
+                dir.display(),
+                records.len()
+            );
+        }
+        let env = super::env::capture();
+        let text = serde_json::to_string_pretty(&env).expect("environment serialises");
+        write_atomic(&dir.join("env.json"), |w| {
+            std::io::Write::write_all(w, text.as_bytes())
+        })?;
+        Ok(ResultsDir {
+            dir: dir.to_path_buf(),
+            records,
+        })
+    }
+
+    pub fn has(&self, key: &str) -> bool {
+        self.records.iter().any(|r| r.key == key)
+    }
+
+    /// Adds (or replaces) a record and rewrites the file atomically.
+    pub fn put(&mut self, rec: RunRecord) -> Result<()> {
+        self.records.retain(|r| r.key != rec.key);
+        self.records.push(rec);
+        let mut text = String::new();
+        for r in &self.records {
+            text.push_str(&serde_json::to_string(r).expect("records serialise"));
+            text.push('\n');
+        }
+        write_atomic(&self.dir.join("results.jsonl"), |w| {
+            std::io::Write::write_all(w, text.as_bytes())
+        })
+    }
+}
+
+fn rss_of(pid: u32) -> Option<u64> {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let kb: u64 = s
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    Some(kb * 1024)
+}
+
+fn failed(job: &Job, common: &Common, reason: String, wall_s: f64) -> RunRecord {
+    RunRecord {
+        key: job.key(),
+        status: "failed".into(),
+        reason: Some(reason),
+        engine: job.engine.clone(),
+        settings: job.settings.iter().cloned().collect(),
+        scene: SceneInfo {
+            name: job.scene_label(),
+            program: Some(job.program.clone()),
+            sf: Some(job.sf),
+            tessellate: job.tessellate,
+            ..Default::default()
+        },
+        threads: job.threads_count(),
+        repeats: common.repeats,
+        size: common.size,
+        wall_s,
+        finished_at: super::env::now_utc(),
+        ..Default::default()
+    }
+}
+
+/// Runs one job in a child process, enforcing the time and memory limits.
+pub fn run_child(job: &Job, common: &Common) -> RunRecord {
+    let exe = match std::env::current_exe() {
+        Ok(e) => e,
+        Err(e) => {
+            return failed(
+                job,
+                common,
+                format!("cannot find the rtbench binary: {e}"),
+                0.0,
+            )
+        }
+    };
+    let mut cmd = Command::new(exe);
+    cmd.args([
+        "run-one",
+        "--engine",
+        &job.engine,
+        "--scene",
+        &job.program,
+        "--sf",
+        &job.sf.to_string(),
+    ]);
+    if let Some(r) = job.tessellate {
+        cmd.args(["--tessellate", &r.to_string()]);
+    }
+    for (k, v) in &job.settings {
+        cmd.args(["--set", &format!("{k}={v}")]);
+    }
+    if let Some(t) = job.threads {
+        cmd.args(["--threads", &t.to_string()]);
+    }
+    cmd.args([
+        "--repeat",
+        &common.repeats.to_string(),
+        "--size",
+        &common.size.to_string(),
+    ]);
+    if !common.check {
+        cmd.arg("--no-check");
+    }
+    cmd.stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let start = Instant::now();
+    let mut child = match cmd.spawn() {
+        Ok(c) => c,
+        Err(e) => return failed(job, common, format!("cannot start the run: {e}"), 0.0),
+    };
+    // Drain both pipes on threads so a chatty child never blocks on a full pipe.
+    let mut out = child.stdout.take().expect("piped");
+    let mut err = child.stderr.take().expect("piped");
+    let out_t = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = out.read_to_string(&mut s);
+        s
+    });
+    let err_t = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = err.read_to_string(&mut s);
+        s
+    });
+    let mut limit_hit = None;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(s)) => break Some(s),
+            Ok(None) => {}
+            Err(e) => {
+                limit_hit = Some(format!("lost the run: {e}"));
+                break None;
+            }
+        }
+        let elapsed = start.elapsed().as_secs_f64();
+        if let Some(max) = common.max_seconds {
+            if elapsed > max {
+                limit_hit = Some(format!("time limit: still running after {max} s"));
+            }
+        }
+        if let (Some(max), Some(rss)) = (common.max_memory, rss_of(child.id())) {
+            if rss > max {
+                limit_hit = Some(format!(
+                    "memory limit: RSS {} MiB over {} MiB",
+                    rss >> 20,
+                    max >> 20
+                ));
+            }
+        }
+        if limit_hit.is_some() {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let wall_s = start.elapsed().as_secs_f64();
+    let stdout = out_t.join().unwrap_or_default();
+    let stderr = err_t.join().unwrap_or_default();
+    if let Some(reason) = limit_hit {
+        return failed(job, common, reason, wall_s);
+    }
+    let status = status.expect("exited");
+    if status.success() {
+        match serde_json::from_str::<RunRecord>(stdout.trim()) {
+            Ok(mut r) => {
+                r.wall_s = wall_s;
+                r
+            }
+            Err(e) => failed(
+                job,
+                common,
+                format!("the run printed no record: {e}"),
+                wall_s,
+            ),
+        }
+    } else {
+        // The child's own one-line error, or the panic message.
+        let line = stderr
+            .lines()
+            .find(|l| l.contains("panicked at"))
+            .map(|l| {
+                let msg = stderr
+                    .lines()
+                    .skip_while(|x| !x.contains("panicked at"))
+                    .nth(1)
+                    .unwrap_or("");
+                format!("panic: {} {}", l.trim(), msg.trim())
+            })
+            .or_else(|| {
+                stderr
+                    .lines()
+                    .rev()
+                    .find(|l| !l.trim().is_empty())
+                    .map(|l| l.trim().to_string())
+            })
+            .unwrap_or_default();
+        let how = match status.code() {
+            Some(c) => format!("exit status {c}"),
+            None => {
+                use std::os::unix::process::ExitStatusExt;
+                format!("killed by signal {}", status.signal().unwrap_or(0))
+            }
+        };
+        failed(job, common, format!("{how}: {line}"), wall_s)
+    }
+}
+
+fn fmt_secs(s: f64) -> String {
+    if s >= 60.0 {
+        format!("{}m{:02}s", (s / 60.0) as u64, (s % 60.0) as u64)
+    } else {
+        format!("{s:.1}s")
+    }
+}
+
+/// Progress on stderr: `[3/42] bvh4 balls4 @1: ok 1.2 s (left ~1m20s)`.
+pub struct Progress {
+    total: usize,
+    done: usize,
+    start: Instant,
+}
+
+impl Progress {
+    pub fn new(total: usize) -> Progress {
+        Progress {
+            total,
+            done: 0,
+            start: Instant::now(),
+        }
+    }
+
+    pub fn finish(&mut self, job: &Job, rec: &RunRecord, skipped: bool) {
+        self.done += 1;
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let left = if self.done < self.total {
+            elapsed / self.done as f64 * (self.total - self.done) as f64
+        } else {
+            0.0
+        };
+        let what = if skipped {
+            "already done".to_string()
+        } else if rec.ok() {
+            let agree = rec
+                .check
+                .as_ref()
+                .map(|c| format!(", agreement {:.6}", c.hit_agreement))
+                .unwrap_or_default();
+            format!(
+                "ok, trace {:.3} s, {:.2} Mrays/s{agree}",
+                rec.time_s.trace.median, rec.mrays_per_s
+            )
+        } else {
+            format!("FAILED ({})", rec.reason.as_deref().unwrap_or(""))
+        };
+        eprintln!(
+            "[{}/{}] {} {} @{}: {what} (elapsed {}, left ~{})",
+            self.done,
+            self.total,
+            job.engine,
+            job.scene_label(),
+            job.threads_count(),
+            fmt_secs(elapsed),
+            fmt_secs(left)
+        );
+    }
+}
+
+/// `rtbench run`: every job, in order; returns how many failed.
+pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) -> Result<usize> {
+    let mut progress = Progress::new(jobs.len());
+    let mut failures = 0;
+    for job in jobs {
+        let key = job.key();
+        if resume && out.has(&key) {
+            let rec = out
+                .records
+                .iter()
+                .find(|r| r.key == key)
+                .cloned()
+                .expect("has");
+            progress.finish(job, &rec, true);
+            continue;
+        }
+        let rec = run_child(job, common);
+        if !rec.ok() {
+            failures += 1;
+        }
+        progress.finish(job, &rec, false);
+        out.put(rec)?;
+    }
+    Ok(failures)
+}
+
+/// `rtbench sweep`: for each scene and engine, raise the SF from `sf_start` until a run fails
+/// (time or memory limit, crash) or takes longer than the time limit.
+pub fn sweep(
+    engines: &[(String, Vec<(String, String)>)],
+    programs: &[String],
+    sf_start: u32,
+    sf_max: u32,
+    threads: Option<usize>,
+    common: &Common,
+    out: &mut ResultsDir,
+    resume: bool,
+) -> Result<usize> {
+    let mut runs = 0;
+    let start = Instant::now();
+    for program in programs {
+        for (engine, settings) in engines {
+            for sf in sf_start..=sf_max {
+                let job = Job {
+                    engine: engine.clone(),
+                    settings: settings.clone(),
+                    program: program.clone(),
+                    sf,
+                    tessellate: None,
+                    threads,
+                };
+                let key = job.key();
+                let rec = if resume && out.has(&key) {
+                    out.records
+                        .iter()
+                        .find(|r| r.key == key)
+                        .cloned()
+                        .expect("has")
+                } else {
+                    let rec = run_child(&job, common);
+                    runs += 1;
+                    out.put(rec.clone())?;
+                    rec
+                };
+                let verdict = if rec.ok() {
+                    format!("ok, {:.2} s wall", rec.wall_s)
+                } else {
+                    format!("FAILED ({})", rec.reason.as_deref().unwrap_or(""))
+                };
+                eprintln!(
+                    "sweep {engine} {program}{sf}: {verdict} (elapsed {})",
+                    fmt_secs(start.elapsed().as_secs_f64())
+                );
+                let over_time = common.max_seconds.is_some_and(|m| rec.wall_s > m);
+                if !rec.ok() || over_time {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(runs)
+}

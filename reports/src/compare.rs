@@ -1,0 +1,410 @@
+//! `compare`: did result set B regress against result set A?
+//!
+//! Runs are matched by key. Two signals, following the measurement rules (docs: ARCHITECTURE.md):
+//! - exact counters (nodes visited, primitive tests …) are free of noise, so any change is a finding;
+//! - times are compared as each engine's trace time over Embree's *within its own set*, so whatever slowed
+//!   or sped up the whole machine between A and B cancels. A ratio that grew by more than
+//!   max(threshold, the runs' own spread) is a regression. Embree's own times are the yardstick (ratio 1)
+//!   and are not compared; its counters are.
+
+use crate::anchor::{Anchors, EMBREE};
+use crate::number;
+use crate::results::{read_environment, read_results, RunRecord};
+use crate::summary::latest_per_key;
+use crate::ReportError;
+use serde::Serialize;
+use serde_json::Value;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write;
+use std::path::Path;
+
+/// What kind of difference a finding is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FindingKind {
+    /// An exact counter changed.
+    Counter,
+    /// Trace time over Embree's moved past the tolerance.
+    TimeRatio,
+    /// Ok in A, failed in B.
+    Failed,
+    /// Failed in A, ok in B.
+    Recovered,
+    /// Failed in both.
+    StillFailing,
+    /// The key is in A only.
+    OnlyInA,
+    /// The key is in B only.
+    OnlyInB,
+    /// Times not compared: no Embree run beside this one in A or B.
+    NoYardstick,
+}
+
+/// One difference between the two sets, about one run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Finding {
+    pub key: String,
+    pub kind: FindingKind,
+    /// The counter's name, `trace time / Embree`, or `status`.
+    pub what: String,
+    /// The value in A (a counter, a ratio, a status); null when absent.
+    pub old: Value,
+    /// The value in B.
+    pub new: Value,
+    /// (new − old) / old, in percent, where that means something.
+    pub change_pct: Option<f64>,
+    /// The change a time had to pass to count: max(threshold, the runs' own spread), in percent.
+    pub tolerance_pct: Option<f64>,
+    /// One line for people.
+    pub message: String,
+}
+
+/// The result of comparing two result sets.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// The directories as given.
+    pub a: String,
+    pub b: String,
+    /// The git commits the sets were measured at (from `env.json`), when recorded.
+    pub a_commit: Option<String>,
+    pub b_commit: Option<String>,
+    pub threshold_pct: f64,
+    /// Keys present in both sets.
+    pub matched: usize,
+    /// Ratios to Embree compared.
+    pub times_compared: usize,
+    /// Counter values compared.
+    pub counters_compared: usize,
+    pub regressions: Vec<Finding>,
+    pub improvements: Vec<Finding>,
+    pub notes: Vec<Finding>,
+}
+
+impl Comparison {
+    /// True when B regressed: `rtbench compare` exits 1.
+    pub fn is_regression(&self) -> bool {
+        !self.regressions.is_empty()
+    }
+
+    /// The comparison as Markdown: a verdict, then regressions, improvements and notes as tables.
+    pub fn to_markdown(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "# rtbench compare\n");
+        let commit = |c: &Option<String>| {
+            c.as_ref()
+                .map(|c| format!(" (commit {c})"))
+                .unwrap_or_default()
+        };
+        let _ = writeln!(s, "- **A**: `{}`{}", self.a, commit(&self.a_commit));
+        let _ = writeln!(s, "- **B**: `{}`{}", self.b, commit(&self.b_commit));
+        let _ = writeln!(
+            s,
+            "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%\n",
+            self.matched,
+            self.times_compared,
+            self.counters_compared,
+            number::sig(self.threshold_pct, 3)
+        );
+        let verdict = if self.is_regression() {
+            format!(
+                "**{} regression{}.**",
+                self.regressions.len(),
+                if self.regressions.len() == 1 { "" } else { "s" }
+            )
+        } else {
+            "**No regression.**".to_string()
+        };
+        let _ = writeln!(s, "{verdict}\n");
+        for (title, list) in [
+            ("Regressions", &self.regressions),
+            ("Improvements", &self.improvements),
+            ("Notes", &self.notes),
+        ] {
+            if list.is_empty() {
+                continue;
+            }
+            let _ = writeln!(s, "## {title}\n");
+            let _ = writeln!(s, "| run | what | A | B | change | tolerance |");
+            let _ = writeln!(s, "|---|---|---:|---:|---:|---:|");
+            for f in list {
+                let pct = |p: Option<f64>| {
+                    p.map(|p| format!("{}%", signed(p)))
+                        .unwrap_or_else(|| "–".to_string())
+                };
+                let _ = writeln!(
+                    s,
+                    "| `{}` | {} | {} | {} | {} | {} |",
+                    f.key.replace('|', "\\|"),
+                    f.what.replace('|', "\\|"),
+                    cell(&f.old),
+                    cell(&f.new),
+                    pct(f.change_pct),
+                    f.tolerance_pct
+                        .map(|t| format!("{}%", number::sig(t, 3)))
+                        .unwrap_or_else(|| "–".to_string()),
+                );
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
+fn signed(p: f64) -> String {
+    if p > 0.0 {
+        format!("+{}", number::sig(p, 3))
+    } else {
+        number::sig(p, 3)
+    }
+}
+
+fn cell(v: &Value) -> String {
+    match v {
+        Value::Null => "–".to_string(),
+        Value::String(s) => s.replace('|', "\\|"),
+        Value::Number(n) if n.is_f64() => n.as_f64().map(number::ratio).unwrap_or_default(),
+        other => other.to_string(),
+    }
+}
+
+fn read_set(dir: &Path) -> Result<(Vec<RunRecord>, Option<String>), ReportError> {
+    let results = dir.join("results.jsonl");
+    if !results.is_file() {
+        return Err(ReportError::NoResults {
+            path: results.display().to_string(),
+        });
+    }
+    let records = latest_per_key(read_results(dir)?);
+    let commit = read_environment(dir)?
+        .map(|e| e.git_commit)
+        .filter(|c| !c.is_empty());
+    Ok((records, commit))
+}
+
+/// Compares result set `b` against `a` (see the module doc). `threshold_pct` is the smallest change of a
+/// trace-time ratio, in percent, that counts; a run noisier than that raises its own bar.
+pub fn compare(a: &Path, b: &Path, threshold_pct: f64) -> Result<Comparison, ReportError> {
+    if !threshold_pct.is_finite() || threshold_pct < 0.0 {
+        return Err(ReportError::BadThreshold(threshold_pct));
+    }
+    let (runs_a, a_commit) = read_set(a)?;
+    let (runs_b, b_commit) = read_set(b)?;
+    let mut c = Comparison {
+        a: a.display().to_string(),
+        b: b.display().to_string(),
+        a_commit,
+        b_commit,
+        threshold_pct,
+        matched: 0,
+        times_compared: 0,
+        counters_compared: 0,
+        regressions: Vec::new(),
+        improvements: Vec::new(),
+        notes: Vec::new(),
+    };
+    compare_records(&runs_a, &runs_b, &mut c);
+    Ok(c)
+}
+
+fn compare_records(runs_a: &[RunRecord], runs_b: &[RunRecord], c: &mut Comparison) {
+    let anchors_a = Anchors::of(runs_a);
+    let anchors_b = Anchors::of(runs_b);
+    let by_key_b: BTreeMap<&str, &RunRecord> = runs_b.iter().map(|r| (r.key.as_str(), r)).collect();
+    let keys_a: BTreeSet<&str> = runs_a.iter().map(|r| r.key.as_str()).collect();
+
+    for ra in runs_a {
+        let Some(rb) = by_key_b.get(ra.key.as_str()).copied() else {
+            c.notes.push(finding(
+                ra,
+                FindingKind::OnlyInA,
+                "run",
+                status(ra),
+                Value::Null,
+                "in A only: not run in B",
+            ));
+            continue;
+        };
+        c.matched += 1;
+        match (ra.ok(), rb.ok()) {
+            (true, false) => {
+                let why = rb
+                    .reason
+                    .clone()
+                    .unwrap_or_else(|| "no reason recorded".to_string());
+                c.regressions.push(finding(
+                    ra,
+                    FindingKind::Failed,
+                    "status",
+                    status(ra),
+                    status(rb),
+                    &format!("failed in B: {why}"),
+                ));
+                continue;
+            }
+            (false, true) => {
+                c.improvements.push(finding(
+                    ra,
+                    FindingKind::Recovered,
+                    "status",
+                    status(ra),
+                    status(rb),
+                    "failed in A, ok in B",
+                ));
+                continue;
+            }
+            (false, false) => {
+                let why = rb
+                    .reason
+                    .clone()
+                    .unwrap_or_else(|| "no reason recorded".to_string());
+                c.notes.push(finding(
+                    ra,
+                    FindingKind::StillFailing,
+                    "status",
+                    status(ra),
+                    status(rb),
+                    &format!("failed in both: {why}"),
+                ));
+                continue;
+            }
+            (true, true) => {}
+        }
+        compare_counters(ra, rb, c);
+        if ra.engine != EMBREE {
+            compare_times(ra, rb, &anchors_a, &anchors_b, c);
+        }
+    }
+    for rb in runs_b.iter().filter(|r| !keys_a.contains(r.key.as_str())) {
+        c.notes.push(finding(
+            rb,
+            FindingKind::OnlyInB,
+            "run",
+            Value::Null,
+            status(rb),
+            "in B only: new run",
+        ));
+    }
+}
+
+fn status(r: &RunRecord) -> Value {
+    Value::String(r.status.clone())
+}
+
+fn finding(
+    r: &RunRecord,
+    kind: FindingKind,
+    what: &str,
+    old: Value,
+    new: Value,
+    message: &str,
+) -> Finding {
+    Finding {
+        key: r.key.clone(),
+        kind,
+        what: what.to_string(),
+        old,
+        new,
+        change_pct: None,
+        tolerance_pct: None,
+        message: format!("{}: {message}", r.key),
+    }
+}
+
+/// Any change of an exact counter, including one that appeared or vanished, is a regression.
+fn compare_counters(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
+    let names: BTreeSet<&String> = ra.counters.keys().chain(rb.counters.keys()).collect();
+    for name in names {
+        c.counters_compared += 1;
+        let (old, new) = (
+            ra.counters.get(name).copied(),
+            rb.counters.get(name).copied(),
+        );
+        if old == new {
+            continue;
+        }
+        let show = |v: Option<u64>| {
+            v.map(|v| v.to_string())
+                .unwrap_or_else(|| "absent".to_string())
+        };
+        let change_pct = match (old, new) {
+            (Some(o), Some(n)) if o > 0 => Some((n as f64 - o as f64) / o as f64 * 100.0),
+            _ => None,
+        };
+        c.regressions.push(Finding {
+            key: ra.key.clone(),
+            kind: FindingKind::Counter,
+            what: name.clone(),
+            old: old.map(Value::from).unwrap_or(Value::Null),
+            new: new.map(Value::from).unwrap_or(Value::Null),
+            change_pct,
+            tolerance_pct: Some(0.0),
+            message: format!("{}: counter {name}: {} → {}", ra.key, show(old), show(new)),
+        });
+    }
+}
+
+/// Trace time over Embree's in A against the same in B.
+fn compare_times(
+    ra: &RunRecord,
+    rb: &RunRecord,
+    anchors_a: &Anchors,
+    anchors_b: &Anchors,
+    c: &mut Comparison,
+) {
+    let (Some(q_a), Some(q_b)) = (anchors_a.ratio(ra), anchors_b.ratio(rb)) else {
+        let missing = match (
+            anchors_a.anchor(ra).is_none(),
+            anchors_b.anchor(rb).is_none(),
+        ) {
+            (true, true) => "A and B",
+            (true, false) => "A",
+            _ => "B",
+        };
+        c.notes.push(finding(
+            ra,
+            FindingKind::NoYardstick,
+            "trace time / Embree",
+            Value::Null,
+            Value::Null,
+            &format!(
+                "times not compared: no ok Embree run on {}@{} in {missing}",
+                ra.scene.name, ra.threads
+            ),
+        ));
+        return;
+    };
+    c.times_compared += 1;
+    let change_pct = (q_b / q_a - 1.0) * 100.0;
+    let spread_pct = ra
+        .time_s
+        .trace
+        .rel_spread()
+        .max(rb.time_s.trace.rel_spread())
+        * 100.0;
+    let tolerance_pct = c.threshold_pct.max(spread_pct);
+    if change_pct.abs() <= tolerance_pct {
+        return;
+    }
+    let (list, word) = if change_pct > 0.0 {
+        (&mut c.regressions, "slower")
+    } else {
+        (&mut c.improvements, "faster")
+    };
+    list.push(Finding {
+        key: ra.key.clone(),
+        kind: FindingKind::TimeRatio,
+        what: "trace time / Embree".to_string(),
+        old: Value::from(q_a),
+        new: Value::from(q_b),
+        change_pct: Some(change_pct),
+        tolerance_pct: Some(tolerance_pct),
+        message: format!(
+            "{}: trace time / Embree {} → {} ({}% {word} relative to Embree; tolerance {}%)",
+            ra.key,
+            number::ratio(q_a),
+            number::ratio(q_b),
+            number::sig(change_pct.abs(), 3),
+            number::sig(tolerance_pct, 3)
+        ),
+    });
+}

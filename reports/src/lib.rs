@@ -1,0 +1,43 @@
+//! rtbench-reports: tables and plots from results files, and the comparison of two result sets.
+//! Knows nothing of engines: everything comes from `results.jsonl` and `env.json`.
+//!
+//! ```no_run
+//! use rtbench_reports::{compare, write_report, Format};
+//! use std::path::Path;
+//!
+//! // report.md, results.csv, summary.json, plots/*.svg and *.png, report.html
+//! let summary = write_report(Path::new("out/nightly"), &Format::ALL)?;
+//! println!("{} runs, {} files", summary.runs, summary.files.len());
+//!
+//! let c = compare(Path::new("out/yesterday"), Path::new("out/today"), 5.0)?;
+//! print!("{}", c.to_markdown());
+//! std::process::exit(if c.is_regression() { 1 } else { 0 });
+//! # Ok::<(), rtbench_reports::ReportError>(())
+//! ```
+//!
+//! One result type, several exports (as hyperfine does): [`Summary`] is built once from the records and
+//! written as Markdown (`markdown.rs`), CSV (`csv.rs`), JSON, HTML (`html.rs`) and plots (`plot/`).
+
+mod anchor;
+mod atomic;
+mod compare;
+mod csv;
+mod error;
+mod html;
+mod markdown;
+pub mod number;
+pub mod plot;
+mod report;
+pub mod results;
+mod summary;
+mod table;
+
+pub use anchor::EMBREE;
+pub use compare::{compare, Comparison, Finding, FindingKind};
+pub use error::ReportError;
+pub use report::{write_report, Format};
+pub use results::{
+    read_environment, read_results, run_key, CheckResult, Environment, ReadError, RunRecord,
+    SceneInfo, Spread, Timings,
+};
+pub use summary::{Failure, Row, Summary};

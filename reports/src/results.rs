@@ -1,0 +1,222 @@
+//! The results files of `rtbench run` / `rtbench sweep`, as reports read them.
+//!
+//! A results directory holds `env.json` (one [`Environment`]) and `results.jsonl`: one [`RunRecord`]
+//! per line, one line per (engine, scene, SF, configuration, threads). `rtbench run` rewrites the
+//! file atomically (temp file, then rename) after each run, so it is always whole. Reports are made
+//! from these files alone.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Where and with what a run was measured.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Environment {
+    pub cpu_model: String,
+    pub cpu_flags: Vec<String>,
+    pub cores_logical: usize,
+    pub cores_physical: Option<usize>,
+    pub memory_bytes: u64,
+    pub os: String,
+    pub kernel: String,
+    pub hostname: String,
+    pub rustc: String,
+    pub git_commit: String,
+    pub git_dirty: bool,
+    pub embree_version: Option<String>,
+    pub rtbench_version: String,
+    pub started_at: String,
+}
+
+/// min / median / max of repeated measurements, and every sample.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Spread {
+    pub min: f64,
+    pub median: f64,
+    pub max: f64,
+    pub samples: Vec<f64>,
+}
+
+impl Spread {
+    pub fn of(samples: &[f64]) -> Spread {
+        let mut s = samples.to_vec();
+        s.sort_by(|a, b| a.total_cmp(b));
+        if s.is_empty() {
+            return Spread::default();
+        }
+        let median = if s.len() % 2 == 1 {
+            s[s.len() / 2]
+        } else {
+            (s[s.len() / 2 - 1] + s[s.len() / 2]) / 2.0
+        };
+        Spread {
+            min: s[0],
+            median,
+            max: s[s.len() - 1],
+            samples: samples.to_vec(),
+        }
+    }
+
+    /// (max − min) / median: the run's own relative spread.
+    pub fn rel_spread(&self) -> f64 {
+        if self.median > 0.0 {
+            (self.max - self.min) / self.median
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The scene a run traced.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct SceneInfo {
+    /// `balls4`, `mount6-jenkins`, `balls4-tess3`, or a file name.
+    pub name: String,
+    pub program: Option<String>,
+    pub sf: Option<u32>,
+    pub tessellate: Option<u32>,
+    pub objects: u64,
+    /// Primitives the engines see (polygons cut into triangles).
+    pub primitives: u64,
+}
+
+/// Timings of the phases, in seconds, over the repeats.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Timings {
+    /// Scene generation (once).
+    pub generate: f64,
+    /// Preprocessing: the engine's build (plus the shared geometry preparation).
+    pub build: Spread,
+    /// Tracing the whole workload, and within it the engine's queries and the shading.
+    pub trace: Spread,
+    pub intersect: Spread,
+    pub shade: Spread,
+}
+
+/// The run's answers against Embree's on the same rays.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct CheckResult {
+    pub against: String,
+    pub rays: u64,
+    pub hit_agreement: f64,
+    pub t_rel_err_median: f64,
+    pub t_rel_err_p99: f64,
+    pub t_rel_err_max: f64,
+    /// `None` when the images are identical (infinite PSNR).
+    pub image_psnr_db: Option<f64>,
+}
+
+/// One line of `results.jsonl`.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct RunRecord {
+    /// What identifies a run for `--resume` and `compare`: engine, settings, scene, threads.
+    pub key: String,
+    /// `ok` or `failed`.
+    pub status: String,
+    /// Why a failed run failed (panic, time limit, memory limit, exit status …).
+    pub reason: Option<String>,
+    pub engine: String,
+    /// The engine's `key=value` settings.
+    pub settings: BTreeMap<String, String>,
+    pub scene: SceneInfo,
+    pub threads: usize,
+    pub repeats: u32,
+    pub size: u32,
+    /// Ray statistics of the workload (as `rtbench render --json` gives them), when ok.
+    pub rays: Option<serde_json::Value>,
+    pub rays_total: u64,
+    pub time_s: Timings,
+    /// Rays per second over the median trace time.
+    pub mrays_per_s: f64,
+    pub structure_bytes: u64,
+    pub peak_rss_bytes: u64,
+    /// Exact counters (the noise-free signal for regressions).
+    pub counters: BTreeMap<String, u64>,
+    pub build_stats: BTreeMap<String, f64>,
+    pub check: Option<CheckResult>,
+    pub image_sha256: Option<String>,
+    /// Wall seconds of the whole child process.
+    pub wall_s: f64,
+    pub finished_at: String,
+}
+
+impl RunRecord {
+    pub fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+}
+
+/// The key of a run: `engine[k=v,…]/scene@threads`.
+pub fn run_key(
+    engine: &str,
+    settings: &BTreeMap<String, String>,
+    scene: &str,
+    threads: usize,
+) -> String {
+    let mut k = engine.to_string();
+    if !settings.is_empty() {
+        let s: Vec<String> = settings.iter().map(|(a, b)| format!("{a}={b}")).collect();
+        k.push_str(&format!("[{}]", s.join(",")));
+    }
+    format!("{k}/{scene}@{threads}")
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}: not a run record: {message}")]
+    Parse {
+        path: String,
+        line: usize,
+        message: String,
+    },
+}
+
+/// Reads `DIR/results.jsonl`. A missing file is an empty list.
+pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>, ReadError> {
+    let path = dir.join("results.jsonl");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => {
+            return Err(ReadError::Io {
+                path: path.display().to_string(),
+                source: e,
+            })
+        }
+    };
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l).map_err(|e| ReadError::Parse {
+                path: path.display().to_string(),
+                line: i + 1,
+                message: e.to_string(),
+            })
+        })
+        .collect()
+}
+
+/// Reads `DIR/env.json`, if there.
+pub fn read_environment(dir: &Path) -> Result<Option<Environment>, ReadError> {
+    let path = dir.join("env.json");
+    match std::fs::read_to_string(&path) {
+        Ok(t) => serde_json::from_str(&t)
+            .map(Some)
+            .map_err(|e| ReadError::Parse {
+                path: path.display().to_string(),
+                line: 1,
+                message: e.to_string(),
+            }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(ReadError::Io {
+            path: path.display().to_string(),
+            source: e,
+        }),
+    }
+}

@@ -1,0 +1,193 @@
+//! The one result type every report format is written from (as hyperfine exports one result several
+//! ways): the environment, one [`Row`] per run that finished, and the runs that failed.
+
+use crate::anchor::{Anchors, EMBREE};
+use crate::results::{CheckResult, Environment, RunRecord, SceneInfo, Spread};
+use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// What `write_report` made of a results directory; also written as `summary.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    /// `None` when the directory has no `env.json`.
+    pub environment: Option<Environment>,
+    /// Runs read (after later lines with the same key replaced earlier ones).
+    pub runs: usize,
+    pub rows: Vec<Row>,
+    pub failures: Vec<Failure>,
+    /// Files written, relative to the results directory (`report.md`, `plots/time-vs-sf-balls.svg` …).
+    pub files: Vec<String>,
+}
+
+/// One run that finished, with the figures the tables and plots show.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub key: String,
+    pub engine: String,
+    /// The engine with its settings: `grid[mailbox=off]`. One line of a plot, one colour.
+    pub label: String,
+    pub settings: BTreeMap<String, String>,
+    pub scene: String,
+    pub program: Option<String>,
+    pub sf: Option<u32>,
+    pub tessellate: Option<u32>,
+    /// The scene without its SF (`balls`, `mount-jenkins`, `balls-tess3`): runs of one family at several
+    /// SFs make one time-vs-SF plot.
+    pub family: String,
+    pub primitives: u64,
+    pub threads: usize,
+    pub repeats: u32,
+    pub rays_total: u64,
+    pub build_s: Spread,
+    pub trace_s: Spread,
+    pub mrays_per_s: f64,
+    /// Trace time over Embree's on the same scene and threads, from the same results set.
+    pub ratio_to_embree: Option<f64>,
+    pub structure_bytes: u64,
+    pub peak_rss_bytes: u64,
+    pub check: Option<CheckResult>,
+}
+
+/// A run that did not finish, and why.
+#[derive(Clone, Debug, Serialize)]
+pub struct Failure {
+    pub key: String,
+    pub engine: String,
+    pub scene: String,
+    pub threads: usize,
+    pub status: String,
+    pub reason: String,
+}
+
+/// One record per key: a later line replaces an earlier one (a re-run after `--resume`).
+pub fn latest_per_key(records: Vec<RunRecord>) -> Vec<RunRecord> {
+    let mut index: BTreeMap<String, usize> = BTreeMap::new();
+    let mut out: Vec<RunRecord> = Vec::with_capacity(records.len());
+    for r in records {
+        match index.get(&r.key) {
+            Some(&i) => out[i] = r,
+            None => {
+                index.insert(r.key.clone(), out.len());
+                out.push(r);
+            }
+        }
+    }
+    out
+}
+
+/// The engine and its settings, as a plot legend names it.
+pub fn label(r: &RunRecord) -> String {
+    if r.settings.is_empty() {
+        r.engine.clone()
+    } else {
+        let s: Vec<String> = r.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        format!("{}[{}]", r.engine, s.join(","))
+    }
+}
+
+/// The scene's name without its SF: `balls4` → `balls`, `mount6-jenkins` → `mount-jenkins`.
+pub fn family(scene: &SceneInfo) -> String {
+    if let (Some(p), Some(sf)) = (&scene.program, scene.sf) {
+        if let Some(rest) = scene.name.strip_prefix(&format!("{p}{sf}")) {
+            return format!("{p}{rest}");
+        }
+    }
+    scene.name.clone()
+}
+
+impl Summary {
+    /// Builds the summary of one results set: rows sorted by threads, scene (program, SF, tessellation),
+    /// Embree first, then engine label.
+    pub fn of(environment: Option<Environment>, records: Vec<RunRecord>) -> Summary {
+        let records = latest_per_key(records);
+        let anchors = Anchors::of(&records);
+        let mut rows: Vec<Row> = records
+            .iter()
+            .filter(|r| r.ok())
+            .map(|r| Row {
+                key: r.key.clone(),
+                engine: r.engine.clone(),
+                label: label(r),
+                settings: r.settings.clone(),
+                scene: r.scene.name.clone(),
+                program: r.scene.program.clone(),
+                sf: r.scene.sf,
+                tessellate: r.scene.tessellate,
+                family: family(&r.scene),
+                primitives: r.scene.primitives,
+                threads: r.threads,
+                repeats: r.repeats,
+                rays_total: r.rays_total,
+                build_s: r.time_s.build.clone(),
+                trace_s: r.time_s.trace.clone(),
+                mrays_per_s: r.mrays_per_s,
+                ratio_to_embree: anchors.ratio(r),
+                structure_bytes: r.structure_bytes,
+                peak_rss_bytes: r.peak_rss_bytes,
+                check: r.check.clone(),
+            })
+            .collect();
+        rows.sort_by(|a, b| {
+            (
+                a.threads,
+                &a.family,
+                a.sf,
+                a.tessellate,
+                &a.scene,
+                a.engine != EMBREE,
+                &a.label,
+            )
+                .cmp(&(
+                    b.threads,
+                    &b.family,
+                    b.sf,
+                    b.tessellate,
+                    &b.scene,
+                    b.engine != EMBREE,
+                    &b.label,
+                ))
+        });
+        let failures = records
+            .iter()
+            .filter(|r| !r.ok())
+            .map(|r| Failure {
+                key: r.key.clone(),
+                engine: r.engine.clone(),
+                scene: r.scene.name.clone(),
+                threads: r.threads,
+                status: r.status.clone(),
+                reason: r
+                    .reason
+                    .clone()
+                    .unwrap_or_else(|| "no reason recorded".to_string()),
+            })
+            .collect();
+        Summary {
+            environment,
+            runs: records.len(),
+            rows,
+            failures,
+            files: Vec::new(),
+        }
+    }
+
+    /// The thread counts the rows were measured with, ascending.
+    pub fn thread_counts(&self) -> Vec<usize> {
+        self.rows
+            .iter()
+            .map(|r| r.threads)
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect()
+    }
+
+    /// Every engine label, Embree first, then by name: the order of legends and colours.
+    pub fn labels(&self) -> Vec<String> {
+        let set: BTreeSet<(bool, &str)> = self
+            .rows
+            .iter()
+            .map(|r| (r.engine != EMBREE, r.label.as_str()))
+            .collect();
+        set.into_iter().map(|(_, l)| l.to_string()).collect()
+    }
+}

@@ -1,0 +1,120 @@
+//! The report's tables as cells, shared by the Markdown and HTML writers.
+
+use crate::number;
+use crate::results::Environment;
+use crate::summary::{Row, Summary};
+
+/// A table with a caption, ready to be written as Markdown or HTML.
+pub struct Table {
+    pub caption: String,
+    pub header: Vec<&'static str>,
+    /// Which columns hold numbers (right-aligned).
+    pub numeric: Vec<bool>,
+    pub rows: Vec<Vec<String>>,
+}
+
+const HEADER: [(&str, bool); 10] = [
+    ("scene", false),
+    ("engine", false),
+    ("build s", true),
+    ("trace s (min–max)", true),
+    ("Mrays/s", true),
+    ("× Embree", true),
+    ("structure MB", true),
+    ("peak RSS MB", true),
+    ("hit agreement", true),
+    ("PSNR dB", true),
+];
+
+/// One table per thread count: scene × engine.
+pub fn run_tables(summary: &Summary) -> Vec<Table> {
+    summary
+        .thread_counts()
+        .into_iter()
+        .map(|threads| Table {
+            caption: format!("{threads} thread{}", if threads == 1 { "" } else { "s" }),
+            header: HEADER.iter().map(|h| h.0).collect(),
+            numeric: HEADER.iter().map(|h| h.1).collect(),
+            rows: summary
+                .rows
+                .iter()
+                .filter(|r| r.threads == threads)
+                .map(cells)
+                .collect(),
+        })
+        .collect()
+}
+
+fn cells(r: &Row) -> Vec<String> {
+    let t = &r.trace_s;
+    vec![
+        r.scene.clone(),
+        r.label.clone(),
+        number::seconds(r.build_s.median),
+        format!(
+            "{} ({}–{})",
+            number::seconds(t.median),
+            number::seconds(t.min),
+            number::seconds(t.max)
+        ),
+        number::sig(r.mrays_per_s, 3),
+        r.ratio_to_embree
+            .map(number::ratio)
+            .unwrap_or_else(|| "–".to_string()),
+        number::megabytes(r.structure_bytes),
+        number::megabytes(r.peak_rss_bytes),
+        r.check
+            .as_ref()
+            .map(|c| number::agreement(c.hit_agreement))
+            .unwrap_or_else(|| "–".to_string()),
+        r.check
+            .as_ref()
+            .map(|c| number::psnr(c.image_psnr_db))
+            .unwrap_or_else(|| "–".to_string()),
+    ]
+}
+
+/// The failed runs: key, then why.
+pub fn failure_lines(summary: &Summary) -> Vec<(String, String)> {
+    summary
+        .failures
+        .iter()
+        .map(|f| (f.key.clone(), format!("{}: {}", f.status, f.reason)))
+        .collect()
+}
+
+/// The environment as (what, value) pairs.
+pub fn environment_lines(env: &Environment) -> Vec<(&'static str, String)> {
+    let cores = match env.cores_physical {
+        Some(p) => format!("{} logical, {p} physical", env.cores_logical),
+        None => format!("{} logical", env.cores_logical),
+    };
+    let commit = if env.git_dirty {
+        format!("{} (dirty)", env.git_commit)
+    } else {
+        env.git_commit.clone()
+    };
+    vec![
+        ("CPU", format!("{} ({cores})", env.cpu_model)),
+        (
+            "memory",
+            format!("{} GB", number::sig(env.memory_bytes as f64 / 1e9, 3)),
+        ),
+        ("OS", format!("{} (kernel {})", env.os, env.kernel)),
+        ("host", env.hostname.clone()),
+        ("rustc", env.rustc.clone()),
+        ("rtbench", format!("{} at {commit}", env.rtbench_version)),
+        (
+            "Embree",
+            env.embree_version
+                .clone()
+                .unwrap_or_else(|| "not available".to_string()),
+        ),
+        ("started", env.started_at.clone()),
+    ]
+}
+
+/// What the columns mean, printed under the tables.
+pub const NOTES: &str = "Times are medians over the repeats, with min–max. × Embree is the trace time over Embree's on \
+the same scene and threads in this results set (– without an Embree run). MB are 10^6 bytes. Hit agreement and PSNR \
+compare each engine's hits and image with Embree's (`rtbench check`); ∞ dB means identical images.";
