@@ -22,13 +22,14 @@ pub mod grid;
 pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
+pub mod testing;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest};
 pub use ray::{Hit, Ray};
 
 /// Every engine rtbench knows, available here or not.
 pub fn registry() -> Vec<EngineInfo> {
-    vec![
+    let mut v = vec![
         reference::info(),
         embree::info(),
         grid::info(),
@@ -36,7 +37,11 @@ pub fn registry() -> Vec<EngineInfo> {
         bvh::info4(),
         bvh::info8(),
         obvhs_engine::info(),
-    ]
+    ];
+    if testing::enabled() {
+        v.extend(testing::infos());
+    }
+    v
 }
 
 /// Finds an engine by name, checks it is available, and builds it with `key=value` settings.

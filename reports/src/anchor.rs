@@ -49,4 +49,18 @@ impl<'a> Anchors<'a> {
         let a = self.anchor(run)?;
         Some(run.time_s.trace.median / a.time_s.trace.median)
     }
+
+    /// The same over the times `compare` uses (CPU time when recorded, see
+    /// [`crate::results::Timings::trace_for_compare`]).
+    pub fn compare_ratio(&self, run: &RunRecord) -> Option<f64> {
+        if !run.ok() {
+            return None;
+        }
+        let a = self.anchor(run)?;
+        let (x, y) = (
+            run.time_s.trace_for_compare().median,
+            a.time_s.trace_for_compare().median,
+        );
+        (y > 0.0).then(|| x / y)
+    }
 }

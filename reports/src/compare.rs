@@ -4,7 +4,9 @@
 //! - exact counters (nodes visited, primitive tests …) are free of noise, so any change is a finding;
 //! - times are compared as each engine's trace time over Embree's *within its own set*, so whatever slowed
 //!   or sped up the whole machine between A and B cancels. A ratio that grew by more than
-//!   max(threshold, the runs' own spread) is a regression. Embree's own times are the yardstick (ratio 1)
+//!   max(threshold, 2 × the runs' own noise) is a regression, where a ratio's noise combines the
+//!   engine's and Embree's (σ ≈ 1.4826 × median absolute deviation of the repeats, relative), the
+//!   larger of set A's and set B's. Embree's own times are the yardstick (ratio 1)
 //!   and are not compared; its counters are.
 
 use crate::anchor::{Anchors, EMBREE};
@@ -103,7 +105,7 @@ impl Comparison {
             self.matched,
             self.times_compared,
             self.counters_compared,
-            number::sig(self.threshold_pct, 3)
+            number::short(self.threshold_pct, 3)
         );
         let verdict = if self.is_regression() {
             format!(
@@ -140,7 +142,7 @@ impl Comparison {
                     cell(&f.new),
                     pct(f.change_pct),
                     f.tolerance_pct
-                        .map(|t| format!("{}%", number::sig(t, 3)))
+                        .map(|t| format!("{}%", number::short(t, 3)))
                         .unwrap_or_else(|| "–".to_string()),
                 );
             }
@@ -152,9 +154,9 @@ impl Comparison {
 
 fn signed(p: f64) -> String {
     if p > 0.0 {
-        format!("+{}", number::sig(p, 3))
+        format!("+{}", number::short(p, 3))
     } else {
-        number::sig(p, 3)
+        number::short(p, 3)
     }
 }
 
@@ -351,7 +353,7 @@ fn compare_times(
     anchors_b: &Anchors,
     c: &mut Comparison,
 ) {
-    let (Some(q_a), Some(q_b)) = (anchors_a.ratio(ra), anchors_b.ratio(rb)) else {
+    let (Some(q_a), Some(q_b)) = (anchors_a.compare_ratio(ra), anchors_b.compare_ratio(rb)) else {
         let missing = match (
             anchors_a.anchor(ra).is_none(),
             anchors_b.anchor(rb).is_none(),
@@ -375,12 +377,16 @@ fn compare_times(
     };
     c.times_compared += 1;
     let change_pct = (q_b / q_a - 1.0) * 100.0;
-    let spread_pct = ra
-        .time_s
-        .trace
-        .rel_spread()
-        .max(rb.time_s.trace.rel_spread())
-        * 100.0;
+    // The ratio's noise: engine and Embree repeats, independent, in each set.
+    let noise = |r: &RunRecord, anchor: Option<&RunRecord>| {
+        let e = r.time_s.trace_for_compare().rel_noise();
+        let y = anchor
+            .map(|a| a.time_s.trace_for_compare().rel_noise())
+            .unwrap_or(0.0);
+        (e * e + y * y).sqrt()
+    };
+    let spread_pct =
+        2.0 * noise(ra, anchors_a.anchor(ra)).max(noise(rb, anchors_b.anchor(rb))) * 100.0;
     let tolerance_pct = c.threshold_pct.max(spread_pct);
     if change_pct.abs() <= tolerance_pct {
         return;
@@ -403,8 +409,8 @@ fn compare_times(
             ra.key,
             number::ratio(q_a),
             number::ratio(q_b),
-            number::sig(change_pct.abs(), 3),
-            number::sig(tolerance_pct, 3)
+            number::short(change_pct.abs(), 3),
+            number::short(tolerance_pct, 3)
         ),
     });
 }

@@ -1,7 +1,8 @@
 //! How numbers are written in tables and on axes: a few significant figures, never a wall of digits.
 
-/// `x` to `sig` significant figures, without trailing zeros after the point and without an exponent in
-/// the range tables use (1e-4 ≤ |x| < 1e6); outside it, `1.23e-5`.
+/// `x` to `sig` significant figures, keeping significant zeros (`0.290`, `2.00`) and without an exponent
+/// in the range tables use (1e-4 ≤ |x| < 1e6); outside it, `1.23e-5`. Integers wider than `sig` digits
+/// keep all their digits (`1235`).
 pub fn sig(x: f64, sig: usize) -> String {
     if !x.is_finite() {
         return if x.is_nan() {
@@ -18,18 +19,29 @@ pub fn sig(x: f64, sig: usize) -> String {
     let sig = sig.max(1);
     let ax = x.abs();
     if !(1e-4..1e6).contains(&ax) {
-        let s = format!("{:.*e}", sig - 1, x);
-        // `1.50e-5` → `1.5e-5`
-        return match s.split_once('e') {
-            Some((m, e)) => format!("{}e{}", trim_zeros(m), e),
-            None => s,
-        };
+        return format!("{:.*e}", sig - 1, x);
     }
     let magnitude = ax.log10().floor() as i32;
     let decimals = (sig as i32 - 1 - magnitude).max(0) as usize;
     let s = format!("{:.*}", decimals, x);
-    // Rounding may carry into a new digit (9.996 → 10.00): trimming zeros keeps it honest.
-    trim_zeros(&s)
+    // Rounding may carry into a new digit (9.996 → 10.00): one decimal fewer then.
+    let carried = s
+        .parse::<f64>()
+        .is_ok_and(|r| r.abs() >= 10f64.powi(magnitude + 1));
+    if carried && decimals > 0 {
+        format!("{:.*}", decimals - 1, x)
+    } else {
+        s
+    }
+}
+
+/// Like [`sig`], without trailing zeros after the point (`0.29`, `2`): for axis ticks.
+pub fn short(x: f64, sig_digits: usize) -> String {
+    let s = sig(x, sig_digits);
+    match s.split_once('e') {
+        Some((m, e)) => format!("{}e{}", trim_zeros(m), e),
+        None => trim_zeros(&s),
+    }
 }
 
 fn trim_zeros(s: &str) -> String {
@@ -87,11 +99,11 @@ pub fn axis(v: f64) -> String {
     }
     let av = v.abs();
     if (1e-3..1e5).contains(&av) {
-        sig(v, 3)
+        short(v, 3)
     } else {
         let s = format!("{v:.1e}");
         match s.split_once('e') {
-            Some((m, e)) => format!("{}e{}", trim_zeros(m), e),
+            Some((m, e)) => format!("{}e{e}", trim_zeros(m)),
             None => s,
         }
     }
@@ -106,9 +118,13 @@ mod tests {
         assert_eq!(sig(0.0012345, 3), "0.00123");
         assert_eq!(sig(12.345, 3), "12.3");
         assert_eq!(sig(1234.6, 3), "1235");
-        assert_eq!(sig(2.0, 3), "2");
-        assert_eq!(sig(9.9996, 3), "10");
-        assert_eq!(sig(1.5e-5, 3), "1.5e-5");
+        assert_eq!(sig(2.0, 3), "2.00");
+        assert_eq!(sig(0.2899999, 3), "0.290");
+        assert_eq!(sig(9.9996, 3), "10.0");
+        assert_eq!(sig(0.09996, 3), "0.100");
+        assert_eq!(sig(1.5e-5, 3), "1.50e-5");
+        assert_eq!(short(1.5e-5, 3), "1.5e-5");
+        assert_eq!(short(0.2899999, 3), "0.29");
         assert_eq!(sig(-0.25, 2), "-0.25");
         assert_eq!(sig(f64::NAN, 3), "–");
     }

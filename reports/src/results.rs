@@ -57,6 +57,27 @@ impl Spread {
         }
     }
 
+    /// Robust relative noise of the samples: 1.4826 × median absolute deviation / median (an
+    /// estimate of σ/median that one outlying repeat does not move).
+    pub fn rel_noise(&self) -> f64 {
+        if self.median <= 0.0 || self.samples.len() < 2 {
+            return 0.0;
+        }
+        let mut dev: Vec<f64> = self
+            .samples
+            .iter()
+            .map(|x| (x - self.median).abs())
+            .collect();
+        dev.sort_by(|a, b| a.total_cmp(b));
+        let n = dev.len();
+        let mad = if n % 2 == 1 {
+            dev[n / 2]
+        } else {
+            (dev[n / 2 - 1] + dev[n / 2]) / 2.0
+        };
+        1.4826 * mad / self.median
+    }
+
     /// (max − min) / median: the run's own relative spread.
     pub fn rel_spread(&self) -> f64 {
         if self.median > 0.0 {
@@ -91,6 +112,21 @@ pub struct Timings {
     pub trace: Spread,
     pub intersect: Spread,
     pub shade: Spread,
+    /// CPU seconds of the trace (all threads; getrusage). Steadier than wall time on a shared
+    /// machine: `compare` uses it when present. Absent in older results.
+    #[serde(default)]
+    pub trace_cpu: Spread,
+}
+
+impl Timings {
+    /// The trace time `compare` uses: CPU time when recorded, else wall time.
+    pub fn trace_for_compare(&self) -> &Spread {
+        if self.trace_cpu.samples.is_empty() {
+            &self.trace
+        } else {
+            &self.trace_cpu
+        }
+    }
 }
 
 /// The run's answers against Embree's on the same rays.

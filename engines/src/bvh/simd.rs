@@ -24,10 +24,10 @@ pub trait ChildTest<const N: usize> {
     /// Bit `i` set when child `i`'s box overlaps `[tmin, tmax]` along the ray; `dist[i]` is
     /// then its entry distance.
     fn test(node: &WideNode<N>, r: &Self::Ray, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32;
-    /// Asks for the `bytes` from `x` to be brought into the cache (a hint; nothing for the
-    /// scalar form). Embree's traversal does the same for every child the ray hits.
+    /// Asks for the node-sized block of memory at `p` to be brought into the cache (a hint;
+    /// nothing for the scalar form).
     #[inline(always)]
-    fn prefetch<X>(_x: &X, _bytes: usize) {}
+    fn prefetch(_p: *const u8) {}
 }
 
 /// The batch entry points of one traversal kernel.
@@ -53,15 +53,26 @@ pub fn scalar<const N: usize>() -> Kernels<N> {
     }
 }
 
-/// SSE kernels for bvh4 (SSE2 is part of x86-64, so always there on that target).
+/// SSE kernels for bvh4 (SSE2 is part of x86-64, so always there on that target). On CPUs
+/// with AVX2 and FMA the same 4-wide test is compiled with those (fused multiply-subtract, and
+/// the whole loop, leaf kernels included, in VEX encoding).
 pub fn sse4() -> Option<Kernels<4>> {
     #[cfg(target_arch = "x86_64")]
     {
-        Some(Kernels {
-            closest: traverse::closest_batch::<4, x86::Sse4>,
-            any: traverse::any_batch::<4, x86::Sse4>,
-            lanes: 4,
-            name: "sse",
+        Some(if x86::has_avx2_fma() {
+            Kernels {
+                closest: x86::fma4_closest,
+                any: x86::fma4_any,
+                lanes: 4,
+                name: "sse+fma",
+            }
+        } else {
+            Kernels {
+                closest: traverse::closest_batch::<4, x86::Sse4<false>>,
+                any: traverse::any_batch::<4, x86::Sse4<false>>,
+                lanes: 4,
+                name: "sse",
+            }
         })
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -164,7 +175,9 @@ mod x86 {
 
     // ------------------------------------------------------------------ SSE, 4 boxes at once
 
-    pub struct Sse4;
+    /// 4 boxes at once in 128-bit registers; `FMA` fuses the plane distance's multiply and
+    /// subtract (only instantiated inside the AVX2 + FMA entry points).
+    pub struct Sse4<const FMA: bool>;
 
     #[derive(Clone, Copy)]
     pub struct Sse4Ray {
@@ -174,26 +187,23 @@ mod x86 {
         far: [usize; 3],
     }
 
-    /// Prefetches the cache lines of `bytes` bytes from `x`.
+    /// Prefetches the `lines` cache lines from `p` (a node: 2 lines for N = 4, 4 for N = 8;
+    /// or as much of a leaf's primitives).
     #[inline(always)]
-    fn prefetch_lines<X>(x: &X, bytes: usize) {
-        let p = x as *const X as *const i8;
-        let mut off = 0;
-        while off < bytes {
-            // SAFETY: SSE is part of the x86-64 baseline; a prefetch is only a hint and never
-            // faults, whatever the address (the offset stays within `bytes` of a live object
-            // or just past it, which `wrapping_add` computes without assuming anything).
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off)) };
-            off += 64;
+    fn prefetch_lines(p: *const u8, lines: usize) {
+        for l in 0..lines {
+            // SAFETY: SSE is part of the x86-64 baseline. A prefetch is only a hint: it never
+            // faults and reads nothing into the program, whatever the address.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * l) as *const i8) };
         }
     }
 
-    impl ChildTest<4> for Sse4 {
+    impl<const FMA: bool> ChildTest<4> for Sse4<FMA> {
         type Ray = Sse4Ray;
 
         #[inline(always)]
-        fn prefetch<X>(x: &X, bytes: usize) {
-            prefetch_lines(x, bytes)
+        fn prefetch(p: *const u8) {
+            prefetch_lines(p, 2)
         }
 
         #[inline(always)]
@@ -217,16 +227,19 @@ mod x86 {
         #[inline(always)]
         fn test(node: &WideNode<4>, r: &Sse4Ray, tmin: f32, tmax: f32, dist: &mut [f32; 4]) -> u32 {
             let base = node.planes.as_ptr() as *const f32;
-            // SAFETY: SSE is part of the x86-64 baseline. `planes` is 6 rows of 4 contiguous
-            // floats (repr(C) arrays) and every offset is `row · 4` with `row < 6`
-            // (`plane_offsets`), so each unaligned load reads 4 floats inside the node; the
-            // store writes exactly the 4 floats of `dist`.
+            // SAFETY: SSE is part of the x86-64 baseline, and `FMA` is only set in the kernels
+            // reached through the feature-checked AVX2 + FMA entry points below. `planes` is 6
+            // rows of 4 contiguous floats (repr(C) arrays) and every offset is `row · 4` with
+            // `row < 6` (`plane_offsets`), so each unaligned load reads 4 floats inside the
+            // node; the store writes exactly the 4 floats of `dist`.
             unsafe {
                 let plane = |off: usize, a: usize| {
-                    _mm_sub_ps(
-                        _mm_mul_ps(_mm_loadu_ps(base.add(off)), r.rdir[a]),
-                        r.org_rdir[a],
-                    )
+                    let p = _mm_loadu_ps(base.add(off));
+                    if FMA {
+                        _mm_fmsub_ps(p, r.rdir[a], r.org_rdir[a])
+                    } else {
+                        _mm_sub_ps(_mm_mul_ps(p, r.rdir[a]), r.org_rdir[a])
+                    }
                 };
                 let t_near = _mm_max_ps(
                     _mm_max_ps(plane(r.near[0], 0), plane(r.near[1], 1)),
@@ -258,17 +271,16 @@ mod x86 {
         type Ray = Avx8Ray;
 
         #[inline(always)]
-        fn prefetch<X>(x: &X, bytes: usize) {
-            prefetch_lines(x, bytes)
+        fn prefetch(p: *const u8) {
+            prefetch_lines(p, 4)
         }
 
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Avx8Ray {
             let (near, far) = plane_offsets(r, 8);
             let (d, o) = (r.rdir, r.org_rdir);
-            // SAFETY: only reached from `avx8_closest_impl` / `avx8_any_impl`, which are
-            // compiled for and called only on CPUs with AVX2 and FMA (checked in
-            // `avx8_closest` / `avx8_any`); `set1` only broadcasts a value.
+            // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`), which run
+            // only on CPUs with both; `set1` only broadcasts a value.
             unsafe {
                 Avx8Ray {
                     rdir: [
@@ -291,7 +303,7 @@ mod x86 {
         fn test(node: &WideNode<8>, r: &Avx8Ray, tmin: f32, tmax: f32, dist: &mut [f32; 8]) -> u32 {
             let base = node.planes.as_ptr() as *const f32;
             // SAFETY: AVX2 and FMA are present (only reached through the feature-checked entry
-            // points below). `planes` is 6 rows of 8 contiguous floats and every offset is
+            // points of `avx2_entry!`). `planes` is 6 rows of 8 contiguous floats and every offset is
             // `row · 8` with `row < 6` (`plane_offsets`), so each unaligned load reads 8 floats
             // inside the node; the store writes exactly the 8 floats of `dist`.
             unsafe {
@@ -313,50 +325,148 @@ mod x86 {
         }
     }
 
-    pub fn avx8_closest(
-        bvh: &Bvh<8>,
-        rays: &[Ray],
-        hits: &mut [Hit],
-        t: TriangleTest,
-        c: &mut Counters,
-    ) {
-        assert!(has_avx2_fma(), "the AVX2 kernel needs AVX2 and FMA");
-        // SAFETY: the CPU has AVX2 and FMA (asserted above), all `avx8_closest_impl` requires.
-        unsafe { avx8_closest_impl(bvh, rays, hits, t, c) }
+    /// Feature-checked entry points whose batch loop is compiled with AVX2 and FMA, so the
+    /// box test's intrinsics (and the leaf kernels) inline into it.
+    macro_rules! avx2_entry {
+        ($closest:ident, $closest_impl:ident, $any:ident, $any_impl:ident, $n:literal, $test:ty) => {
+            pub fn $closest(
+                bvh: &Bvh<$n>,
+                rays: &[Ray],
+                hits: &mut [Hit],
+                t: TriangleTest,
+                c: &mut Counters,
+            ) {
+                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
+                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
+                unsafe { $closest_impl(bvh, rays, hits, t, c) }
+            }
+
+            pub fn $any(
+                bvh: &Bvh<$n>,
+                rays: &[Ray],
+                out: &mut [bool],
+                t: TriangleTest,
+                c: &mut Counters,
+            ) {
+                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
+                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
+                unsafe { $any_impl(bvh, rays, out, t, c) }
+            }
+
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn $closest_impl(
+                bvh: &Bvh<$n>,
+                rays: &[Ray],
+                hits: &mut [Hit],
+                t: TriangleTest,
+                c: &mut Counters,
+            ) {
+                traverse::closest_batch::<$n, $test>(bvh, rays, hits, t, c)
+            }
+
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn $any_impl(
+                bvh: &Bvh<$n>,
+                rays: &[Ray],
+                out: &mut [bool],
+                t: TriangleTest,
+                c: &mut Counters,
+            ) {
+                traverse::any_batch::<$n, $test>(bvh, rays, out, t, c)
+            }
+        };
     }
 
-    pub fn avx8_any(
-        bvh: &Bvh<8>,
-        rays: &[Ray],
-        out: &mut [bool],
-        t: TriangleTest,
-        c: &mut Counters,
-    ) {
-        assert!(has_avx2_fma(), "the AVX2 kernel needs AVX2 and FMA");
-        // SAFETY: the CPU has AVX2 and FMA (asserted above), all `avx8_any_impl` requires.
-        unsafe { avx8_any_impl(bvh, rays, out, t, c) }
-    }
+    avx2_entry!(
+        avx8_closest,
+        avx8_closest_impl,
+        avx8_any,
+        avx8_any_impl,
+        8,
+        Avx8
+    );
+    avx2_entry!(
+        fma4_closest,
+        fma4_closest_impl,
+        fma4_any,
+        fma4_any_impl,
+        4,
+        Sse4<true>
+    );
+}
 
-    /// The whole batch loop compiled with AVX2 and FMA, so `Avx8`'s intrinsics inline into it.
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn avx8_closest_impl(
-        bvh: &Bvh<8>,
-        rays: &[Ray],
-        hits: &mut [Hit],
-        t: TriangleTest,
-        c: &mut Counters,
-    ) {
-        traverse::closest_batch::<8, Avx8>(bvh, rays, hits, t, c)
-    }
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::build_bvh;
+    use crate::bvh::config::Config;
+    use crate::engine::Settings;
+    use crate::geometry::Geometry;
+    use glam::Vec3;
+    use rtbench_scenes::generate_scene;
+    use rtbench_scenes::spd::{Options, Program};
 
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn avx8_any_impl(
-        bvh: &Bvh<8>,
-        rays: &[Ray],
-        out: &mut [bool],
-        t: TriangleTest,
-        c: &mut Counters,
-    ) {
-        traverse::any_batch::<8, Avx8>(bvh, rays, out, t, c)
+    /// Every kernel this CPU can run gives exactly the scalar kernel's hits and node counts on
+    /// the same tree (the SIMD forms only round the entry distances differently, which can
+    /// only matter for rays grazing a box; none of these do).
+    #[test]
+    fn every_kernel_matches_scalar() {
+        let scene = generate_scene(
+            Program::Tree,
+            &Options {
+                size_factor: 4,
+                ..Options::standard(Program::Tree)
+            },
+        )
+        .unwrap();
+        let g = Geometry::from_scene(&scene);
+        let c = (g.bounds_min + g.bounds_max) * 0.5;
+        let r = (g.bounds_max - g.bounds_min).length();
+        let rays: Vec<Ray> = (0..400)
+            .map(|i| {
+                let a = i as f32 * 0.0713;
+                let o = c + Vec3::new(a.cos(), 0.4 * (a * 1.7).sin(), a.sin()) * r;
+                let t = c + Vec3::new((a * 5.0).sin(), (a * 3.0).cos(), (a * 2.0).sin()) * 0.25 * r;
+                Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY)
+            })
+            .collect();
+        fn run<const N: usize>(
+            bvh: &Bvh<N>,
+            k: &Kernels<N>,
+            rays: &[Ray],
+        ) -> (Vec<Hit>, Vec<bool>, Counters) {
+            let mut hits = vec![Hit::MISS; rays.len()];
+            let mut any = vec![false; rays.len()];
+            let mut c = Counters::default();
+            (k.closest)(bvh, rays, &mut hits, TriangleTest::Watertight, &mut c);
+            (k.any)(
+                bvh,
+                rays,
+                &mut any,
+                TriangleTest::Watertight,
+                &mut Counters::default(),
+            );
+            (hits, any, c)
+        }
+        let config = |w: usize| Config::parse(w, Settings::new("bvh", vec![])).unwrap();
+        let (bvh4, _) = build_bvh::<4>(&g, &config(4)).unwrap();
+        let want4 = run(&bvh4, &scalar::<4>(), &rays);
+        assert!(want4.0.iter().filter(|h| h.is_hit()).count() > 100);
+        let mut fours: Vec<Kernels<4>> = sse4().into_iter().collect();
+        #[cfg(target_arch = "x86_64")]
+        fours.push(Kernels {
+            closest: traverse::closest_batch::<4, x86::Sse4<false>>,
+            any: traverse::any_batch::<4, x86::Sse4<false>>,
+            lanes: 4,
+            name: "sse",
+        });
+        for k in &fours {
+            assert_eq!(run(&bvh4, k, &rays), want4, "{}", k.name);
+        }
+        let (bvh8, _) = build_bvh::<8>(&g, &config(8)).unwrap();
+        let want8 = run(&bvh8, &scalar::<8>(), &rays);
+        if let Some(k) = avx8() {
+            assert_eq!(run(&bvh8, &k, &rays), want8, "{}", k.name);
+        }
     }
 }

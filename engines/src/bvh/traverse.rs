@@ -33,24 +33,17 @@ pub struct Bvh<const N: usize> {
     pub objects: Vec<u32>,
 }
 
-/// Prefetches every child in `mask`: a node's cache lines, or a leaf's first primitives.
+/// Where child reference `c` points: its node, or its leaf's first primitive. Only ever
+/// prefetched, never read through, so it is computed with wrapping arithmetic and no check.
 #[inline(always)]
-fn prefetch_children<const N: usize, T: ChildTest<N>>(
-    bvh: &Bvh<N>,
-    node: &WideNode<N>,
-    mut mask: u32,
-) {
-    while mask != 0 {
-        let c = node.child[mask.trailing_zeros() as usize];
-        mask &= mask - 1;
-        if is_leaf(c) {
-            let (first, count) = leaf_range(c);
-            if let Some(p) = bvh.prims.get(first) {
-                T::prefetch(p, (count * std::mem::size_of::<Prim>()).min(256));
-            }
-        } else if let Some(n) = bvh.nodes.get(c as usize) {
-            T::prefetch(n, std::mem::size_of::<WideNode<N>>());
-        }
+fn child_addr<const N: usize>(bvh: &Bvh<N>, c: u32) -> *const u8 {
+    let (first, _) = leaf_range(c);
+    let leaf = bvh.prims.as_ptr().wrapping_add(first) as *const u8;
+    let node = bvh.nodes.as_ptr().wrapping_add(c as usize) as *const u8;
+    if is_leaf(c) {
+        leaf
+    } else {
+        node
     }
 }
 
@@ -166,7 +159,6 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
             tally.boxes += node.len as u64;
             let mut mask = T::test(node, &tr, r.tmin, r.tmax, &mut dist);
             if mask != 0 {
-                prefetch_children::<N, T>(bvh, node, mask);
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if mask == 0 {
@@ -177,6 +169,9 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
                 mask &= mask - 1;
                 if mask == 0 {
                     let (near, far) = if dist[j] < dist[i] { (j, i) } else { (i, j) };
+                    // A child put on the stack is fetched while its sibling is traversed
+                    // (Embree prefetches every child it is going to visit).
+                    T::prefetch(child_addr(bvh, node.child[far]));
                     stack[sp] = Entry {
                         node: node.child[far],
                         dist: dist[far],
@@ -188,6 +183,7 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
                 // Three or more: push all, then insertion-sort the new entries farthest first.
                 let base = sp;
                 for k in [i, j] {
+                    T::prefetch(child_addr(bvh, node.child[k]));
                     stack[sp] = Entry {
                         node: node.child[k],
                         dist: dist[k],
@@ -197,6 +193,7 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
                 while mask != 0 {
                     let k = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
+                    T::prefetch(child_addr(bvh, node.child[k]));
                     stack[sp] = Entry {
                         node: node.child[k],
                         dist: dist[k],
@@ -266,12 +263,12 @@ fn any<const N: usize, T: ChildTest<N>, const W: bool>(
             tally.boxes += node.len as u64;
             let mut mask = T::test(node, &tr, ray.tmin, ray.tmax, &mut dist);
             if mask != 0 {
-                prefetch_children::<N, T>(bvh, node, mask);
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 while mask != 0 {
                     let k = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
+                    T::prefetch(child_addr(bvh, node.child[k]));
                     stack[sp] = node.child[k];
                     sp += 1;
                 }

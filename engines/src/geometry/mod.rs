@@ -62,7 +62,11 @@ impl Prim {
 
     /// The shared kernel for this primitive: (t, u, v) of the nearest hit in (tmin, tmax).
     /// `wt` is the ray's watertight set-up, made once per ray by the caller.
-    #[inline]
+    ///
+    /// Always inlined: left to itself the compiler keeps this one out of line, so a traversal
+    /// loop compiled for AVX2 (bvh8) called an SSE2 copy through a call; inlined, bvh8 traces
+    /// the tessellated scenes 7–10% faster.
+    #[inline(always)]
     pub fn intersect(
         &self,
         ray: &Ray,

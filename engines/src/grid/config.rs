@@ -112,7 +112,8 @@ impl FromStr for Count {
 }
 
 /// Rayshade's two extras together (seed 000 §3.4): `rss` is rayshade-ss (shadow cache and
-/// per-voxel ray–box culling on), `rss-r` is rayshade-ss-r (both off).
+/// per-voxel ray–box culling on, as Rayshade ships, and the default), `rss-r` is rayshade-ss-r
+/// (both off).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
     Rss,
@@ -157,8 +158,8 @@ impl Default for GridConfig {
             count: Count::Prims,
             insertion: Insertion::BoundingBox,
             mailbox: true,
-            shadow_cache: false,
-            voxel_cull: false,
+            shadow_cache: true,
+            voxel_cull: true,
             floor: Floor::In,
             triangle: TriangleTest::Watertight,
         }

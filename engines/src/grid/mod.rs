@@ -15,9 +15,9 @@
 //! | `count` | `prims`, `objects` | `prims` | the n of the policies: grid primitives, or scene objects as Rayshade counted |
 //! | `insert` | `bbox`, `exact` | `bbox` | cells a primitive's bounding box reaches (Rayshade), or its surface ([`overlap`]) |
 //! | `mailbox` | `true`, `false` | `true` | test each primitive once per ray |
-//! | `preset` | `rss`, `rss-r` | none | `rss`: shadow cache and voxel culling on; `rss-r`: both off (seed 000 §3.4) |
-//! | `shadow_cache` | `true`, `false` | `false` (or the preset's) | last blocker per light first ([`shadow_cache`]) |
-//! | `voxel_cull` | `true`, `false` | `false` (or the preset's) | per-voxel ray–box culling (Snyder and Barr 1987) |
+//! | `preset` | `rss`, `rss-r` | `rss` | `rss`: shadow cache and voxel culling on, as Rayshade ships; `rss-r`: both off (seed 000 §3.4) |
+//! | `shadow_cache` | `true`, `false` | the preset's | last blocker per light first ([`shadow_cache`]) |
+//! | `voxel_cull` | `true`, `false` | the preset's | per-voxel ray–box culling (Snyder and Barr 1987) |
 //! | `floor` | `in`, `out` | `in` | `out` keeps floor/backdrop polygons out of the grid (SPD rule 11; [`build::floor_objects`]) |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //!

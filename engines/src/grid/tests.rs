@@ -172,13 +172,17 @@ fn agrees(want: &Hit, got: &Hit) -> bool {
 #[test]
 fn config_defaults_presets_and_errors() {
     let c = |p: &[(&str, &str)]| GridConfig::from_settings(Settings::new("grid", kv(p)));
-    assert_eq!(c(&[]).unwrap(), GridConfig::default());
+    let d = c(&[]).unwrap();
+    assert_eq!(d, GridConfig::default());
+    assert_eq!(d.resolution, Resolution::CubeRoot);
+    assert_eq!(d.insertion, Insertion::BoundingBox);
+    assert!(d.mailbox && d.shadow_cache && d.voxel_cull && d.floor == Floor::In);
     let rss = c(&[("preset", "rss")]).unwrap();
     assert!(rss.shadow_cache && rss.voxel_cull);
     let rssr = c(&[("preset", "rss-r")]).unwrap();
     assert!(!rssr.shadow_cache && !rssr.voxel_cull);
-    let mixed = c(&[("preset", "rss"), ("voxel_cull", "false")]).unwrap();
-    assert!(mixed.shadow_cache && !mixed.voxel_cull);
+    let mixed = c(&[("preset", "rss-r"), ("voxel_cull", "true")]).unwrap();
+    assert!(!mixed.shadow_cache && mixed.voxel_cull);
     let full = c(&[
         ("res", "woo"),
         ("density", "4"),
@@ -452,9 +456,9 @@ fn hits_wait_for_their_cell_and_mailboxes_count() {
     let (ta, tb) = (1.0 + 0.1 + 3.8 * 1.95 / 3.5, 1.0 + 1.5 - 0.035f32.sqrt());
     let ray = Ray::new(Vec3::new(-1.0, 0.45, 0.45), Vec3::X, 0.0, f32::INFINITY);
     for pairs in [
+        vec![("res", "4,4,4"), ("preset", "rss-r")],
+        vec![("res", "4,4,4"), ("preset", "rss-r"), ("mailbox", "false")],
         vec![("res", "4,4,4")],
-        vec![("res", "4,4,4"), ("mailbox", "false")],
-        vec![("res", "4,4,4"), ("voxel_cull", "true")],
     ] {
         let both = grid(&shapes(vec![a.clone(), b.clone()]), &pairs);
         let mut h = [Hit::MISS];
@@ -497,14 +501,14 @@ fn hits_wait_for_their_cell_and_mailboxes_count() {
         assert!(!h[0].is_hit());
         c
     };
-    let with = count(&[("res", "8,8,8")]);
-    let without = count(&[("res", "8,8,8"), ("mailbox", "false")]);
+    let with = count(&[("res", "8,8,8"), ("preset", "rss-r")]);
+    let without = count(&[("res", "8,8,8"), ("preset", "rss-r"), ("mailbox", "false")]);
     assert_eq!(with.cells_visited, 8);
     assert_eq!((with.primitive_tests, with.mailbox_skips), (1, 7));
     assert_eq!((without.primitive_tests, without.mailbox_skips), (8, 0));
     // Voxel culling: the sphere's box holds the ray's piece of the first cell, so it passes the
     // box test there and the mailbox answers for the other cells.
-    let culled = count(&[("res", "8,8,8"), ("voxel_cull", "true")]);
+    let culled = count(&[("res", "8,8,8")]);
     assert_eq!((culled.box_tests, culled.primitive_tests), (1, 1));
     // An exact grid lists the sphere only in cells its surface reaches: the ray's row near the
     // box corner holds fewer listings.
@@ -542,7 +546,7 @@ fn agrees_with_brute_force_and_reference_for_every_policy_and_insertion() {
         }
     }
     extras.push(vec![("res", "woo"), ("density", "8"), ("insert", "exact")]);
-    extras.push(vec![("preset", "rss")]);
+    extras.push(vec![("preset", "rss-r")]);
     extras.push(vec![
         ("preset", "rss"),
         ("insert", "exact"),
@@ -651,7 +655,7 @@ fn shadow_cache_answers_the_same_and_hits() {
     // Shadow rays as the workload makes them: from each hit point (in scan order) towards each
     // light in turn, ending a millionth short of it.
     let eye = input.scene.view.from.as_vec3();
-    let plain = grid(&input, &[]);
+    let plain = grid(&input, &[("preset", "rss-r")]);
     let mut eye_rays = Vec::new();
     let (lo, hi) = (Vec3::new(-2.0, -2.0, 0.0), Vec3::new(2.0, 2.0, 1.0));
     for j in 0..30 {
@@ -682,8 +686,8 @@ fn shadow_cache_answers_the_same_and_hits() {
     assert!(blocked > 20, "only {blocked} of {} blocked", shadow.len());
     assert_eq!(cw.shadow_cache_hits, 0);
     for pairs in [
-        vec![("shadow_cache", "true")],
-        vec![("preset", "rss"), ("insert", "exact")],
+        vec![("preset", "rss-r"), ("shadow_cache", "true")],
+        vec![("insert", "exact")],
     ] {
         let cached = grid(&input, &pairs);
         let mut got = vec![false; shadow.len()];

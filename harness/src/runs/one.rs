@@ -50,14 +50,22 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     let pool = workload::pool(spec.threads)?;
     let prepared = workload::prepare(&spec.source)?;
     let scene = &prepared.input.scene;
-    let (mut build, mut tr, mut is, mut sh) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut build, mut tr, mut is, mut sh, mut cpu) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut last = None;
+    // One untimed render first: the first repeats of a fresh process run measurably slower
+    // (cold caches, page faults on first touch), which would widen every spread.
+    {
+        let (engine, _) = workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
+        pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
+    }
     for _ in 0..spec.repeats.max(1) {
         let (engine, build_s) =
             workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
         let r = pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
         build.push(prepared.prepare_s + build_s);
         tr.push(r.trace_s);
+        cpu.push(r.trace_cpu_s);
         is.push(r.intersect_s);
         sh.push(r.shade_s);
         last = Some((engine, r));
@@ -132,6 +140,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             trace,
             intersect: Spread::of(&is),
             shade: Spread::of(&sh),
+            trace_cpu: Spread::of(&cpu),
         },
         structure_bytes: engine.structure_bytes(),
         peak_rss_bytes,

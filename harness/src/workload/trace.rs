@@ -89,6 +89,8 @@ pub struct Render {
     pub intersect_s: f64,
     pub shade_s: f64,
     pub trace_s: f64,
+    /// CPU seconds the trace used on our threads (the render's and the pool's).
+    pub trace_cpu_s: f64,
 }
 
 impl Render {
@@ -113,39 +115,70 @@ impl Render {
     }
 }
 
-/// Runs closest-hit queries over a batch, split across the pool's threads.
-fn intersect_all(engine: &dyn Engine, rays: &[Ray], hits: &mut Vec<Hit>, counters: &mut Counters) {
+/// CPU seconds spent by pool threads other than the render's own (whose time the render
+/// measures as a whole), so nothing is counted twice.
+fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
+    let c0 = super::thread_cpu_seconds();
+    work();
+    if rayon::current_thread_index() != me {
+        super::thread_cpu_seconds() - c0
+    } else {
+        0.0
+    }
+}
+
+/// Runs closest-hit queries over a batch, split across the pool's threads. Returns the CPU
+/// seconds used on threads other than the caller's.
+fn intersect_all(
+    engine: &dyn Engine,
+    rays: &[Ray],
+    hits: &mut Vec<Hit>,
+    counters: &mut Counters,
+) -> f64 {
     hits.clear();
     hits.resize(rays.len(), Hit::MISS);
-    let sums: Vec<Counters> = rays
+    let me = rayon::current_thread_index();
+    let sums: Vec<(Counters, f64)> = rays
         .par_chunks(BATCH)
         .zip(hits.par_chunks_mut(BATCH))
         .map(|(r, h)| {
             let mut c = Counters::default();
-            engine.intersect(r, h, &mut c);
-            c
+            let cpu = other_thread_cpu(me, || engine.intersect(r, h, &mut c));
+            (c, cpu)
         })
         .collect();
-    for c in &sums {
+    let mut cpu = 0.0;
+    for (c, t) in &sums {
         counters.add(c);
+        cpu += t;
     }
+    cpu
 }
 
-fn occluded_all(engine: &dyn Engine, rays: &[Ray], out: &mut Vec<bool>, counters: &mut Counters) {
+fn occluded_all(
+    engine: &dyn Engine,
+    rays: &[Ray],
+    out: &mut Vec<bool>,
+    counters: &mut Counters,
+) -> f64 {
     out.clear();
     out.resize(rays.len(), false);
-    let sums: Vec<Counters> = rays
+    let me = rayon::current_thread_index();
+    let sums: Vec<(Counters, f64)> = rays
         .par_chunks(BATCH)
         .zip(out.par_chunks_mut(BATCH))
         .map(|(r, o)| {
             let mut c = Counters::default();
-            engine.occluded(r, o, &mut c);
-            c
+            let cpu = other_thread_cpu(me, || engine.occluded(r, o, &mut c));
+            (c, cpu)
         })
         .collect();
-    for c in &sums {
+    let mut cpu = 0.0;
+    for (c, t) in &sums {
         counters.add(c);
+        cpu += t;
     }
+    cpu
 }
 
 fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
@@ -162,6 +195,8 @@ pub fn render(
     mut record: Option<&mut Recording>,
 ) -> Render {
     let start = Instant::now();
+    let cpu_start = super::thread_cpu_seconds();
+    let mut other_cpu = 0.0;
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
     let w = size + 1;
@@ -214,7 +249,7 @@ pub fn render(
             ..Default::default()
         };
         let t0 = Instant::now();
-        intersect_all(engine, &rays, &mut hits, &mut counters);
+        other_cpu += intersect_all(engine, &rays, &mut hits, &mut counters);
         intersect_s += t0.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.closest
@@ -307,7 +342,7 @@ pub fn render(
         shade_s += t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
-        occluded_all(engine, &shadow_rays, &mut blocked, &mut counters);
+        other_cpu += occluded_all(engine, &shadow_rays, &mut blocked, &mut counters);
         intersect_s += t2.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.any
@@ -346,5 +381,6 @@ pub fn render(
         intersect_s,
         shade_s,
         trace_s: start.elapsed().as_secs_f64(),
+        trace_cpu_s: super::thread_cpu_seconds() - cpu_start + other_cpu,
     }
 }

@@ -116,7 +116,14 @@ fn series_by_label(
 }
 
 fn sf_panel(title: &str, y_label: &str, series: Vec<Series>) -> Panel {
+    let sfs: BTreeSet<u64> = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.x.to_bits()))
+        .collect();
+    let mut x_ticks: Vec<f64> = sfs.into_iter().map(f64::from_bits).collect();
+    x_ticks.sort_by(f64::total_cmp);
     Panel::Xy(XyPanel {
+        x_ticks,
         title: title.to_string(),
         x_label: "SF".to_string(),
         y_label: y_label.to_string(),
@@ -267,6 +274,7 @@ fn speed_vs_error(summary: &Summary, colors: &BTreeMap<String, usize>) -> Option
             y_label: "Mrays/s".to_string(),
             x_log: true,
             y_log: true,
+            x_ticks: Vec::new(),
             lines: false,
             legend: LegendAt::UpperRight,
             series,

@@ -1,9 +1,12 @@
 //! Drawing a [`Chart`] with plotters, as SVG text or PNG bytes. One drawing routine serves both
 //! backends, so the two files of a plot always show the same thing.
 
+use super::bitmap::Bitmap;
 use super::font::{self, FAMILY};
 use super::model::{BarPanel, Chart, LegendAt, Panel, XyPanel};
+use super::ticks::log_ticks;
 use crate::number;
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::coord::ranged1d::{AsRangedCoord, SegmentValue, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -68,7 +71,11 @@ pub fn png(chart: &Chart) -> Result<Vec<u8>, String> {
     let (w, h) = size(chart);
     let mut pixels = vec![0u8; (w * h * 3) as usize];
     {
-        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        let backend = Bitmap::new(
+            BitMapBackend::with_buffer(&mut pixels, (w, h)),
+            font::font_ref()?,
+        );
+        let root = backend.into_drawing_area();
         draw(&root, chart)?;
         root.present().map_err(|e| e.to_string())?;
     }
@@ -119,6 +126,22 @@ fn bounds(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
+/// A panel's frame: its caption (if any), margins and the room for tick labels.
+fn builder<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    y_label_room: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut b = ChartBuilder::on(area);
+    if !title.is_empty() {
+        b.caption(title, text(16));
+    }
+    b.margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(y_label_room);
+    b
+}
+
 fn draw_xy_any<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &XyPanel,
@@ -131,11 +154,29 @@ fn draw_xy_any<DB: DrawingBackend>(
             .flatten(),
         p.y_log,
     );
+    let (x_bold, x_light) = if p.x_ticks.is_empty() {
+        log_ticks(x0, x1)
+    } else {
+        (p.x_ticks.clone(), p.x_ticks.clone())
+    };
+    let (y_bold, y_light) = log_ticks(y0, y1);
+    let x_log = || {
+        (x0..x1)
+            .log_scale()
+            .with_key_points(x_bold.clone())
+            .with_light_points(x_light.clone())
+    };
+    let y_log = || {
+        (y0..y1)
+            .log_scale()
+            .with_key_points(y_bold.clone())
+            .with_light_points(y_light.clone())
+    };
     // The coordinate types differ with the scale, so each combination is its own instance.
     match (p.x_log, p.y_log) {
-        (true, true) => draw_xy(area, p, (x0..x1).log_scale(), (y0..y1).log_scale()),
-        (true, false) => draw_xy(area, p, (x0..x1).log_scale(), y0..y1),
-        (false, true) => draw_xy(area, p, x0..x1, (y0..y1).log_scale()),
+        (true, true) => draw_xy(area, p, x_log(), y_log()),
+        (true, false) => draw_xy(area, p, x_log(), y0..y1),
+        (false, true) => draw_xy(area, p, x0..x1, y_log()),
         (false, false) => draw_xy(area, p, x0..x1, y0..y1),
     }
 }
@@ -149,11 +190,7 @@ where
     Y::CoordDescType: ValueFormatter<f64>,
 {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, text(16))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
+    let mut chart = builder(area, &p.title, 64)
         .build_cartesian_2d(x, y)
         .map_err(e)?;
     chart
@@ -234,12 +271,9 @@ fn draw_bars<DB: DrawingBackend>(
         .map(|b| b.label.chars().count())
         .max()
         .unwrap_or(4) as u32;
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, text(16))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size((longest * 8 + 16).clamp(60, 320))
-        .build_cartesian_2d(0.0..x_max, (0..n).into_segmented())
+    let mut chart = builder(area, &p.title, (longest * 7 + 16).clamp(60, 320))
+        // An integer range includes its end: 0..n−1 holds n categories.
+        .build_cartesian_2d(0.0..x_max, (0..n - 1).into_segmented())
         .map_err(e)?;
     // The first bar on top: category i is drawn at row n − 1 − i.
     let label_of = |v: &SegmentValue<usize>| match v {
@@ -259,7 +293,7 @@ fn draw_bars<DB: DrawingBackend>(
         .x_desc(&p.value_label)
         .label_style(text(13))
         .axis_desc_style(text(14))
-        .light_line_style(RGBColor(235, 235, 235))
+        .light_line_style(WHITE)
         .bold_line_style(RGBColor(215, 215, 215))
         .draw()
         .map_err(e)?;

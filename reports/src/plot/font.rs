@@ -1,7 +1,9 @@
 //! The font plots are drawn with: DejaVu Sans (cut down to the characters reports use), compiled into
-//! the crate and registered with plotters' `ab_glyph` text backend. Nothing is looked up on the machine,
-//! so a fresh system without fontconfig or any font package draws the same labels. See `fonts/README.md`.
+//! the crate. It is registered with plotters' `ab_glyph` text backend (which sizes text for the SVG
+//! files) and drawn by the PNG backend (`bitmap.rs`). Nothing is looked up on the machine, so a fresh
+//! system without fontconfig or any font package draws the same labels. See `fonts/README.md`.
 
+use ab_glyph::FontRef;
 use plotters::style::{register_font, FontStyle};
 use std::sync::OnceLock;
 
@@ -19,4 +21,10 @@ pub fn register() -> Result<(), String> {
         })
     })
     .clone()
+}
+
+/// The font itself, for the PNG backend's text (`bitmap.rs`).
+pub fn font_ref() -> Result<FontRef<'static>, String> {
+    FontRef::try_from_slice(FONT)
+        .map_err(|e| format!("the bundled font fonts/DejaVuSans-subset.ttf: {e}"))
 }

@@ -24,6 +24,8 @@ pub struct XyPanel {
     pub y_label: String,
     pub x_log: bool,
     pub y_log: bool,
+    /// Where to put the x ticks (the SFs measured); empty: chosen from the range.
+    pub x_ticks: Vec<f64>,
     /// Join each series' points with a line (else a scatter).
     pub lines: bool,
     pub legend: LegendAt,

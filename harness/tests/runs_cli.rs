@@ -1,0 +1,286 @@
+//! `rtbench run`, `sweep`, `report`, `compare` (issue 6): results survive a kill, `--resume`
+//! completes them, crashing and memory-hungry runs are recorded as failed without stopping the
+//! sweep, and `compare` tells noise from a planted slowdown.
+//!
+//! Uses the test-only engines of engines/src/testing.rs (RTBENCH_TEST_ENGINES=1).
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+/// These tests time runs and start many processes: one at a time, so they do not load each other.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn rtbench() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rtbench"));
+    c.env("RTBENCH_TEST_ENGINES", "1")
+        .env_remove("RTBENCH_TEST_SLOWDOWN");
+    c
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rtbench-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn records(dir: &Path) -> Vec<Value> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every line of results.jsonl is a whole record"))
+        .collect()
+}
+
+fn ok(out: &Output) -> bool {
+    if !out.status.success() {
+        eprintln!("{}", String::from_utf8_lossy(&out.stderr));
+    }
+    out.status.success()
+}
+
+#[test]
+fn killed_run_leaves_valid_results_and_resume_completes_it() {
+    let _one_at_a_time = serial();
+    let dir = tmp("resume");
+    let args = [
+        "run",
+        "--engines",
+        "bvh2,bvh4,embree",
+        "--scenes",
+        "tetra,tree",
+        "--sf",
+        "3",
+        "--repeat",
+        "2",
+        "--size",
+        "128",
+        "--out",
+    ];
+    let mut child = rtbench()
+        .args(args)
+        .arg(&dir)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill it once the first runs are in, before all six are.
+    let t = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(dir.join("results.jsonl"))
+            .map(|s| s.lines().count())
+            .unwrap_or(0);
+        if n >= 2 || t.elapsed() > Duration::from_secs(120) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let before = records(&dir);
+    assert!(
+        !before.is_empty() && before.len() < 6,
+        "killed after {} of 6 runs",
+        before.len()
+    );
+    let out = rtbench()
+        .args(args)
+        .arg(&dir)
+        .arg("--resume")
+        .output()
+        .unwrap();
+    assert!(ok(&out));
+    let after = records(&dir);
+    assert_eq!(after.len(), 6);
+    // The runs done before the kill were kept, not redone.
+    for r in &before {
+        assert!(
+            after
+                .iter()
+                .any(|a| a["key"] == r["key"] && a["finished_at"] == r["finished_at"]),
+            "{} redone",
+            r["key"]
+        );
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("already done").count(), before.len(), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn crashing_and_memory_hungry_runs_fail_and_the_sweep_goes_on() {
+    let _one_at_a_time = serial();
+    let dir = tmp("sweep-fail");
+    let out = rtbench()
+        .args([
+            "sweep",
+            "--engines",
+            "test-panic,test-hog,bvh2",
+            "--set",
+            "test-hog.bytes=600000000",
+            "--scenes",
+            "tetra",
+        ])
+        .args([
+            "--sf-max",
+            "3",
+            "--repeat",
+            "1",
+            "--size",
+            "64",
+            "--max-seconds",
+            "60",
+            "--max-memory",
+            "300MiB",
+            "--no-check",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ok(&out), "sweep itself succeeds");
+    let recs = records(&dir);
+    let by = |k: &str| {
+        recs.iter()
+            .find(|r| r["key"] == k)
+            .unwrap_or_else(|| panic!("{k} missing"))
+    };
+    let panic = by("test-panic/tetra1@1");
+    assert_eq!(panic["status"], "failed");
+    assert!(
+        panic["reason"].as_str().unwrap().contains("panic"),
+        "{panic}"
+    );
+    let hog = by("test-hog[bytes=600000000]/tetra1@1");
+    assert_eq!(hog["status"], "failed");
+    assert!(
+        hog["reason"].as_str().unwrap().contains("memory limit"),
+        "{hog}"
+    );
+    // Each failing engine stopped at its first SF; bvh2 went on to the last.
+    assert!(!recs.iter().any(|r| r["key"] == "test-panic/tetra2@1"));
+    for sf in 1..=3 {
+        assert_eq!(by(&format!("bvh2/tetra{sf}@1"))["status"], "ok");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sweep_stops_at_the_time_limit() {
+    let _one_at_a_time = serial();
+    let dir = tmp("sweep-time");
+    // tetra SF 9 (262,144 triangles) with the brute-force reference takes far more than 3 s.
+    let out = rtbench()
+        .args([
+            "sweep",
+            "--engines",
+            "reference",
+            "--scenes",
+            "tetra",
+            "--sf-max",
+            "9",
+            "--repeat",
+            "1",
+            "--size",
+            "64",
+        ])
+        .args(["--max-seconds", "3", "--no-check", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ok(&out));
+    let recs = records(&dir);
+    let last = recs.last().unwrap();
+    assert!(recs.len() < 9, "the sweep went to the end");
+    assert!(
+        last["status"] == "failed" && last["reason"].as_str().unwrap().contains("time limit")
+            || last["wall_s"].as_f64().unwrap() > 3.0,
+        "{last}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn quick_run(dir: &Path, slowdown: Option<&str>) {
+    let mut c = rtbench();
+    if let Some(s) = slowdown {
+        c.env("RTBENCH_TEST_SLOWDOWN", s);
+    }
+    let out = c
+        .args([
+            "run",
+            "--engines",
+            "embree,test-slow",
+            "--scenes",
+            "balls,tetra",
+            "--sf",
+            "4",
+            "--repeat",
+            "7",
+            "--size",
+            "256",
+            "--no-check",
+            "--out",
+        ])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(ok(&out));
+}
+
+#[test]
+fn compare_passes_noise_and_names_a_planted_slowdown() {
+    let _one_at_a_time = serial();
+    let (a, b, c) = (tmp("cmp-a"), tmp("cmp-b"), tmp("cmp-c"));
+    quick_run(&a, None);
+    quick_run(&b, None);
+    // test-slow spins 15% of its query time more: at least 10% of its trace time (queries are
+    // 75–90% of it here; the rest is shading).
+    quick_run(&c, Some("0.15"));
+    let same = rtbench()
+        .args(["compare"])
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .unwrap();
+    assert_eq!(
+        same.status.code(),
+        Some(0),
+        "same commit, same engines: {}{}",
+        String::from_utf8_lossy(&same.stdout),
+        String::from_utf8_lossy(&same.stderr)
+    );
+    let slow = rtbench()
+        .args(["compare"])
+        .arg(&a)
+        .arg(&c)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&slow.stderr);
+    assert_eq!(
+        slow.status.code(),
+        Some(1),
+        "planted slowdown not found: {}{err}",
+        String::from_utf8_lossy(&slow.stdout)
+    );
+    assert!(
+        err.contains("test-slow"),
+        "the regression names the run: {err}"
+    );
+    assert!(
+        !err.contains("embree/"),
+        "Embree is the yardstick, not a regression: {err}"
+    );
+    // The report is made from the results alone.
+    let rep = rtbench().args(["report"]).arg(&c).output().unwrap();
+    assert!(ok(&rep));
+    for f in ["report.md", "results.csv", "report.html"] {
+        assert!(c.join(f).is_file(), "{f}");
+    }
+    for d in [a, b, c] {
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -1,0 +1,241 @@
+//! `compare` on synthetic result sets.
+
+mod common;
+
+use common::{failed, run, samples, write_set, TempDir};
+use rtbench_reports::{compare, Comparison, FindingKind, ReportError, RunRecord};
+
+/// embree, bvh2 and grid on balls3 and balls4.
+fn base() -> Vec<RunRecord> {
+    let mut v = Vec::new();
+    for sf in [3, 4] {
+        v.push(run("embree", "balls", sf, 1.0 * sf as f64));
+        v.push(run("bvh2", "balls", sf, 2.0 * sf as f64));
+        v.push(run("grid", "balls", sf, 0.5 * sf as f64));
+    }
+    v
+}
+
+fn compare_sets(a: &[RunRecord], b: &[RunRecord], threshold: f64) -> Comparison {
+    let (da, db) = (TempDir::new("cmp-a"), TempDir::new("cmp-b"));
+    write_set(da.path(), a);
+    write_set(db.path(), b);
+    compare(da.path(), db.path(), threshold).unwrap()
+}
+
+/// Scales a run's trace times (median, min, max, samples) by `f`, keeping its relative spread.
+fn scale_trace(r: &mut RunRecord, f: f64) {
+    let t = &mut r.time_s.trace;
+    t.min *= f;
+    t.median *= f;
+    t.max *= f;
+    t.samples.iter_mut().for_each(|s| *s *= f);
+    r.mrays_per_s /= f;
+}
+
+fn find<'a>(runs: &'a mut [RunRecord], key: &str) -> &'a mut RunRecord {
+    runs.iter_mut().find(|r| r.key == key).unwrap()
+}
+
+#[test]
+fn identical_sets_do_not_regress() {
+    let c = compare_sets(&base(), &base(), 5.0);
+    assert!(!c.is_regression(), "{}", c.to_markdown());
+    assert!(c.improvements.is_empty() && c.notes.is_empty());
+    assert_eq!(c.matched, 6);
+    assert_eq!(
+        c.times_compared, 4,
+        "bvh2 and grid on two scenes; Embree is the yardstick"
+    );
+    assert_eq!(c.counters_compared, 12);
+    assert_eq!(c.a_commit.as_deref(), Some("abc1234"));
+    assert!(c.to_markdown().contains("**No regression.**"));
+}
+
+#[test]
+fn slower_relative_to_embree_is_a_regression() {
+    let mut b = base();
+    // The whole machine 30% slower (cancels), and bvh2 on balls4 15% slower than that.
+    b.iter_mut().for_each(|r| scale_trace(r, 1.3));
+    scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
+    let c = compare_sets(&base(), &b, 5.0);
+    assert!(c.is_regression());
+    assert_eq!(c.regressions.len(), 1, "{}", c.to_markdown());
+    let f = &c.regressions[0];
+    assert_eq!(f.key, "bvh2/balls4@1");
+    assert_eq!(f.kind, FindingKind::TimeRatio);
+    assert!(
+        (f.change_pct.unwrap() - 15.0).abs() < 1e-9,
+        "{:?}",
+        f.change_pct
+    );
+    assert!(
+        (f.tolerance_pct.unwrap() - 5.0).abs() < 1e-9,
+        "spread 2% < threshold 5%"
+    );
+    assert!(
+        (f.old.as_f64().unwrap() - 2.0).abs() < 1e-12
+            && (f.new.as_f64().unwrap() - 2.3).abs() < 1e-12
+    );
+    assert!(
+        f.message.contains("bvh2/balls4@1") && f.message.contains("2.00 → 2.30"),
+        "{}",
+        f.message
+    );
+    let md = c.to_markdown();
+    assert!(
+        md.contains("**1 regression.**")
+            && md.contains("| `bvh2/balls4@1` | trace time / Embree | 2.00 | 2.30 | +15% | 5% |"),
+        "{md}"
+    );
+    let json = serde_json::to_value(&c).unwrap();
+    assert_eq!(json["regressions"][0]["key"], "bvh2/balls4@1");
+    assert_eq!(json["regressions"][0]["kind"], "time_ratio");
+}
+
+#[test]
+fn the_threshold_and_the_runs_noise_set_the_bar() {
+    let mut b = base();
+    scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
+    assert!(compare_sets(&base(), &b, 14.9).is_regression());
+    assert!(!compare_sets(&base(), &b, 15.1).is_regression());
+
+    // A run whose own repeats are noisy needs more to count: the bar is twice the ratio's noise,
+    // σ ≈ 1.4826 × MAD / median of the engine's and of Embree's repeats combined. Here the engine
+    // spreads ±10% (MAD 10%) and Embree ±1% (MAD 1%): the bar is 2 × 1.4826 × √(0.1² + 0.01²).
+    let mut a = base();
+    find(&mut a, "bvh2/balls4@1").time_s.trace = samples(8.0, 0.2);
+    let mut b = a.clone();
+    scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
+    assert!(!compare_sets(&a, &b, 5.0).is_regression());
+    scale_trace(find(&mut b, "bvh2/balls4@1"), 1.2);
+    let c = compare_sets(&a, &b, 5.0);
+    assert!(c.is_regression());
+    let bar = 200.0 * 1.4826 * (0.1f64 * 0.1 + 0.01 * 0.01).sqrt();
+    assert!(
+        (c.regressions[0].tolerance_pct.unwrap() - bar).abs() < 1e-6,
+        "{:?}",
+        c.regressions[0].tolerance_pct
+    );
+}
+
+#[test]
+fn faster_relative_to_embree_is_an_improvement() {
+    let mut b = base();
+    scale_trace(find(&mut b, "grid/balls3@1"), 0.8);
+    let c = compare_sets(&base(), &b, 5.0);
+    assert!(!c.is_regression());
+    assert_eq!(c.improvements.len(), 1);
+    assert_eq!(c.improvements[0].key, "grid/balls3@1");
+    assert!((c.improvements[0].change_pct.unwrap() + 20.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_changed_counter_is_a_regression_at_any_size() {
+    let mut b = base();
+    *find(&mut b, "grid/balls3@1")
+        .counters
+        .get_mut("nodes_visited")
+        .unwrap() += 1;
+    // Embree's counters count too; its times do not (they are the yardstick).
+    find(&mut b, "embree/balls4@1")
+        .counters
+        .insert("sweeps".to_string(), 2);
+    let c = compare_sets(&base(), &b, 50.0);
+    assert!(c.is_regression());
+    assert_eq!(c.regressions.len(), 2, "{}", c.to_markdown());
+    let grid = c
+        .regressions
+        .iter()
+        .find(|f| f.key == "grid/balls3@1")
+        .unwrap();
+    assert_eq!(grid.kind, FindingKind::Counter);
+    assert_eq!(grid.what, "nodes_visited");
+    assert_eq!(
+        (grid.old.as_u64(), grid.new.as_u64()),
+        (Some(3004), Some(3005))
+    );
+    assert_eq!(
+        grid.message,
+        "grid/balls3@1: counter nodes_visited: 3004 → 3005"
+    );
+    let embree = c
+        .regressions
+        .iter()
+        .find(|f| f.key == "embree/balls4@1")
+        .unwrap();
+    assert_eq!(
+        embree.message,
+        "embree/balls4@1: counter sweeps: absent → 2"
+    );
+}
+
+#[test]
+fn failures_and_unmatched_runs_are_reported() {
+    let mut a = base();
+    a.push(failed("bvh2", "teapot", 3, "panic"));
+    a.push(run("grid", "rings", 2, 1.0));
+    let mut b = base();
+    *find(&mut b, "bvh2/balls3@1") = failed("bvh2", "balls", 3, "memory limit");
+    b.push(run("bvh2", "teapot", 3, 1.0));
+    b.push(run("grid", "gears", 2, 1.0));
+    let c = compare_sets(&a, &b, 5.0);
+
+    assert_eq!(c.regressions.len(), 1, "{}", c.to_markdown());
+    assert_eq!(c.regressions[0].kind, FindingKind::Failed);
+    assert_eq!(
+        c.regressions[0].message,
+        "bvh2/balls3@1: failed in B: memory limit"
+    );
+    assert_eq!(c.improvements.len(), 1);
+    assert_eq!(c.improvements[0].kind, FindingKind::Recovered);
+    let kinds: Vec<(FindingKind, &str)> =
+        c.notes.iter().map(|f| (f.kind, f.key.as_str())).collect();
+    assert!(
+        kinds.contains(&(FindingKind::OnlyInA, "grid/rings2@1")),
+        "{kinds:?}"
+    );
+    assert!(
+        kinds.contains(&(FindingKind::OnlyInB, "grid/gears2@1")),
+        "{kinds:?}"
+    );
+}
+
+#[test]
+fn no_embree_no_time_comparison() {
+    let a = vec![run("bvh2", "teapot", 3, 1.0)];
+    let mut b = a.clone();
+    scale_trace(&mut b[0], 2.0);
+    let c = compare_sets(&a, &b, 5.0);
+    assert!(
+        !c.is_regression(),
+        "a time without a yardstick cannot regress"
+    );
+    assert_eq!(c.notes.len(), 1);
+    assert_eq!(c.notes[0].kind, FindingKind::NoYardstick);
+    assert!(
+        c.notes[0].message.contains("in A and B"),
+        "{}",
+        c.notes[0].message
+    );
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let (da, db) = (TempDir::new("bad-a"), TempDir::new("bad-b"));
+    write_set(da.path(), &base());
+    let e = compare(da.path(), db.path(), 5.0).unwrap_err();
+    assert!(
+        matches!(e, ReportError::NoResults { .. }) && e.to_string().contains("results.jsonl"),
+        "{e}"
+    );
+    write_set(db.path(), &base());
+    assert!(matches!(
+        compare(da.path(), db.path(), -1.0),
+        Err(ReportError::BadThreshold(_))
+    ));
+    assert!(matches!(
+        compare(da.path(), db.path(), f64::NAN),
+        Err(ReportError::BadThreshold(_))
+    ));
+}
