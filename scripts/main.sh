@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# rtbench's main job, from a fresh clone: set up (libclang, Embree), build, then trace the SPD workload on the
-# seven standard scenes with every available engine and print the ray-statistics table against the published one.
-# Results: out/quick/spd-stats.md, out/quick/spd-stats.json, out/quick/images/*.png.
-# Usage: bash scripts/main.sh [OUT_DIR]
+# rtbench's main job, from a fresh clone: set up (libclang, Embree), build, then the quick run: every available
+# engine × the seven standard SPD scenes at their standard size factors, one thread, 3 repeats, each run
+# cross-checked against Embree; then the report (tables and plots) and the SPD ray-statistics table.
+# Results: OUT_DIR/results.jsonl, OUT_DIR/report.md, OUT_DIR/report.html, OUT_DIR/plots/, OUT_DIR/spd-stats.md.
+# Usage: bash scripts/main.sh [OUT_DIR]     (default out/quick; an existing OUT_DIR is resumed)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -11,5 +12,14 @@ command -v cargo >/dev/null || { echo "main.sh: error: cargo not found (install 
 OUT="${1:-out/quick}"
 bash scripts/setup.sh
 cargo build --release -p rtbench --quiet
-./target/release/rtbench engines
-./target/release/rtbench reproduce spd-stats --out "$OUT"
+RT=./target/release/rtbench
+$RT engines
+$RT run --engines all --scenes standard --repeat 3 --threads 1 --out "$OUT" --resume
+$RT report "$OUT"
+$RT reproduce spd-stats --engines embree --out "$OUT" >/dev/null
+echo
+sed -n '/^## /,$p' "$OUT/report.md" | sed '/^## Plots/,$d'
+echo
+cat "$OUT/spd-stats.md"
+echo
+echo "main.sh: report in $OUT/report.md and $OUT/report.html"

@@ -1,1 +1,1 @@
-//! End-to-end tests live in tests/tests/.
+//! Cross-crate tests live in tests/tests/ (the CLI tests, which need the binary, in harness/tests/).

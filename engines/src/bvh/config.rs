@@ -5,9 +5,15 @@
 //! | `builder` | `median` (001 object median), `sah-sweep` (001 full-sweep SAH), `sah-binned` | `sah-binned` |
 //! | `wide` | `collapse` (binary tree collapsed to N-wide), `direct` (001's own N-ary builders) | `collapse` |
 //! | `leaf` | most primitives per leaf, 1–16 (001 uses 1) | 1 for bvh2, 4 for bvh4/bvh8 |
-//! | `simd` | `on`, `off` (bvh4: SSE, bvh8: AVX2+FMA when the CPU has them) | `on` (bvh2: `off`) |
+//! | `simd` | `on`, `off` (bvh4: SSE, with FMA when the CPU has AVX2 + FMA; bvh8: AVX2 + FMA) | `on` (bvh2: `off`) |
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
+//!
+//! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
+//! the SAH prefers a leaf (`median`: always). With `wide=collapse` a subtree of ≤ `leaf`
+//! primitives becomes a leaf, but node slots left free are spent splitting such leaves further
+//! (`collapse.rs`), so wide leaves are often smaller. `simd=on` on a CPU without the
+//! instructions runs the scalar test (`build_stats.simd_lanes` says which ran).
 
 use super::node::MAX_LEAF_PRIMS;
 use crate::engine::{EngineError, Settings, TriangleTest};
