@@ -15,7 +15,10 @@
 
 use super::tree::{BuildKind, BuildTree, MAX_WIDTH};
 
-pub fn collapse(bin: &BuildTree, width: usize, leaf: usize) -> BuildTree {
+/// `split_leaves`: spend free slots on splitting leaf-sized subtrees (worth it when each
+/// primitive is tested on its own; not with triangle packets, which test a whole leaf of up to
+/// 4 triangles for the price of one, see `leaf.rs`).
+pub fn collapse(bin: &BuildTree, width: usize, leaf: usize, split_leaves: bool) -> BuildTree {
     assert!((2..=MAX_WIDTH).contains(&width) && leaf >= 1);
     let mut span = vec![(0u32, 0u32); bin.nodes.len()];
     spans(bin, 0, &mut span);
@@ -23,7 +26,7 @@ pub fn collapse(bin: &BuildTree, width: usize, leaf: usize) -> BuildTree {
         nodes: Vec::with_capacity(bin.nodes.len() / (width - 1) + 1),
         order: bin.order.clone(),
     };
-    node(bin, &span, 0, width, leaf, &mut out);
+    node(bin, &span, 0, width, leaf, split_leaves, &mut out);
     out
 }
 
@@ -51,6 +54,7 @@ fn node(
     i: u32,
     width: usize,
     leaf: usize,
+    split_leaves: bool,
     out: &mut BuildTree,
 ) -> u32 {
     let n = &bin.nodes[i as usize];
@@ -77,6 +81,7 @@ fn node(
                 let big = span[k as usize].1 as usize > leaf;
                 (slot, big, bin.nodes[k as usize].bounds.half_area())
             })
+            .filter(|&(_, big, _)| big || split_leaves)
             .max_by(|a, b| a.1.cmp(&b.1).then(a.2.total_cmp(&b.2)));
         let Some((slot, _, _)) = best else { break };
         let grand = bin.children(kids[slot]).to_vec();
@@ -85,7 +90,7 @@ fn node(
     let me = out.push(n.bounds, n.kind);
     let mut wide = [0u32; MAX_WIDTH];
     for (slot, &k) in kids.iter().enumerate() {
-        wide[slot] = node(bin, span, k, width, leaf, out);
+        wide[slot] = node(bin, span, k, width, leaf, split_leaves, out);
     }
     out.nodes[me as usize].kind = BuildKind::Inner {
         children: wide,
@@ -130,15 +135,15 @@ mod tests {
         // no empty slot; 8-wide: 9 inner nodes (the root's 8 children hold 2 leaves each).
         let p = row(16);
         let bin = build_median::binary(&p, 1);
-        let w4 = collapse(&bin, 4, 1);
+        let w4 = collapse(&bin, 4, 1, true);
         w4.validate(&p, 4).unwrap();
         assert_eq!(inner(&w4), 5);
         assert_eq!(w4.children(0).len(), 4);
-        let w8 = collapse(&bin, 8, 1);
+        let w8 = collapse(&bin, 8, 1, true);
         w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
         assert_eq!(w8.children(0).len(), 8);
-        let w2 = collapse(&bin, 2, 1);
+        let w2 = collapse(&bin, 2, 1, true);
         assert_eq!(w2.nodes.len(), bin.nodes.len());
     }
 
@@ -148,7 +153,7 @@ mod tests {
         // opened into 3 + 3, then (slots still free) into 1 + 2 + 1 + 2.
         let p = row(24);
         let bin = build_median::binary(&p, 1);
-        let w4 = collapse(&bin, 4, 2);
+        let w4 = collapse(&bin, 4, 2, true);
         w4.validate(&p, 4).unwrap();
         let mut leaves: Vec<u32> = w4
             .nodes
@@ -163,7 +168,7 @@ mod tests {
         assert_eq!(inner(&w4), 5);
         // With room to spare every leaf ends up with one primitive: 64 primitives, 8-wide.
         let p = row(64);
-        let w8 = collapse(&build_median::binary(&p, 1), 8, 4);
+        let w8 = collapse(&build_median::binary(&p, 1), 8, 4, true);
         w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
         assert_eq!(w8.nodes.len() - inner(&w8), 64);

@@ -8,6 +8,7 @@
 //! | `simd` | `on`, `off` (bvh4: SSE, with FMA when the CPU has AVX2 + FMA; bvh8: AVX2 + FMA) | `on` (bvh2: `off`) |
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
+//! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
 //!
 //! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
 //! the SAH prefers a leaf (`median`: always). With `wide=collapse` a subtree of ≤ `leaf`
@@ -108,6 +109,8 @@ pub struct Config {
     pub simd: bool,
     pub triangle: TriangleTest,
     pub bins: usize,
+    pub packets: bool,
+    pub split_leaves: bool,
 }
 
 impl Config {
@@ -126,6 +129,8 @@ impl Config {
         let simd = settings.get("simd", OnOff(width > 2))?.0;
         let triangle = settings.get("triangle", TriangleTest::default())?;
         let bins = settings.get("bins", 32usize)?;
+        let packets = settings.get("packets", OnOff(width > 2))?.0;
+        let split_leaves = settings.get("split_leaves", OnOff(!packets))?.0;
         settings.finish()?;
         if !(1..=MAX_LEAF_PRIMS).contains(&leaf) {
             return Err(bad(
@@ -152,6 +157,8 @@ impl Config {
             simd,
             triangle,
             bins,
+            packets,
+            split_leaves,
         })
     }
 }

@@ -6,7 +6,8 @@
 //! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
 //! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
 //! ([`simd`]). Leaves hold up to `leaf` primitives of the shared [`Geometry`], copied in
-//! leaf order, and test them with the shared kernels (`Prim::intersect`).
+//! leaf order: triangles in packets of 4 tested with the shared SIMD triangle kernel, other
+//! primitives tested with the shared scalar kernels (`Prim::intersect`); see [`leaf`].
 //!
 //! Settings: see [`config`].
 
@@ -14,6 +15,7 @@ pub mod build_median;
 pub mod build_sah;
 pub mod collapse;
 pub mod config;
+pub mod leaf;
 pub mod node;
 pub mod simd;
 pub mod stats;
@@ -27,7 +29,7 @@ use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Setti
 use crate::geometry::Geometry;
 use crate::ray::{Hit, Ray};
 use config::{Builder, Config, WideMethod};
-use node::{flatten, WideNode, MAX_PRIMS};
+use node::{flatten, WideNode, MAX_TRAVERSAL_PRIMS};
 use simd::Kernels;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -100,7 +102,7 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     if width == 2 {
         binary
     } else {
-        collapse::collapse(&binary, width, leaf)
+        collapse::collapse(&binary, width, leaf, config.split_leaves)
     }
 }
 
@@ -110,12 +112,12 @@ pub fn build_bvh<const N: usize>(
     config: &Config,
 ) -> Result<(Bvh<N>, stats::TreeStats), EngineError> {
     let n = geometry.prims.len();
-    if n >= MAX_PRIMS {
+    if n >= MAX_TRAVERSAL_PRIMS {
         return Err(EngineError::Build {
             engine: format!("bvh{N}"),
             reason: format!(
                 "{n} primitives: at most {} fit a leaf reference",
-                MAX_PRIMS - 1
+                MAX_TRAVERSAL_PRIMS - 1
             ),
         });
     }
@@ -137,6 +139,7 @@ pub fn build_bvh<const N: usize>(
             root: flat.root,
             prims: Vec::new(),
             objects: Vec::new(),
+            packets: Vec::new(),
         };
         return Ok((bvh, s));
     }
@@ -146,24 +149,22 @@ pub fn build_bvh<const N: usize>(
         Ok(()),
         "builder broke an invariant"
     );
-    let flat = flatten::<N>(&tree);
+    let mut flat = flatten::<N>(&tree);
     let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
-    let prims = tree
-        .order
-        .iter()
-        .map(|&i| geometry.prims[i as usize])
-        .collect();
-    let objects = tree
-        .order
-        .iter()
-        .map(|&i| geometry.prim_object[i as usize])
-        .collect();
+    let leaves = leaf::lay_out(
+        &mut flat.nodes,
+        &mut flat.root,
+        &tree.order,
+        geometry,
+        config.packets,
+    );
     Ok((
         Bvh {
             nodes: flat.nodes,
             root: flat.root,
-            prims,
-            objects,
+            prims: leaves.prims,
+            objects: leaves.objects,
+            packets: leaves.packets,
         },
         s,
     ))
@@ -189,6 +190,7 @@ fn build_engine<const N: usize>(
     stats.insert("build_s".into(), build_s);
     stats.insert("leaf_size".into(), config.leaf as f64);
     stats.insert("simd_lanes".into(), kernels.lanes as f64);
+    stats.insert("triangle_packets".into(), bvh.packets.len() as f64);
     let mut engine = BvhEngine {
         bvh,
         config,
@@ -219,11 +221,13 @@ impl<const N: usize> Engine for BvhEngine<N> {
         (self.kernels.any)(&self.bvh, rays, occluded, self.config.triangle, counters);
     }
 
-    /// Nodes, plus the primitives and their object indices copied in leaf order.
+    /// Nodes, plus the primitives and their object indices copied in leaf order (triangle
+    /// packets, padding included, and scalar primitives).
     fn structure_bytes(&self) -> u64 {
         (std::mem::size_of::<WideNode<N>>() * self.bvh.nodes.len()
             + std::mem::size_of::<crate::geometry::Prim>() * self.bvh.prims.len()
-            + 4 * self.bvh.objects.len()) as u64
+            + 4 * self.bvh.objects.len()
+            + std::mem::size_of::<leaf::LeafPacket>() * self.bvh.packets.len()) as u64
     }
 
     fn build_stats(&self) -> BTreeMap<String, f64> {

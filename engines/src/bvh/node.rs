@@ -4,7 +4,9 @@
 //!
 //! A child reference is a `u32`: an inner node's index in the node array, or, with the top bit
 //! set, a leaf holding `count` (1–16) consecutive primitives of the engine's reordered
-//! primitive array from `first`. Leaves are not nodes of their own: the parent's slot is all a
+//! primitive array from `first`. In the traversal's tree ([`super::traverse::Bvh`]) a leaf of
+//! triangles only has [`PACKET_BIT`] set too: its `count` triangles are then in
+//! `ceil(count / 4)` consecutive triangle packets from packet `first` ([`super::leaf`]). Leaves are not nodes of their own: the parent's slot is all a
 //! leaf needs (Embree does the same).
 //!
 //! Empty slots (a node with fewer than N children) get the empty box, +∞ lower and −∞ upper
@@ -22,6 +24,11 @@ const COUNT_SHIFT: u32 = 27;
 pub const MAX_LEAF_PRIMS: usize = 16;
 /// Most primitives a tree can index (27 bits of first primitive).
 pub const MAX_PRIMS: usize = 1 << COUNT_SHIFT;
+/// In the traversal's tree, set in a leaf reference whose primitives are triangle packets.
+/// Leaf indices stay below it.
+pub const PACKET_BIT: u32 = 1 << (COUNT_SHIFT - 1);
+/// Most primitives a traversal tree can index (leaf indices must leave [`PACKET_BIT`] clear).
+pub const MAX_TRAVERSAL_PRIMS: usize = PACKET_BIT as usize;
 /// The reference in an empty slot (never followed: the empty box is never hit).
 pub const EMPTY_SLOT: u32 = u32::MAX;
 
@@ -35,6 +42,26 @@ pub fn leaf_ref(first: u32, count: u32) -> u32 {
 #[inline]
 pub fn is_leaf(r: u32) -> bool {
     r & LEAF_BIT != 0
+}
+
+/// A leaf reference to the triangles in packets from `first_packet` (`count` triangles).
+#[inline]
+pub fn packet_leaf_ref(first_packet: u32, count: u32) -> u32 {
+    debug_assert!(first_packet < PACKET_BIT);
+    leaf_ref(first_packet, count) | PACKET_BIT
+}
+
+/// Whether a leaf reference holds triangle packets (traversal tree only).
+#[inline]
+pub fn is_packet_leaf(r: u32) -> bool {
+    r & PACKET_BIT != 0
+}
+
+/// (first packet, triangles) of a packet leaf reference.
+#[inline]
+pub fn packet_range(r: u32) -> (usize, usize) {
+    let (first, count) = leaf_range(r);
+    (first & (PACKET_BIT as usize - 1), count)
 }
 
 /// (first, count) of a leaf reference.
@@ -147,6 +174,10 @@ mod tests {
             assert_eq!(leaf_range(r), (first as usize, count as usize));
         }
         assert!(!is_leaf(12345));
+        let r = packet_leaf_ref(PACKET_BIT - 1, 16);
+        assert!(is_leaf(r) && is_packet_leaf(r));
+        assert_eq!(packet_range(r), (PACKET_BIT as usize - 1, 16));
+        assert!(!is_packet_leaf(leaf_ref(PACKET_BIT - 1, 16)));
     }
 
     #[test]

@@ -14,6 +14,9 @@ use super::node::WideNode;
 use super::traverse::{self, Bvh};
 use crate::engine::{Counters, TriangleTest};
 use crate::geometry::aabb::SlabRay;
+use crate::geometry::triangle_simd::ScalarPackets;
+#[cfg(target_arch = "x86_64")]
+use crate::geometry::triangle_simd::Sse4 as SsePackets;
 use crate::ray::{Hit, Ray};
 
 /// One slab test of a ray against the N children of a node.
@@ -46,8 +49,8 @@ pub struct Kernels<const N: usize> {
 /// The scalar kernels (any width).
 pub fn scalar<const N: usize>() -> Kernels<N> {
     Kernels {
-        closest: traverse::closest_batch::<N, Scalar>,
-        any: traverse::any_batch::<N, Scalar>,
+        closest: traverse::closest_batch::<N, Scalar, ScalarPackets>,
+        any: traverse::any_batch::<N, Scalar, ScalarPackets>,
         lanes: 0,
         name: "scalar",
     }
@@ -68,8 +71,8 @@ pub fn sse4() -> Option<Kernels<4>> {
             }
         } else {
             Kernels {
-                closest: traverse::closest_batch::<4, x86::Sse4<false>>,
-                any: traverse::any_batch::<4, x86::Sse4<false>>,
+                closest: traverse::closest_batch::<4, x86::Sse4<false>, SsePackets>,
+                any: traverse::any_batch::<4, x86::Sse4<false>, SsePackets>,
                 lanes: 4,
                 name: "sse",
             }
@@ -153,6 +156,7 @@ mod x86 {
     use super::ChildTest;
     use crate::engine::{Counters, TriangleTest};
     use crate::geometry::aabb::SlabRay;
+    use crate::geometry::triangle_simd::Sse4 as SsePackets;
     use crate::ray::{Hit, Ray};
     use std::arch::x86_64::*;
 
@@ -361,7 +365,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::closest_batch::<$n, $test>(bvh, rays, hits, t, c)
+                traverse::closest_batch::<$n, $test, SsePackets>(bvh, rays, hits, t, c)
             }
 
             #[target_feature(enable = "avx2,fma")]
@@ -372,7 +376,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::any_batch::<$n, $test>(bvh, rays, out, t, c)
+                traverse::any_batch::<$n, $test, SsePackets>(bvh, rays, out, t, c)
             }
         };
     }
@@ -455,8 +459,8 @@ mod tests {
         let mut fours: Vec<Kernels<4>> = sse4().into_iter().collect();
         #[cfg(target_arch = "x86_64")]
         fours.push(Kernels {
-            closest: traverse::closest_batch::<4, x86::Sse4<false>>,
-            any: traverse::any_batch::<4, x86::Sse4<false>>,
+            closest: traverse::closest_batch::<4, x86::Sse4<false>, SsePackets>,
+            any: traverse::any_batch::<4, x86::Sse4<false>, SsePackets>,
             lanes: 4,
             name: "sse",
         });

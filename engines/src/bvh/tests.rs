@@ -158,8 +158,8 @@ fn all_configurations_agree_with_reference() {
                     if width == 2 && wide == "direct" {
                         continue;
                     }
-                    for leaf in ["1", "3"] {
-                        for simd in ["off", "on"] {
+                    for leaf in ["1", "3", "6"] {
+                        for (simd, packets) in [("off", "off"), ("off", "on"), ("on", "on")] {
                             if width == 2 && simd == "on" {
                                 continue;
                             }
@@ -168,6 +168,7 @@ fn all_configurations_agree_with_reference() {
                                 ("wide", wide),
                                 ("leaf", leaf),
                                 ("simd", simd),
+                                ("packets", packets),
                             ];
                             let label = format!("bvh{width} {kv:?} on {program}{sf}");
                             let e = engine(&inp, width, &kv);
@@ -333,6 +334,43 @@ fn simd_and_scalar_kernels_give_the_same_hits_and_counts() {
             ca.nodes_visited,
             cb.nodes_visited
         );
+    }
+}
+
+/// Triangle packets change how leaves are stored and tested, not what is found or counted: on
+/// the same tree (`split_leaves` fixed), packets on and off give the same hits, the same nodes
+/// and box tests, and the same primitive tests (padding is not counted), with either test.
+#[test]
+fn packets_change_no_answer_and_no_count() {
+    let inp = input(Program::Balls, 1, Some(3));
+    let rays = rays(&inp.geometry, 600, 23);
+    for w in [4, 8] {
+        for triangle in ["watertight", "moller"] {
+            for simd in ["on", "off"] {
+                let run = |packets| {
+                    let kv = [
+                        ("packets", packets),
+                        ("split_leaves", "off"),
+                        ("triangle", triangle),
+                        ("simd", simd),
+                    ];
+                    let e = engine(&inp, w, &kv);
+                    let (hits, c) = closest(e.as_ref(), &rays);
+                    (hits, c, occluded(e.as_ref(), &rays), e.build_stats())
+                };
+                let (on, off) = (run("on"), run("off"));
+                let label = format!("bvh{w} {triangle} simd={simd}");
+                assert!(on.3["triangle_packets"] > 0.0 && off.3["triangle_packets"] == 0.0);
+                assert_eq!(on.0, off.0, "{label}");
+                assert_eq!(on.2, off.2, "{label}");
+                assert_eq!(
+                    (on.1.nodes_visited, on.1.box_tests, on.1.primitive_tests),
+                    (off.1.nodes_visited, off.1.box_tests, off.1.primitive_tests),
+                    "{label}"
+                );
+                assert!(on.1.primitive_hits >= off.1.primitive_hits, "{label}");
+            }
+        }
     }
 }
 

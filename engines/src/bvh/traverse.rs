@@ -11,13 +11,21 @@
 //!
 //! Any-hit queries (shadow rays) need no order and stop at the first hit (Embree's separate
 //! `occluded` kernel does the same).
+//!
+//! Leaves of triangle packets ([`super::leaf`]) are tested a packet at a time with the shared
+//! packet kernel ([`PacketKernel`]: SSE, or lane by lane with `simd=off`). The counters stay
+//! exact: `primitive_tests` counts the triangles of a packet leaf (not its padding);
+//! `primitive_hits` counts the triangles of a packet that hit within the segment as it was
+//! when the packet was tested (testing one by one counts only those that shrink it).
 
-use super::node::{is_leaf, leaf_range, WideNode};
+use super::leaf::{LeafPacket, PACKET};
+use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
 use super::simd::ChildTest;
 use super::tree::{MAX_DEPTH, MAX_WIDTH};
 use crate::engine::{Counters, TriangleTest};
 use crate::geometry::aabb::SlabRay;
 use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::triangle_simd::{LaneHits, PacketKernel};
 use crate::geometry::Prim;
 use crate::ray::{Hit, Ray};
 
@@ -25,26 +33,35 @@ use crate::ray::{Hit, Ray};
 pub const STACK_SIZE: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
 
 /// A built BVH as traversal reads it: flat node array, root reference, and the primitives in
-/// leaf order (leaves index `prims` directly) with their scene objects.
+/// leaf order with their scene objects: triangle packets (packet leaves index `packets`) and
+/// scalar primitives (other leaves index `prims` and `objects`).
 pub struct Bvh<const N: usize> {
     pub nodes: Vec<WideNode<N>>,
     pub root: u32,
     pub prims: Vec<Prim>,
     pub objects: Vec<u32>,
+    pub packets: Vec<LeafPacket>,
 }
 
-/// Where child reference `c` points: its node, or its leaf's first primitive. Only ever
-/// prefetched, never read through, so it is computed with wrapping arithmetic and no check.
+/// Where child reference `c` points: its node, or its leaf's first packet or primitive. Only
+/// ever prefetched, never read through, so it is computed with wrapping arithmetic and no check.
 #[inline(always)]
 fn child_addr<const N: usize>(bvh: &Bvh<N>, c: u32) -> *const u8 {
-    let (first, _) = leaf_range(c);
-    let leaf = bvh.prims.as_ptr().wrapping_add(first) as *const u8;
     let node = bvh.nodes.as_ptr().wrapping_add(c as usize) as *const u8;
-    if is_leaf(c) {
-        leaf
-    } else {
+    if !is_leaf(c) {
         node
+    } else if is_packet_leaf(c) {
+        bvh.packets.as_ptr().wrapping_add(packet_range(c).0) as *const u8
+    } else {
+        bvh.prims.as_ptr().wrapping_add(leaf_range(c).0) as *const u8
     }
+}
+
+/// The packets of a packet leaf reference, and its triangle count.
+#[inline(always)]
+fn leaf_packets<const N: usize>(bvh: &Bvh<N>, c: u32) -> (&[LeafPacket], usize) {
+    let (first, count) = packet_range(c);
+    (&bvh.packets[first..first + count.div_ceil(PACKET)], count)
 }
 
 #[derive(Clone, Copy, Default)]
@@ -100,7 +117,7 @@ fn triangle_test<const W: bool>() -> TriangleTest {
 
 /// Closest hits of a batch of rays.
 #[inline(always)]
-pub fn closest_batch<const N: usize, T: ChildTest<N>>(
+pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
     bvh: &Bvh<N>,
     rays: &[Ray],
     hits: &mut [Hit],
@@ -111,8 +128,8 @@ pub fn closest_batch<const N: usize, T: ChildTest<N>>(
     let mut tally = Tally::default();
     for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
         *hit = match test {
-            TriangleTest::Watertight => closest::<N, T, true>(bvh, ray, &mut stack, &mut tally),
-            TriangleTest::Moller => closest::<N, T, false>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Watertight => closest::<N, T, P, true>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Moller => closest::<N, T, P, false>(bvh, ray, &mut stack, &mut tally),
         };
     }
     tally.add_to(counters, rays.len());
@@ -120,7 +137,7 @@ pub fn closest_batch<const N: usize, T: ChildTest<N>>(
 
 /// Any-hit answers of a batch of rays.
 #[inline(always)]
-pub fn any_batch<const N: usize, T: ChildTest<N>>(
+pub fn any_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
     bvh: &Bvh<N>,
     rays: &[Ray],
     out: &mut [bool],
@@ -131,15 +148,15 @@ pub fn any_batch<const N: usize, T: ChildTest<N>>(
     let mut tally = Tally::default();
     for (ray, o) in rays.iter().zip(out.iter_mut()) {
         *o = match test {
-            TriangleTest::Watertight => any::<N, T, true>(bvh, ray, &mut stack, &mut tally),
-            TriangleTest::Moller => any::<N, T, false>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Watertight => any::<N, T, P, true>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Moller => any::<N, T, P, false>(bvh, ray, &mut stack, &mut tally),
         };
     }
     tally.add_to(counters, rays.len());
 }
 
 #[inline(always)]
-fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
+fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [Entry; STACK_SIZE],
@@ -147,6 +164,8 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
 ) -> Hit {
     let tr = T::prepare(&SlabRay::new(ray));
     let wt = triangle_setup::<W>(ray.dir);
+    let pr = P::prepare(ray.origin, ray.dir, &wt);
+    let mut lanes = LaneHits::default();
     let mut r = *ray;
     let mut best = Hit::MISS;
     let mut dist = [0.0f32; N];
@@ -213,6 +232,23 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
                 cur = stack[sp].node;
                 continue;
             }
+        } else if is_packet_leaf(cur) {
+            let (packets, count) = leaf_packets(bvh, cur);
+            tally.prims += count as u64;
+            for p in packets {
+                let mask = P::test::<W>(&p.tri, &pr, r.tmin, r.tmax, &mut lanes);
+                if mask != 0 {
+                    tally.prim_hits += mask.count_ones() as u64;
+                    let i = lanes.nearest(mask);
+                    r.tmax = lanes.t[i];
+                    best = Hit {
+                        t: lanes.t[i],
+                        object: p.object[i],
+                        u: lanes.u[i],
+                        v: lanes.v[i],
+                    };
+                }
+            }
         } else {
             let (first, count) = leaf_range(cur);
             for k in first..first + count {
@@ -245,7 +281,7 @@ fn closest<const N: usize, T: ChildTest<N>, const W: bool>(
 }
 
 #[inline(always)]
-fn any<const N: usize, T: ChildTest<N>, const W: bool>(
+fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [u32; STACK_SIZE],
@@ -253,6 +289,8 @@ fn any<const N: usize, T: ChildTest<N>, const W: bool>(
 ) -> bool {
     let tr = T::prepare(&SlabRay::new(ray));
     let wt = triangle_setup::<W>(ray.dir);
+    let pr = P::prepare(ray.origin, ray.dir, &wt);
+    let mut lanes = LaneHits::default();
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
@@ -275,6 +313,18 @@ fn any<const N: usize, T: ChildTest<N>, const W: bool>(
                 cur = node.child[i];
                 continue;
             }
+        } else if is_packet_leaf(cur) {
+            let (packets, count) = leaf_packets(bvh, cur);
+            for (n, p) in packets.iter().enumerate() {
+                let mask = P::test::<W>(&p.tri, &pr, ray.tmin, ray.tmax, &mut lanes);
+                if mask != 0 {
+                    // The leaf stops at this packet: its triangles and those before it.
+                    tally.prims += count.min((n + 1) * PACKET) as u64;
+                    tally.prim_hits += mask.count_ones() as u64;
+                    return true;
+                }
+            }
+            tally.prims += count as u64;
         } else {
             let (first, count) = leaf_range(cur);
             for k in first..first + count {

@@ -8,6 +8,7 @@
 
 pub mod aabb;
 pub mod kernels;
+pub mod triangle_simd;
 
 use crate::engine::TriangleTest;
 use crate::ray::Ray;

@@ -6,7 +6,6 @@ use crate::geometry::kernels::f64 as k;
 use crate::ray::{Hit, Ray};
 use glam::DVec3;
 use rtbench_scenes::Shape;
-use std::sync::Arc;
 
 pub fn info() -> EngineInfo {
     EngineInfo {
@@ -72,7 +71,6 @@ fn build(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, Engi
             },
         })
         .collect();
-    let _keep: &Arc<_> = &input.scene;
     Ok(Box::new(Reference { prims }))
 }
 

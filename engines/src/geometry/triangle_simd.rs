@@ -1,0 +1,829 @@
+//! One ray against a packet of 4 or 8 triangles at once: the shared triangle kernels of
+//! `kernels.rs` (watertight, Woop, Benthin and Wald 2013; Möller–Trumbore 1997) written over
+//! SIMD lanes, one triangle per lane, as Embree's `TriangleM` leaves are tested (4 triangles
+//! per SSE instruction, 8 per AVX instruction).
+//!
+//! Triangles are stored structure-of-arrays ([`TrianglePacket`]): one load gives a coordinate of
+//! one vertex of every triangle of the packet. Unused lanes hold NaN vertices, which no form of
+//! either test ever hits (every comparison that accepts a hit is false on NaN).
+//!
+//! Every form gives exactly the answers of the scalar kernels, lane by lane: the same
+//! operations in the same order with no fused multiply-add, the watertight test's fallback to
+//! double precision on an edge included. So the watertight packet test keeps its promise (no
+//! gaps, no double hits on shared edges), and engines may mix packet and scalar tests freely.
+//!
+//! Three forms of [`PacketKernel`]: [`ScalarPackets`] (any width, lane by lane through the
+//! scalar kernels; the fallback), `Sse4` (4 lanes, SSE2, part of the x86-64 baseline) and
+//! `Avx8` (8 lanes, AVX2; callers must check the CPU, see [`Avx8::available`]). [`closest4`]
+//! and [`closest8`] choose at run time with `is_x86_feature_detected!`.
+
+use super::kernels::f32::{self as k, WatertightRay};
+use crate::engine::TriangleTest;
+use glam::Vec3;
+
+/// K triangles, structure-of-arrays: `v[i][a][lane]` is coordinate `a` (x, y, z) of vertex `i`
+/// of the triangle in `lane`. Unused lanes are NaN.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct TrianglePacket<const K: usize> {
+    pub v: [[[f32; K]; 3]; 3],
+}
+
+impl<const K: usize> TrianglePacket<K> {
+    /// A packet of up to K triangles; lanes beyond `tris.len()` are padding that never hits.
+    pub fn new(tris: &[[Vec3; 3]]) -> Self {
+        assert!(
+            tris.len() <= K,
+            "{} triangles in a packet of {K}",
+            tris.len()
+        );
+        let mut v = [[[f32::NAN; K]; 3]; 3];
+        for (lane, tri) in tris.iter().enumerate() {
+            for (i, vertex) in tri.iter().enumerate() {
+                for a in 0..3 {
+                    v[i][a][lane] = vertex[a];
+                }
+            }
+        }
+        TrianglePacket { v }
+    }
+
+    /// The triangle in `lane` (NaN vertices for padding).
+    pub fn triangle(&self, lane: usize) -> [Vec3; 3] {
+        let p = &self.v;
+        [0, 1, 2].map(|i| Vec3::new(p[i][0][lane], p[i][1][lane], p[i][2][lane]))
+    }
+}
+
+/// What a packet test found, lane by lane: `t`, `u`, `v` as the scalar kernels return them,
+/// meaningful in the lanes of the returned mask.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneHits<const K: usize> {
+    pub t: [f32; K],
+    pub u: [f32; K],
+    pub v: [f32; K],
+}
+
+impl<const K: usize> Default for LaneHits<K> {
+    fn default() -> Self {
+        LaneHits {
+            t: [0.0; K],
+            u: [0.0; K],
+            v: [0.0; K],
+        }
+    }
+}
+
+impl<const K: usize> LaneHits<K> {
+    /// The lane of `mask` (non-zero) with the smallest `t`, the lowest such lane on a tie: what
+    /// testing the lanes one after the other, shrinking `tmax` at each hit, would keep.
+    #[inline(always)]
+    pub fn nearest(&self, mut mask: u32) -> usize {
+        let mut best = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if self.t[i] < self.t[best] {
+                best = i;
+            }
+        }
+        best
+    }
+}
+
+/// One form of the packet test.
+pub trait PacketKernel<const K: usize> {
+    /// The ray as this form wants it (splatted into SIMD registers for the SIMD forms), made
+    /// once per ray. `wt` is the ray's watertight set-up (any value for Möller).
+    type Ray: Copy;
+    fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray;
+    /// Bit `lane` set when that triangle is hit in `(tmin, tmax)`; `hits` then holds its
+    /// `(t, u, v)`. `W`: the watertight test, else Möller–Trumbore.
+    fn test<const W: bool>(
+        p: &TrianglePacket<K>,
+        r: &Self::Ray,
+        tmin: f32,
+        tmax: f32,
+        hits: &mut LaneHits<K>,
+    ) -> u32;
+}
+
+/// Lane by lane through the scalar kernels (any width; the fallback and the reference).
+pub struct ScalarPackets;
+
+#[derive(Clone, Copy)]
+pub struct ScalarRay {
+    origin: Vec3,
+    dir: Vec3,
+    wt: WatertightRay,
+}
+
+impl<const K: usize> PacketKernel<K> for ScalarPackets {
+    type Ray = ScalarRay;
+
+    #[inline(always)]
+    fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> ScalarRay {
+        ScalarRay {
+            origin,
+            dir,
+            wt: *wt,
+        }
+    }
+
+    #[inline(always)]
+    fn test<const W: bool>(
+        p: &TrianglePacket<K>,
+        r: &ScalarRay,
+        tmin: f32,
+        tmax: f32,
+        hits: &mut LaneHits<K>,
+    ) -> u32 {
+        let mut mask = 0;
+        for lane in 0..K {
+            let [a, b, c] = p.triangle(lane);
+            let hit = if W {
+                k::triangle_watertight(r.origin, &r.wt, tmin, tmax, a, b, c)
+            } else {
+                k::triangle_moller(r.origin, r.dir, tmin, tmax, a, b, c)
+            };
+            if let Some((t, u, v)) = hit {
+                mask |= 1 << lane;
+                hits.t[lane] = t;
+                hits.u[lane] = u;
+                hits.v[lane] = v;
+            }
+        }
+        mask
+    }
+}
+
+/// Nearest hit of a ray among the triangles of a packet of 4: (lane, t, u, v). SSE on x86-64,
+/// the scalar kernels elsewhere.
+pub fn closest4(
+    p: &TrianglePacket<4>,
+    origin: Vec3,
+    dir: Vec3,
+    test: TriangleTest,
+    tmin: f32,
+    tmax: f32,
+) -> Option<(usize, f32, f32, f32)> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        closest_with::<4, Sse4>(p, origin, dir, test, tmin, tmax)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        closest_with::<4, ScalarPackets>(p, origin, dir, test, tmin, tmax)
+    }
+}
+
+/// Nearest hit of a ray among the triangles of a packet of 8: (lane, t, u, v). AVX2 when the
+/// CPU has it (checked at run time), the scalar kernels otherwise.
+pub fn closest8(
+    p: &TrianglePacket<8>,
+    origin: Vec3,
+    dir: Vec3,
+    test: TriangleTest,
+    tmin: f32,
+    tmax: f32,
+) -> Option<(usize, f32, f32, f32)> {
+    #[cfg(target_arch = "x86_64")]
+    if Avx8::available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above), all the callee requires.
+        return unsafe { x86::closest8_avx2(p, origin, dir, test, tmin, tmax) };
+    }
+    closest_with::<8, ScalarPackets>(p, origin, dir, test, tmin, tmax)
+}
+
+/// Nearest hit among a packet's triangles with the form `P`.
+#[inline(always)]
+pub fn closest_with<const K: usize, P: PacketKernel<K>>(
+    p: &TrianglePacket<K>,
+    origin: Vec3,
+    dir: Vec3,
+    test: TriangleTest,
+    tmin: f32,
+    tmax: f32,
+) -> Option<(usize, f32, f32, f32)> {
+    let wt = WatertightRay::new(dir);
+    let r = P::prepare(origin, dir, &wt);
+    let mut hits = LaneHits::default();
+    let mask = match test {
+        TriangleTest::Watertight => P::test::<true>(p, &r, tmin, tmax, &mut hits),
+        TriangleTest::Moller => P::test::<false>(p, &r, tmin, tmax, &mut hits),
+    };
+    (mask != 0).then(|| {
+        let i = hits.nearest(mask);
+        (i, hits.t[i], hits.u[i], hits.v[i])
+    })
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx8, Sse4};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::{LaneHits, PacketKernel, TrianglePacket};
+    use crate::engine::TriangleTest;
+    use crate::geometry::kernels::f32::WatertightRay;
+    use glam::Vec3;
+    use std::arch::x86_64::*;
+
+    /// The lane operations the kernels use, for 4 lanes (`__m128`) and 8 (`__m256`), so each
+    /// kernel is written once. Plain IEEE operations only (no FMA, no approximate reciprocal):
+    /// each lane rounds exactly as the scalar kernel does.
+    ///
+    /// Safety: the methods use SSE2 (x86-64 baseline) or AVX; the `__m256` ones may only run
+    /// on a CPU with AVX, which the `Avx8` form's callers guarantee.
+    trait Lanes: Copy {
+        const K: usize;
+        unsafe fn splat(x: f32) -> Self;
+        /// Loads `K` floats from `p`.
+        unsafe fn load(p: *const f32) -> Self;
+        /// Stores `K` floats to `p`.
+        unsafe fn store(self, p: *mut f32);
+        unsafe fn add(self, o: Self) -> Self;
+        unsafe fn sub(self, o: Self) -> Self;
+        unsafe fn mul(self, o: Self) -> Self;
+        unsafe fn div(self, o: Self) -> Self;
+        unsafe fn and(self, o: Self) -> Self;
+        unsafe fn or(self, o: Self) -> Self;
+        /// `!self & o`.
+        unsafe fn andnot(self, o: Self) -> Self;
+        // Comparisons: ordered (false on NaN) except `ne`, `nlt`, `ngt` (true on NaN), as
+        // the scalar `!=`, `!(a < b)`, `!(a > b)`.
+        unsafe fn eq(self, o: Self) -> Self;
+        unsafe fn ne(self, o: Self) -> Self;
+        unsafe fn lt(self, o: Self) -> Self;
+        unsafe fn gt(self, o: Self) -> Self;
+        unsafe fn le(self, o: Self) -> Self;
+        unsafe fn ge(self, o: Self) -> Self;
+        unsafe fn nlt(self, o: Self) -> Self;
+        unsafe fn ngt(self, o: Self) -> Self;
+        unsafe fn mask(self) -> u32;
+    }
+
+    impl Lanes for __m128 {
+        const K: usize = 4;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Self {
+            _mm_set1_ps(x)
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f32) -> Self {
+            _mm_loadu_ps(p)
+        }
+        #[inline(always)]
+        unsafe fn store(self, p: *mut f32) {
+            _mm_storeu_ps(p, self)
+        }
+        #[inline(always)]
+        unsafe fn add(self, o: Self) -> Self {
+            _mm_add_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn sub(self, o: Self) -> Self {
+            _mm_sub_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn mul(self, o: Self) -> Self {
+            _mm_mul_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn div(self, o: Self) -> Self {
+            _mm_div_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn and(self, o: Self) -> Self {
+            _mm_and_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn or(self, o: Self) -> Self {
+            _mm_or_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn andnot(self, o: Self) -> Self {
+            _mm_andnot_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn eq(self, o: Self) -> Self {
+            _mm_cmpeq_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ne(self, o: Self) -> Self {
+            _mm_cmpneq_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn lt(self, o: Self) -> Self {
+            _mm_cmplt_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn gt(self, o: Self) -> Self {
+            _mm_cmpgt_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn le(self, o: Self) -> Self {
+            _mm_cmple_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ge(self, o: Self) -> Self {
+            _mm_cmpge_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn nlt(self, o: Self) -> Self {
+            _mm_cmpnlt_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ngt(self, o: Self) -> Self {
+            _mm_cmpngt_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn mask(self) -> u32 {
+            _mm_movemask_ps(self) as u32
+        }
+    }
+
+    impl Lanes for __m256 {
+        const K: usize = 8;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Self {
+            _mm256_set1_ps(x)
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f32) -> Self {
+            _mm256_loadu_ps(p)
+        }
+        #[inline(always)]
+        unsafe fn store(self, p: *mut f32) {
+            _mm256_storeu_ps(p, self)
+        }
+        #[inline(always)]
+        unsafe fn add(self, o: Self) -> Self {
+            _mm256_add_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn sub(self, o: Self) -> Self {
+            _mm256_sub_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn mul(self, o: Self) -> Self {
+            _mm256_mul_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn div(self, o: Self) -> Self {
+            _mm256_div_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn and(self, o: Self) -> Self {
+            _mm256_and_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn or(self, o: Self) -> Self {
+            _mm256_or_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn andnot(self, o: Self) -> Self {
+            _mm256_andnot_ps(self, o)
+        }
+        #[inline(always)]
+        unsafe fn eq(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_EQ_OQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ne(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_NEQ_UQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn lt(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_LT_OQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn gt(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_GT_OQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn le(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_LE_OQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ge(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_GE_OQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn nlt(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_NLT_UQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn ngt(self, o: Self) -> Self {
+            _mm256_cmp_ps::<_CMP_NGT_UQ>(self, o)
+        }
+        #[inline(always)]
+        unsafe fn mask(self) -> u32 {
+            _mm256_movemask_ps(self) as u32
+        }
+    }
+
+    /// A ray splatted into lanes: origin, direction, and the watertight shear with its axes.
+    #[derive(Clone, Copy)]
+    pub struct LanesRay<L> {
+        o: [L; 3],
+        d: [L; 3],
+        /// sx, sy, sz of the watertight set-up.
+        s: [L; 3],
+        /// kx, ky, kz of the watertight set-up.
+        k: [usize; 3],
+    }
+
+    #[inline(always)]
+    unsafe fn prepare<L: Lanes>(o: Vec3, d: Vec3, wt: &WatertightRay) -> LanesRay<L> {
+        LanesRay {
+            o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
+            d: [L::splat(d.x), L::splat(d.y), L::splat(d.z)],
+            s: [L::splat(wt.sx), L::splat(wt.sy), L::splat(wt.sz)],
+            k: [wt.kx, wt.ky, wt.kz],
+        }
+    }
+
+    /// Row `a` (an axis, < 3) of vertex `i` (< 3) of a packet of `L::K` lanes.
+    #[inline(always)]
+    unsafe fn row<L: Lanes, const K: usize>(p: &TrianglePacket<K>, i: usize, a: usize) -> L {
+        debug_assert!(K == L::K && i < 3 && a < 3);
+        L::load(p.v[i][a].as_ptr())
+    }
+
+    /// The watertight test (`kernels.rs`, `triangle_watertight`) on every lane.
+    #[inline(always)]
+    unsafe fn watertight<L: Lanes, const K: usize>(
+        p: &TrianglePacket<K>,
+        r: &LanesRay<L>,
+        tmin: f32,
+        tmax: f32,
+        hits: &mut LaneHits<K>,
+    ) -> u32 {
+        let [kx, ky, kz] = r.k;
+        // The vertices relative to the origin, on the three axes of the ray's set-up.
+        let rel = |i: usize, a: usize| row::<L, K>(p, i, a).sub(r.o[a]);
+        let (a_x, a_y, a_z) = (rel(0, kx), rel(0, ky), rel(0, kz));
+        let (b_x, b_y, b_z) = (rel(1, kx), rel(1, ky), rel(1, kz));
+        let (c_x, c_y, c_z) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let (sx, sy, sz) = (r.s[0], r.s[1], r.s[2]);
+        let ax = a_x.sub(sx.mul(a_z));
+        let ay = a_y.sub(sy.mul(a_z));
+        let bx = b_x.sub(sx.mul(b_z));
+        let by = b_y.sub(sy.mul(b_z));
+        let cx = c_x.sub(sx.mul(c_z));
+        let cy = c_y.sub(sy.mul(c_z));
+        let mut u = cx.mul(by).sub(cy.mul(bx));
+        let mut v = ax.mul(cy).sub(ay.mul(cx));
+        let mut w = bx.mul(ay).sub(by.mul(ax));
+        let zero = L::splat(0.0);
+        let on_edge = u.eq(zero).or(v.eq(zero)).or(w.eq(zero)).mask();
+        if on_edge != 0 {
+            (u, v, w) = edge_in_f64::<L, K>(on_edge, [ax, ay, bx, by, cx, cy], [u, v, w]);
+        }
+        let neg = u.lt(zero).or(v.lt(zero)).or(w.lt(zero));
+        let pos = u.gt(zero).or(v.gt(zero)).or(w.gt(zero));
+        let det = u.add(v).add(w);
+        let ok = neg.and(pos).andnot(det.ne(zero));
+        let az = sz.mul(a_z);
+        let bz = sz.mul(b_z);
+        let cz = sz.mul(c_z);
+        let inv = L::splat(1.0).div(det);
+        let t = u.mul(az).add(v.mul(bz)).add(w.mul(cz)).mul(inv);
+        let hit = ok
+            .and(t.gt(L::splat(tmin)))
+            .and(t.lt(L::splat(tmax)))
+            .mask();
+        if hit != 0 {
+            t.store(hits.t.as_mut_ptr());
+            v.mul(inv).store(hits.u.as_mut_ptr());
+            w.mul(inv).store(hits.v.as_mut_ptr());
+        }
+        hit
+    }
+
+    /// The scalar kernel's fallback for rays through an edge or vertex: u, v, w recomputed in
+    /// double precision, in the lanes where one of them is zero.
+    #[cold]
+    #[inline(never)]
+    unsafe fn edge_in_f64<L: Lanes, const K: usize>(
+        lanes: u32,
+        e: [L; 6],
+        uvw: [L; 3],
+    ) -> (L, L, L) {
+        let mut f = [[0.0f32; K]; 6];
+        for (row, x) in f.iter_mut().zip(e) {
+            x.store(row.as_mut_ptr());
+        }
+        let mut out = [[0.0f32; K]; 3];
+        for (row, x) in out.iter_mut().zip(uvw) {
+            x.store(row.as_mut_ptr());
+        }
+        for lane in (0..K).filter(|&l| lanes & (1 << l) != 0) {
+            let [ax, ay, bx, by, cx, cy] = f.map(|row| row[lane] as f64);
+            out[0][lane] = (cx * by - cy * bx) as f32;
+            out[1][lane] = (ax * cy - ay * cx) as f32;
+            out[2][lane] = (bx * ay - by * ax) as f32;
+        }
+        (
+            L::load(out[0].as_ptr()),
+            L::load(out[1].as_ptr()),
+            L::load(out[2].as_ptr()),
+        )
+    }
+
+    /// Möller–Trumbore (`kernels.rs`, `triangle_moller`) on every lane, with glam's operation
+    /// order for cross and dot products.
+    #[inline(always)]
+    unsafe fn moller<L: Lanes, const K: usize>(
+        p: &TrianglePacket<K>,
+        r: &LanesRay<L>,
+        tmin: f32,
+        tmax: f32,
+        hits: &mut LaneHits<K>,
+    ) -> u32 {
+        let v0 = [0, 1, 2].map(|a| row::<L, K>(p, 0, a));
+        let e1 = [0, 1, 2].map(|a| row::<L, K>(p, 1, a).sub(v0[a]));
+        let e2 = [0, 1, 2].map(|a| row::<L, K>(p, 2, a).sub(v0[a]));
+        let cross = |a: [L; 3], b: [L; 3]| {
+            [
+                a[1].mul(b[2]).sub(b[1].mul(a[2])),
+                a[2].mul(b[0]).sub(b[2].mul(a[0])),
+                a[0].mul(b[1]).sub(b[0].mul(a[1])),
+            ]
+        };
+        let dot = |a: [L; 3], b: [L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
+        let d = r.d;
+        let pv = cross(d, e2);
+        let det = dot(e1, pv);
+        let inv = L::splat(1.0).div(det);
+        let s = [0, 1, 2].map(|a| r.o[a].sub(v0[a]));
+        let u = dot(s, pv).mul(inv);
+        let q = cross(s, e1);
+        let v = dot(d, q).mul(inv);
+        let t = dot(e2, q).mul(inv);
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let hit = det
+            .ne(zero)
+            .and(u.ge(zero))
+            .and(u.le(one))
+            .and(v.nlt(zero))
+            .and(u.add(v).ngt(one))
+            .and(t.gt(L::splat(tmin)))
+            .and(t.lt(L::splat(tmax)))
+            .mask();
+        if hit != 0 {
+            t.store(hits.t.as_mut_ptr());
+            u.store(hits.u.as_mut_ptr());
+            v.store(hits.v.as_mut_ptr());
+        }
+        hit
+    }
+
+    /// 4 triangles per instruction, SSE2 (x86-64 baseline: safe to use anywhere on x86-64).
+    pub struct Sse4;
+
+    impl PacketKernel<4> for Sse4 {
+        type Ray = LanesRay<__m128>;
+
+        #[inline(always)]
+        fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray {
+            // SAFETY: SSE2 is part of the x86-64 baseline; `set1` only broadcasts.
+            unsafe { prepare(origin, dir, wt) }
+        }
+
+        #[inline(always)]
+        fn test<const W: bool>(
+            p: &TrianglePacket<4>,
+            r: &Self::Ray,
+            tmin: f32,
+            tmax: f32,
+            hits: &mut LaneHits<4>,
+        ) -> u32 {
+            // SAFETY: SSE2 is part of the x86-64 baseline. Every load reads one row of 4
+            // floats of `p.v` (`row`: vertex and axis < 3), every store writes one row of 4
+            // floats of `hits` or of a local array of 4.
+            unsafe {
+                if W {
+                    watertight(p, r, tmin, tmax, hits)
+                } else {
+                    moller(p, r, tmin, tmax, hits)
+                }
+            }
+        }
+    }
+
+    /// 8 triangles per instruction, AVX. Only for code that has checked [`Avx8::available`]
+    /// (the BVH's AVX2 + FMA entry points; [`super::closest8`]).
+    pub struct Avx8;
+
+    impl Avx8 {
+        /// The CPU has what this form (and the BVH entry points that compile it in) needs.
+        pub fn available() -> bool {
+            is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+        }
+    }
+
+    impl PacketKernel<8> for Avx8 {
+        type Ray = LanesRay<__m256>;
+
+        #[inline(always)]
+        fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray {
+            // SAFETY: only reached from code run after `Avx8::available()` (this form's
+            // contract); `set1` only broadcasts.
+            unsafe { prepare(origin, dir, wt) }
+        }
+
+        #[inline(always)]
+        fn test<const W: bool>(
+            p: &TrianglePacket<8>,
+            r: &Self::Ray,
+            tmin: f32,
+            tmax: f32,
+            hits: &mut LaneHits<8>,
+        ) -> u32 {
+            // SAFETY: only reached from code run after `Avx8::available()` (this form's
+            // contract). Every load reads one row of 8 floats of `p.v`, every store writes one
+            // row of 8 floats of `hits` or of a local array of 8.
+            unsafe {
+                if W {
+                    watertight(p, r, tmin, tmax, hits)
+                } else {
+                    moller(p, r, tmin, tmax, hits)
+                }
+            }
+        }
+    }
+
+    /// [`super::closest8`] compiled with AVX2 and FMA, so the AVX intrinsics inline.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn closest8_avx2(
+        p: &TrianglePacket<8>,
+        origin: Vec3,
+        dir: Vec3,
+        test: TriangleTest,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(usize, f32, f32, f32)> {
+        super::closest_with::<8, Avx8>(p, origin, dir, test, tmin, tmax)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::TriangleTest;
+
+    /// A small deterministic generator (64-bit LCG, top bits), in [-1, 1).
+    struct Lcg(u64);
+
+    impl Lcg {
+        fn next(&mut self) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        }
+        fn vec(&mut self) -> Vec3 {
+            Vec3::new(self.next(), self.next(), self.next())
+        }
+    }
+
+    /// The nearest hit by the scalar kernels, triangle after triangle.
+    fn scalar_closest(
+        tris: &[[Vec3; 3]],
+        o: Vec3,
+        d: Vec3,
+        test: TriangleTest,
+        tmin: f32,
+        mut tmax: f32,
+    ) -> Option<(usize, f32, f32, f32)> {
+        let wt = WatertightRay::new(d);
+        let mut best = None;
+        for (i, &[a, b, c]) in tris.iter().enumerate() {
+            let h = match test {
+                TriangleTest::Watertight => k::triangle_watertight(o, &wt, tmin, tmax, a, b, c),
+                TriangleTest::Moller => k::triangle_moller(o, d, tmin, tmax, a, b, c),
+            };
+            if let Some((t, u, v)) = h {
+                tmax = t;
+                best = Some((i, t, u, v));
+            }
+        }
+        best
+    }
+
+    /// Triangles of a grid of quads in the plane z = 0 (two per quad, sharing a diagonal, and
+    /// sharing edges with their neighbours), some random triangles, and rays of three kinds:
+    /// through the grid's vertices and edges exactly (the watertight test's hard case),
+    /// random, and parallel to the plane.
+    fn cases() -> (Vec<[Vec3; 3]>, Vec<(Vec3, Vec3)>) {
+        let mut rng = Lcg(7);
+        let mut tris = Vec::new();
+        for j in 0..3 {
+            for i in 0..3 {
+                let p = |x: i32, y: i32| Vec3::new((i + x) as f32, (j + y) as f32, 0.0);
+                tris.push([p(0, 0), p(1, 0), p(1, 1)]);
+                tris.push([p(0, 0), p(1, 1), p(0, 1)]);
+            }
+        }
+        for _ in 0..14 {
+            let c = rng.vec() * 3.0 + Vec3::new(1.5, 1.5, 0.0);
+            tris.push([c + rng.vec(), c + rng.vec(), c + rng.vec()]);
+        }
+        let mut rays = Vec::new();
+        for j in 0..=6 {
+            for i in 0..=6 {
+                let target = Vec3::new(i as f32 * 0.5, j as f32 * 0.5, 0.0);
+                for dir in [Vec3::Z, Vec3::new(0.1, 0.2, 1.0), -Vec3::Z] {
+                    rays.push((target - dir * 2.0, dir));
+                }
+            }
+        }
+        for _ in 0..400 {
+            let o = rng.vec() * 6.0 + Vec3::new(1.5, 1.5, 0.0);
+            rays.push((o, rng.vec().normalize_or(Vec3::X)));
+        }
+        rays.push((Vec3::new(-1.0, 0.5, 0.0), Vec3::X));
+        (tris, rays)
+    }
+
+    fn check<const K: usize>(
+        form: &str,
+        closest: impl Fn(
+            &TrianglePacket<K>,
+            Vec3,
+            Vec3,
+            TriangleTest,
+            f32,
+            f32,
+        ) -> Option<(usize, f32, f32, f32)>,
+    ) {
+        let (tris, rays) = cases();
+        let mut hits = 0;
+        for test in [TriangleTest::Watertight, TriangleTest::Moller] {
+            for chunk in tris.chunks(K) {
+                let p = TrianglePacket::<K>::new(chunk);
+                for &(o, d) in &rays {
+                    for tmax in [f32::INFINITY, 2.0] {
+                        let want = scalar_closest(chunk, o, d, test, 0.0, tmax);
+                        let got = closest(&p, o, d, test, 0.0, tmax);
+                        assert_eq!(got, want, "{form} {test:?}: ray {o} {d}, {chunk:?}");
+                        let lanes = closest_with::<K, ScalarPackets>(&p, o, d, test, 0.0, tmax);
+                        assert_eq!(lanes, want, "scalar packets {test:?}: ray {o} {d}");
+                        hits += want.is_some() as usize;
+                    }
+                }
+            }
+        }
+        assert!(hits > 300, "{form}: only {hits} hits");
+    }
+
+    #[test]
+    fn packets_give_the_scalar_kernels_answers() {
+        check::<4>("closest4", closest4);
+        check::<8>("closest8", closest8);
+    }
+
+    #[test]
+    fn padding_never_hits() {
+        let p = TrianglePacket::<4>::new(&[]);
+        for d in [Vec3::Z, Vec3::X, Vec3::new(1.0, 2.0, 3.0)] {
+            for test in [TriangleTest::Watertight, TriangleTest::Moller] {
+                assert_eq!(closest4(&p, -d, d, test, 0.0, f32::INFINITY), None);
+            }
+        }
+    }
+
+    /// Rays through the shared edges and vertices of the quad grid hit the watertight packet
+    /// test exactly once or (at an edge between two triangles of one packet) the nearer-first
+    /// of the two, never nothing: every ray aimed at the grid's inside finds a triangle.
+    #[test]
+    fn watertight_packets_leave_no_gaps() {
+        let (tris, _) = cases();
+        let grid = &tris[..18];
+        for j in 1..6 {
+            for i in 1..6 {
+                let target = Vec3::new(i as f32 * 0.5, j as f32 * 0.5, 0.0);
+                let d = Vec3::new(0.1, 0.2, 1.0);
+                let found = grid.chunks(4).any(|c| {
+                    closest4(
+                        &TrianglePacket::new(c),
+                        target - d * 2.0,
+                        d,
+                        TriangleTest::Watertight,
+                        0.0,
+                        f32::INFINITY,
+                    )
+                    .is_some()
+                });
+                assert!(found, "gap at {target}");
+            }
+        }
+    }
+}
