@@ -486,6 +486,11 @@ mod x86 {
         let pos = u.gt(zero).or(v.gt(zero)).or(w.gt(zero));
         let det = u.add(v).add(w);
         let ok = neg.and(pos).andnot(det.ne(zero));
+        // Most rays miss every triangle of a packet: stop before the division (Embree's
+        // kernels do the same).
+        if ok.mask() == 0 {
+            return 0;
+        }
         let az = sz.mul(a_z);
         let bz = sz.mul(b_z);
         let cz = sz.mul(c_z);
@@ -562,14 +567,19 @@ mod x86 {
         let u = dot(s, pv).mul(inv);
         let q = cross(s, e1);
         let v = dot(d, q).mul(inv);
-        let t = dot(e2, q).mul(inv);
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let hit = det
+        let inside = det
             .ne(zero)
             .and(u.ge(zero))
             .and(u.le(one))
             .and(v.nlt(zero))
-            .and(u.add(v).ngt(one))
+            .and(u.add(v).ngt(one));
+        // Most rays miss every triangle of a packet: stop before t.
+        if inside.mask() == 0 {
+            return 0;
+        }
+        let t = dot(e2, q).mul(inv);
+        let hit = inside
             .and(t.gt(L::splat(tmin)))
             .and(t.lt(L::splat(tmax)))
             .mask();
