@@ -9,11 +9,13 @@
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
+//! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
 //! the SAH prefers a leaf (`median`: always). With `wide=collapse` a subtree of ≤ `leaf`
-//! primitives becomes a leaf, but node slots left free are spent splitting such leaves further
-//! (`collapse.rs`), so wide leaves are often smaller. `simd=on` on a CPU without the
+//! primitives becomes a leaf; with `split_leaves=on` node slots left free are spent splitting
+//! such leaves further (`collapse.rs`), so wide leaves are often smaller. With triangle packets
+//! a leaf of up to 4 triangles costs one test, so by default leaves are then kept whole. `simd=on` on a CPU without the
 //! instructions runs the scalar test (`build_stats.simd_lanes` says which ran).
 
 use super::node::MAX_LEAF_PRIMS;
@@ -190,6 +192,10 @@ mod tests {
         assert!(parse(8, &[("leaf", "17")]).is_err());
         assert!(parse(8, &[("builder", "kd")]).is_err());
         assert!(parse(2, &[("simd", "on")]).is_err());
+        assert_eq!((c.packets, c.split_leaves), (true, false));
+        let c = parse(4, &[("packets", "off")]).unwrap();
+        assert_eq!((c.packets, c.split_leaves), (false, true));
+        assert!(!parse(2, &[]).unwrap().packets);
         assert!(matches!(
             parse(4, &[("colour", "red")]),
             Err(EngineError::UnknownKey { .. })

@@ -412,13 +412,21 @@ mod tests {
 
     /// Every kernel this CPU can run gives exactly the scalar kernel's hits and node counts on
     /// the same tree (the SIMD forms only round the entry distances differently, which can
-    /// only matter for rays grazing a box; none of these do).
+    /// only matter for rays grazing a box; none of these do), on the tree as spheres and cones
+    /// and tessellated (triangle packets: SIMD against lane by lane).
     #[test]
     fn every_kernel_matches_scalar() {
+        for tessellate in [None, Some(2)] {
+            kernels_match_scalar(tessellate);
+        }
+    }
+
+    fn kernels_match_scalar(tessellate: Option<u32>) {
         let scene = generate_scene(
             Program::Tree,
             &Options {
                 size_factor: 4,
+                tessellate,
                 ..Options::standard(Program::Tree)
             },
         )
