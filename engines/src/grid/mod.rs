@@ -186,6 +186,12 @@ impl Engine for Grid {
     }
 
     fn build_stats(&self) -> BTreeMap<String, f64> {
-        self.stats.clone()
+        let mut s = self.stats.clone();
+        // The grid proper (offsets over the cells and the flat reference list: 4 bytes each) and
+        // what per-voxel culling adds (one box per primitive), apart: the first is what seed 000
+        // and Havran count.
+        s.insert("cell_structure_bytes".into(), self.cells.bytes() as f64);
+        s.insert("culling_box_bytes".into(), (self.prim_bounds.len() * std::mem::size_of::<[Vec3; 2]>()) as f64);
+        s
     }
 }
