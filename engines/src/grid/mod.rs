@@ -191,7 +191,10 @@ impl Engine for Grid {
         // what per-voxel culling adds (one box per primitive), apart: the first is what seed 000
         // and Havran count.
         s.insert("cell_structure_bytes".into(), self.cells.bytes() as f64);
-        s.insert("culling_box_bytes".into(), (self.prim_bounds.len() * std::mem::size_of::<[Vec3; 2]>()) as f64);
+        s.insert(
+            "culling_box_bytes".into(),
+            (self.prim_bounds.len() * std::mem::size_of::<[Vec3; 2]>()) as f64,
+        );
         s
     }
 }

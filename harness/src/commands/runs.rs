@@ -272,7 +272,11 @@ pub fn report(a: &ReportArgs) -> Result<()> {
     }
     let summary =
         rtbench_reports::write_report(&a.dir, &formats).map_err(|e| input(e.to_string()))?;
-    eprintln!("report: {} files in {}", summary.files.len(), a.dir.display());
+    eprintln!(
+        "report: {} files in {}",
+        summary.files.len(),
+        a.dir.display()
+    );
     Ok(())
 }
 
