@@ -174,8 +174,11 @@ pub struct EngineInfo {
     pub description: &'static str,
     /// `Err(reason)` when a dependency is missing (e.g. Embree not installed or not built in).
     pub available: fn() -> Result<(), String>,
-    pub build: fn(&BuildInput, Settings) -> Result<Box<dyn Engine>, EngineError>,
+    pub build: BuildFn,
 }
+
+/// How an engine is built from a scene and its settings.
+pub type BuildFn = fn(&BuildInput, Settings) -> Result<Box<dyn Engine>, EngineError>;
 
 /// The ray–triangle test an engine that uses the shared kernels should call.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]

@@ -50,6 +50,7 @@ macro_rules! kernels {
         /// the base disc (centre `base`, radius `rb`) and the apex disc (`apex`, `ra`), no caps.
         /// Solves |q⊥ + t·d⊥|² = (rb + k·(q·w + t·d·w))² with w the unit axis, k the slope.
         #[inline]
+        #[allow(clippy::too_many_arguments)]
         pub fn cone(o: V, d: V, tmin: T, tmax: T, base: V, rb: T, apex: V, ra: T) -> Option<T> {
             // Solve from the ray's point nearest the cone's centre, not from its far-away origin:
             // the quadratic's coefficients then carry no large, cancelling terms (in f32 this

@@ -59,8 +59,11 @@ pub fn parse_bytes(s: &str) -> Result<u64> {
     Ok((n * mult) as u64)
 }
 
+/// An engine's name and its `key=value` settings.
+type EngineSettings = (String, Vec<(String, String)>);
+
 /// Engines of a plan with their settings (`engine.key=value`), checked against the registry.
-fn plan_engines(p: &PlanArgs) -> Result<Vec<(String, Vec<(String, String)>)>> {
+fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
     let registry = rtbench_engines::registry();
     let names: Vec<String> = if p.engines.trim() == "all" {
         registry
@@ -135,7 +138,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         return Err(input("--repeat must be at least 1"));
     }
     if let Some(s) = p.max_seconds {
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             return Err(input(format!("--max-seconds {s}: must be positive")));
         }
     }
@@ -286,7 +289,7 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
             return Err(input(format!("{}: no results.jsonl here", d.display())));
         }
     }
-    if !(a.threshold >= 0.0) {
+    if a.threshold.is_nan() || a.threshold < 0.0 {
         return Err(input(format!(
             "--threshold {}: must be a percentage ≥ 0",
             a.threshold

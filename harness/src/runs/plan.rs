@@ -382,6 +382,7 @@ pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) ->
 
 /// `rtbench sweep`: for each scene and engine, raise the SF from `sf_start` until a run fails
 /// (time or memory limit, crash) or takes longer than the time limit.
+#[allow(clippy::too_many_arguments)]
 pub fn sweep(
     engines: &[(String, Vec<(String, String)>)],
     programs: &[String],

@@ -47,8 +47,11 @@ pub fn write_g(out: &mut Vec<u8>, x: f64) {
         let _ = write!(out, "{a}");
     } else if exp >= 0 {
         let int_digits = exp as usize + 1;
-        for i in 0..int_digits {
-            out.push(if i < nd { digits[i] } else { b'0' });
+        for (i, d) in digits.iter().enumerate().take(int_digits.min(6)) {
+            out.push(if i < nd { *d } else { b'0' });
+        }
+        for _ in 6..int_digits {
+            out.push(b'0');
         }
         if nd > int_digits {
             out.push(b'.');
@@ -90,7 +93,7 @@ fn fast_digits(x: f64) -> Option<(bool, i32, [u8; 6])> {
             e -= 1;
             continue;
         }
-        if scaled >= 999999.5 && scaled < 1e6 - 1e-3 {
+        if (999999.5..1e6 - 1e-3).contains(&scaled) {
             return None;
         }
         if scaled >= 1e6 {
