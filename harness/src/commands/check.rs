@@ -33,7 +33,6 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             tested.as_ref(),
             yardstick.as_ref(),
             a.size,
-            None,
         )
     });
     let agreement = c.agreement();
@@ -49,6 +48,11 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         "t_rel_err": c.t_rel_err.to_json(),
         "t_rel_err_raw": c.t_rel_err_raw.to_json(),
         "image_psnr_db": c.image_psnr_db.map(|p| json!(p)).unwrap_or(json!("inf")),
+        "image_where_hits_agree": {
+            "pixels": c.pixels_same_hits,
+            "pixels_differing": c.pixels_same_hits_differing,
+            "max_abs_diff": c.pixels_same_hits_max_diff,
+        },
         "threshold": a.threshold,
         "pass": agreement >= a.threshold,
         "mismatches": c.mismatches,

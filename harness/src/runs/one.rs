@@ -81,13 +81,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     {
         let (yardstick, _) = workload::build("embree", &prepared.input, vec![])?;
         let c = pool.install(|| {
-            crosscheck::cross_check(
-                scene,
-                engine.as_ref(),
-                yardstick.as_ref(),
-                spec.size,
-                Some(&render),
-            )
+            crosscheck::cross_check(scene, engine.as_ref(), yardstick.as_ref(), spec.size)
         });
         Some(CheckResult {
             against: "embree".into(),

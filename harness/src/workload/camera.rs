@@ -44,3 +44,23 @@ impl Camera {
         Ray::new(self.eye, d, self.hither, f32::INFINITY)
     }
 }
+
+impl Camera {
+    /// 001's setting (Kimura 2007, §4.3): one eye ray through the centre of every pixel of a
+    /// `width`×`height` image, row by row from the top. The seed gives no camera; the NFF angle is
+    /// taken as vertical, spanning the centres of the top and bottom pixel rows as NFF.TXT says,
+    /// and pixels are square, so a 4:3 image sees 4/3 of that horizontally.
+    pub fn pixel_centre_rays(&self, width: u32, height: u32) -> Vec<Ray> {
+        let span = (height.max(2) - 1) as f32;
+        let mut rays = Vec::with_capacity(width as usize * height as usize);
+        for j in 0..height {
+            let y = (height as f32 - 1.0 - 2.0 * j as f32) / span;
+            for i in 0..width {
+                let x = (2.0 * i as f32 - (width as f32 - 1.0)) / span;
+                let d = (self.forward + self.right * x + self.up * y).normalize();
+                rays.push(Ray::new(self.eye, d, self.hither, f32::INFINITY));
+            }
+        }
+        rays
+    }
+}

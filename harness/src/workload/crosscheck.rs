@@ -12,7 +12,7 @@
 //! by t alone would measure where rays start, not the engine. The plain |Δt|/t_ref is reported
 //! too (`t_rel_err_raw`).
 
-use super::trace::{self, Render};
+use super::trace;
 use rayon::prelude::*;
 use rtbench_engines::{Counters, Engine, Hit};
 use rtbench_scenes::Scene;
@@ -58,6 +58,12 @@ pub struct CrossCheck {
     pub t_rel_err_raw: ErrorQuantiles,
     /// `None` when the images are identical.
     pub image_psnr_db: Option<f64>,
+    /// Pixels whose whole ray trees (at all four corners) got the same answers from both
+    /// engines — same object for every closest-hit query, same verdict for every shadow query —
+    /// how many of those differ in any channel, and their largest difference (0–255).
+    pub pixels_same_hits: u64,
+    pub pixels_same_hits_differing: u64,
+    pub pixels_same_hits_max_diff: u8,
     /// The first few disagreeing queries.
     pub mismatches: Vec<Value>,
 }
@@ -82,25 +88,21 @@ fn psnr(a: &[u8], b: &[u8]) -> Option<f64> {
     (mse > 0.0).then(|| 10.0 * (255.0f64 * 255.0 / mse).log10())
 }
 
-/// Checks `tested` against `yardstick` on the workload's rays. `tested_render`, if the caller
-/// has already rendered with the tested engine, saves a render.
+/// Checks `tested` against `yardstick` on the workload's rays; renders with both, recording, to
+/// compare hits query by query and images where the ray trees agree.
 pub fn cross_check(
     scene: &Scene,
     tested: &dyn Engine,
     yardstick: &dyn Engine,
     size: u32,
-    tested_render: Option<&Render>,
 ) -> CrossCheck {
     let mut rec = trace::Recording::default();
     let want = trace::render(scene, yardstick, size, Some(&mut rec));
-    let own;
-    let got = match tested_render {
-        Some(r) => r,
-        None => {
-            own = trace::render(scene, tested, size, None);
-            &own
-        }
-    };
+    // The tested engine's own render, recorded too: its ray trees are compared with the
+    // yardstick's corner by corner for the image comparison.
+    let mut own_rec = trace::Recording::default();
+    let own = trace::render(scene, tested, size, Some(&mut own_rec));
+    let got = &own;
     let rays: Vec<_> = rec.closest.iter().map(|(r, _)| *r).collect();
     let mut hits = vec![Hit::MISS; rays.len()];
     rays.par_chunks(4096)
@@ -156,13 +158,60 @@ pub fn cross_check(
             );
         }
     }
+    // Images where the hits agree: a corner agrees when its ray tree in the tested engine's own
+    // render got the same answers, query for query, as in the yardstick's (same objects hit,
+    // same shadow verdicts, in the same order).
+    let w = size as usize + 1;
+    let tree_hash = |r: &trace::Recording| {
+        let mut h = vec![0xcbf2_9ce4_8422_2325u64; w * w];
+        let mut mix = |c: u32, v: u64| {
+            let x = &mut h[c as usize];
+            *x = (*x ^ v).wrapping_mul(0x0100_0000_01b3);
+        };
+        for ((_, hit), c) in r.closest.iter().zip(&r.closest_corner) {
+            mix(*c, hit.object as u64);
+        }
+        for ((_, b), c) in r.any.iter().zip(&r.any_corner) {
+            mix(*c, 1 << 40 | *b as u64);
+        }
+        h
+    };
+    let (hw, hg) = (tree_hash(&rec), tree_hash(&own_rec));
+    let same_corner: Vec<bool> = hw.iter().zip(&hg).map(|(a, b)| a == b).collect();
+    let (pw, pg) = (want.pixels(), got.pixels());
+    let (mut n_same, mut n_diff, mut max_diff) = (0u64, 0u64, 0u8);
+    for j in 0..size as usize {
+        for i in 0..size as usize {
+            let corners = [
+                j * w + i,
+                j * w + i + 1,
+                (j + 1) * w + i,
+                (j + 1) * w + i + 1,
+            ];
+            if corners.iter().all(|&c| same_corner[c]) {
+                n_same += 1;
+                let k = (j * size as usize + i) * 3;
+                let d = (0..3)
+                    .map(|c| pw[k + c].abs_diff(pg[k + c]))
+                    .max()
+                    .unwrap_or(0);
+                if d > 0 {
+                    n_diff += 1;
+                    max_diff = max_diff.max(d);
+                }
+            }
+        }
+    }
     CrossCheck {
+        pixels_same_hits: n_same,
+        pixels_same_hits_differing: n_diff,
+        pixels_same_hits_max_diff: max_diff,
         closest_rays: rec.closest.len() as u64,
         any_rays: rec.any.len() as u64,
         agree,
         t_rel_err: ErrorQuantiles::of(t_err),
         t_rel_err_raw: ErrorQuantiles::of(t_err_raw),
-        image_psnr_db: psnr(&want.pixels(), &got.pixels()),
+        image_psnr_db: psnr(&pw, &pg),
         mismatches,
     }
 }

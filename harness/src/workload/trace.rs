@@ -78,6 +78,9 @@ pub struct RayStats {
 pub struct Recording {
     pub closest: Vec<(Ray, Hit)>,
     pub any: Vec<(Ray, bool)>,
+    /// The pixel corner each query belongs to (its ray tree), for `closest` and `any`.
+    pub closest_corner: Vec<u32>,
+    pub any_corner: Vec<u32>,
 }
 
 pub struct Render {
@@ -254,6 +257,7 @@ pub fn render(
         if let Some(rec) = record.as_deref_mut() {
             rec.closest
                 .extend(rays.iter().copied().zip(hits.iter().copied()));
+            rec.closest_corner.extend(paths.iter().map(|p| p.corner));
         }
 
         let t1 = Instant::now();
@@ -347,6 +351,7 @@ pub fn render(
         if let Some(rec) = record.as_deref_mut() {
             rec.any
                 .extend(shadow_rays.iter().copied().zip(blocked.iter().copied()));
+            rec.any_corner.extend(shadow_gain.iter().map(|(c, _)| *c));
         }
         let t3 = Instant::now();
         g.shadow = shadow_rays.len() as u64;
