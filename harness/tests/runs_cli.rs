@@ -237,9 +237,10 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
     let (a, b, c) = (tmp("cmp-a"), tmp("cmp-b"), tmp("cmp-c"));
     quick_run(&a, None);
     quick_run(&b, None);
-    // test-slow spins 15% of its query time more: at least 10% of its trace time (queries are
-    // 75–90% of it here; the rest is shading).
-    quick_run(&c, Some("0.15"));
+    // test-slow spins 20% of its query time more: 13–16% of its trace time relative to Embree,
+    // as measured (queries are 75–90% of a trace here; the rest is shading). A 15% plant gave
+    // +11% against a noise bar of ~10%: too close to be a test that cannot flake.
+    quick_run(&c, Some("0.2"));
     let same = rtbench()
         .args(["compare"])
         .arg(&a)
