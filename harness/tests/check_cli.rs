@@ -1,15 +1,10 @@
 //! `rtbench check` and `rtbench render` as scripts use them: Embree against the f64 reference on
 //! the seven small SPD scenes, bad input → exit 2 with one line.
 
-use serde_json::Value;
-use std::process::{Command, Output};
+mod common;
 
-fn rtbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbench"))
-        .args(args)
-        .output()
-        .expect("rtbench runs")
-}
+use common::{expect_input_error, rtbench};
+use serde_json::Value;
 
 fn embree_available() -> bool {
     let out = rtbench(&["engines", "--json"]);
@@ -131,22 +126,6 @@ fn same_image_from_two_engines_when_hits_agree() {
     );
     assert_eq!(a["rays"], b["rays"]);
     assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
-}
-
-fn expect_input_error(args: &[&str], needle: &str) {
-    let out = rtbench(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    assert!(
-        err.contains(needle),
-        "{args:?}: '{err}' does not mention '{needle}'"
-    );
-    assert!(out.stdout.is_empty());
 }
 
 #[test]

@@ -1,15 +1,10 @@
 //! `rtbench scene …` as scripts use it (../shared/CLI.md): counts against the SPD formulas,
 //! computed here independently of the generators, by streaming; bad input → exit 2, one line.
 
-use serde_json::Value;
-use std::process::{Command, Output};
+mod common;
 
-fn rtbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbench"))
-        .args(args)
-        .output()
-        .expect("rtbench runs")
-}
+use common::{expect_input_error, rtbench};
+use serde_json::Value;
 
 fn stats(program: &str, sf: u32, extra: &[&str]) -> Value {
     let sf = sf.to_string();
@@ -100,28 +95,6 @@ fn stats_json_has_the_contract_fields() {
     }
     assert_eq!(v["lights"], 3);
     assert_eq!(v["bounds"][0].as_array().unwrap().len(), 3);
-}
-
-fn expect_input_error(args: &[&str], needle: &str) {
-    let out = rtbench(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(2),
-        "{args:?}: status {:?}, stderr {err}",
-        out.status
-    );
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    assert!(
-        err.contains(needle),
-        "{args:?}: '{err}' does not mention '{needle}'"
-    );
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
-    assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout");
 }
 
 #[test]

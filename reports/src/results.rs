@@ -77,15 +77,6 @@ impl Spread {
         };
         1.4826 * mad / self.median
     }
-
-    /// (max − min) / median: the run's own relative spread.
-    pub fn rel_spread(&self) -> f64 {
-        if self.median > 0.0 {
-            (self.max - self.min) / self.median
-        } else {
-            0.0
-        }
-    }
 }
 
 /// The scene a run traced.

@@ -82,6 +82,7 @@ impl Reference {
         let tmin = ray.tmin as f64;
         let mut tmax = ray.tmax as f64;
         let mut best = Hit::MISS;
+        let wt = k::WatertightRay::new(d);
         c.rays += 1;
         for (i, p) in self.prims.iter().enumerate() {
             c.primitive_tests += 1;
@@ -96,7 +97,7 @@ impl Reference {
                     k::polygon(o, d, tmin, tmax, verts, *normal).map(|t| (t, 0.0, 0.0))
                 }
                 RefPrim::Triangle([a, b, cc]) => {
-                    k::triangle_watertight(o, &k::WatertightRay::new(d), tmin, tmax, *a, *b, *cc)
+                    k::triangle_watertight(o, &wt, tmin, tmax, *a, *b, *cc)
                 }
             };
             if let Some((t, u, v)) = h {

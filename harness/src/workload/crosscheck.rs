@@ -13,7 +13,6 @@
 //! too (`t_rel_err_raw`).
 
 use super::trace;
-use rayon::prelude::*;
 use rtbench_engines::{Counters, Engine, Hit};
 use rtbench_scenes::Scene;
 use serde_json::{json, Value};
@@ -104,16 +103,15 @@ pub fn cross_check(
     let own = trace::render(scene, tested, size, Some(&mut own_rec));
     let got = &own;
     let rays: Vec<_> = rec.closest.iter().map(|(r, _)| *r).collect();
-    let mut hits = vec![Hit::MISS; rays.len()];
-    rays.par_chunks(4096)
-        .zip(hits.par_chunks_mut(4096))
-        .for_each(|(r, h)| tested.intersect(r, h, &mut Counters::default()));
+    let (mut hits, mut occ) = (Vec::new(), Vec::new());
+    let mut counters = Counters::default();
+    trace::query_all(&rays, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
+        tested.intersect(r, h, c)
+    });
     let srays: Vec<_> = rec.any.iter().map(|(r, _)| *r).collect();
-    let mut occ = vec![false; srays.len()];
-    srays
-        .par_chunks(4096)
-        .zip(occ.par_chunks_mut(4096))
-        .for_each(|(r, o)| tested.occluded(r, o, &mut Counters::default()));
+    trace::query_all(&srays, &mut occ, false, &mut counters, |r, o, c| {
+        tested.occluded(r, o, c)
+    });
 
     let mut agree = 0u64;
     let (mut t_err, mut t_err_raw) = (Vec::new(), Vec::new());

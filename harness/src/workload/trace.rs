@@ -130,49 +130,26 @@ fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
     }
 }
 
-/// Runs closest-hit queries over a batch, split across the pool's threads. Returns the CPU
-/// seconds used on threads other than the caller's.
-fn intersect_all(
-    engine: &dyn Engine,
+/// Answers a batch of queries (`engine.intersect` or `engine.occluded`) split into chunks over
+/// the pool's threads, each chunk with its own counters, summed into `counters`. `out` is resized
+/// to the batch and filled with `fill` first. Returns the CPU seconds used on threads other than
+/// the caller's.
+pub(crate) fn query_all<T: Clone + Send>(
     rays: &[Ray],
-    hits: &mut Vec<Hit>,
+    out: &mut Vec<T>,
+    fill: T,
     counters: &mut Counters,
-) -> f64 {
-    hits.clear();
-    hits.resize(rays.len(), Hit::MISS);
-    let me = rayon::current_thread_index();
-    let sums: Vec<(Counters, f64)> = rays
-        .par_chunks(BATCH)
-        .zip(hits.par_chunks_mut(BATCH))
-        .map(|(r, h)| {
-            let mut c = Counters::default();
-            let cpu = other_thread_cpu(me, || engine.intersect(r, h, &mut c));
-            (c, cpu)
-        })
-        .collect();
-    let mut cpu = 0.0;
-    for (c, t) in &sums {
-        counters.add(c);
-        cpu += t;
-    }
-    cpu
-}
-
-fn occluded_all(
-    engine: &dyn Engine,
-    rays: &[Ray],
-    out: &mut Vec<bool>,
-    counters: &mut Counters,
+    query: impl Fn(&[Ray], &mut [T], &mut Counters) + Sync,
 ) -> f64 {
     out.clear();
-    out.resize(rays.len(), false);
+    out.resize(rays.len(), fill);
     let me = rayon::current_thread_index();
     let sums: Vec<(Counters, f64)> = rays
         .par_chunks(BATCH)
         .zip(out.par_chunks_mut(BATCH))
         .map(|(r, o)| {
             let mut c = Counters::default();
-            let cpu = other_thread_cpu(me, || engine.occluded(r, o, &mut c));
+            let cpu = other_thread_cpu(me, || query(r, o, &mut c));
             (c, cpu)
         })
         .collect();
@@ -252,7 +229,9 @@ pub fn render(
             ..Default::default()
         };
         let t0 = Instant::now();
-        other_cpu += intersect_all(engine, &rays, &mut hits, &mut counters);
+        other_cpu += query_all(&rays, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
+            engine.intersect(r, h, c)
+        });
         intersect_s += t0.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.closest
@@ -346,7 +325,13 @@ pub fn render(
         shade_s += t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
-        other_cpu += occluded_all(engine, &shadow_rays, &mut blocked, &mut counters);
+        other_cpu += query_all(
+            &shadow_rays,
+            &mut blocked,
+            false,
+            &mut counters,
+            |r, o, c| engine.occluded(r, o, c),
+        );
         intersect_s += t2.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.any

@@ -59,10 +59,6 @@ impl<'s> Output<'s> {
         }
     }
 
-    pub fn sink(&mut self) -> &mut dyn Sink {
-        self.sink
-    }
-
     /// `lib_set_polygonalization`.
     pub fn set_polygonalization(&mut self, u: u32, v: u32) {
         self.u_resolution = u;
