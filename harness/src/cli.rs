@@ -29,6 +29,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Cross-check an engine's hits against Embree or the reference engine on the same rays.
     Check(CheckArgs),
+    /// 001's statistics of a BVH of any width 2–16 (even), built but not traced.
+    TreeStats(TreeStatsArgs),
     /// Remeasure a published table: `reproduce list`, `reproduce <id> --out DIR`.
     Reproduce(ReproduceArgs),
     /// Many engines × scenes × SFs, each run in its own process, results to DIR/results.jsonl.
@@ -238,6 +240,20 @@ pub struct RenderArgs {
     pub threads: Option<usize>,
     #[arg(long)]
     pub png: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct TreeStatsArgs {
+    #[command(flatten)]
+    pub scene: SceneFlag,
+    /// Branching factor: 2 to 16, even (001's N); a power of two with wide=direct and a SAH builder.
+    #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
+    pub width: usize,
+    /// BVH settings, `key=value` (builder, wide, leaf, bins, split_leaves; see `rtbench engines`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     #[arg(long)]
     pub json: bool,
 }

@@ -29,6 +29,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Engines { json } => commands::engines::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),
+        Command::TreeStats(a) => commands::tree_stats::run(&a),
         Command::Run(a) => commands::runs::run(&a),
         Command::Sweep(a) => commands::runs::sweep(&a),
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),

@@ -128,6 +128,73 @@ fn same_image_from_two_engines_when_hits_agree() {
     assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
 }
 
+/// Issue 5's bad BVH settings: an unknown builder, leaf size 0, width 3 (and a SAH width that is
+/// not a power of two) exit 2 with one line; `tree-stats` builds 001's wider trees.
+#[test]
+fn bad_bvh_settings_exit_2() {
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "bvh4",
+            "--set",
+            "builder=kd-tree",
+        ],
+        "bad value 'kd-tree' for 'builder'",
+    );
+    expect_input_error(
+        &[
+            "render", "--scene", "tetra", "--engine", "bvh8", "--set", "leaf=0",
+        ],
+        "bad value '0' for 'leaf'",
+    );
+    expect_input_error(
+        &["tree-stats", "--scene", "tetra", "--width", "3"],
+        "bad value '3' for 'width'",
+    );
+    expect_input_error(
+        &[
+            "tree-stats",
+            "--scene",
+            "tetra",
+            "--width",
+            "6",
+            "--set",
+            "builder=sah-sweep",
+            "--set",
+            "wide=direct",
+        ],
+        "needs a power of two",
+    );
+    let out = rtbench(&[
+        "tree-stats",
+        "--scene",
+        "tetra",
+        "--sf",
+        "4",
+        "--width",
+        "16",
+        "--set",
+        "builder=median",
+        "--set",
+        "wide=direct",
+        "--set",
+        "leaf=1",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    // 256 triangles in 16 × 16: two full levels.
+    assert_eq!(v["stats"]["internal_nodes"], 17.0);
+    assert_eq!(v["stats"]["max_leaf_depth"], 2.0);
+}
+
 #[test]
 fn bad_render_and_check_input_exits_2() {
     expect_input_error(

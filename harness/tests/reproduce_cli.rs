@@ -55,6 +55,10 @@ fn kimura_trees_quick_four_ary_is_shallower() {
                 .unwrap_or_else(|| panic!("no {builder} N={w} row"))
         };
         assert!(
+            depth(16) < depth(8),
+            "{builder}: N=16 not shallower than N=8"
+        );
+        assert!(
             depth(4) < depth(2),
             "{builder}: N=4 depth {} not below N=2 depth {}",
             depth(4),

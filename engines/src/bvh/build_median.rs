@@ -84,12 +84,15 @@ fn build(
 /// positions `cuts[i]..cuts[i+1]` on `axis` (multi-selection: one `select_nth` at the middle
 /// cut, then each side recursively).
 fn select_groups(prims: &BuildPrims, ids: &mut [u32], cuts: &[usize], axis: usize) {
-    // Only the interior cuts (not 0 or ids.len()) need a selection.
-    let inner: Vec<usize> = cuts
+    // Only the interior cuts (not 0 or ids.len()) need a selection, each once: with fewer
+    // primitives than groups, cuts repeat (empty groups), and a repeated cut would ask the
+    // left part for a position one past its end.
+    let mut inner: Vec<usize> = cuts
         .iter()
         .copied()
         .filter(|&c| c > 0 && c < ids.len())
         .collect();
+    inner.dedup();
     select_rec(prims, ids, 0, &inner, axis);
 }
 

@@ -19,6 +19,7 @@
 //! instructions runs the scalar test (`build_stats.simd_lanes` says which ran).
 
 use super::node::MAX_LEAF_PRIMS;
+use super::tree::MAX_WIDTH;
 use crate::engine::{EngineError, Settings, TriangleTest};
 use std::str::FromStr;
 
@@ -144,6 +145,7 @@ impl Config {
         if !(2..=256).contains(&bins) {
             return Err(bad("bins", bins.to_string(), "must be from 2 to 256"));
         }
+        check_width(width, builder, wide).map_err(|r| bad("width", width.to_string(), &r))?;
         if simd && width == 2 {
             return Err(bad(
                 "simd",
@@ -163,6 +165,21 @@ impl Config {
             split_leaves,
         })
     }
+}
+
+/// 001's branching factors (§1.4–§1.5): 2 to [`MAX_WIDTH`] in steps of two; 001's N-ary SAH
+/// (`wide=direct` with a SAH builder) splits in halves, so it needs a power of two.
+pub fn check_width(width: usize, builder: Builder, wide: WideMethod) -> Result<(), String> {
+    if !(2..=MAX_WIDTH).contains(&width) || width % 2 != 0 {
+        return Err(format!("must be even, from 2 to {MAX_WIDTH}"));
+    }
+    if wide == WideMethod::Direct && builder != Builder::Median && !width.is_power_of_two() {
+        return Err(format!(
+            "wide=direct with builder={} needs a power of two (001's SAH splits in halves)",
+            builder.name()
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -200,5 +217,21 @@ mod tests {
             parse(4, &[("colour", "red")]),
             Err(EngineError::UnknownKey { .. })
         ));
+    }
+
+    #[test]
+    fn widths_are_001s() {
+        for w in [2, 4, 6, 8, 10, 12, 14, 16] {
+            assert!(parse(w, &[("builder", "median"), ("wide", "direct")]).is_ok());
+            assert!(parse(w, &[("simd", "off")]).is_ok(), "collapse to {w}");
+        }
+        for w in [0, 1, 3, 7, 18, 32] {
+            let e = parse(w, &[("simd", "off")]).unwrap_err();
+            assert!(e.to_string().contains("'width'"), "{e}");
+        }
+        for w in [6, 10, 12, 14] {
+            assert!(parse(w, &[("builder", "sah-sweep"), ("wide", "direct")]).is_err());
+        }
+        assert!(parse(16, &[("builder", "sah-sweep"), ("wide", "direct")]).is_ok());
     }
 }

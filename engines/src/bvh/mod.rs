@@ -106,6 +106,31 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     }
 }
 
+/// 001's tree statistics for any of its branching factors (2 to 16, even; `config.width`, checked
+/// by [`Config::parse`]), without building an engine: the engines traverse N = 2, 4 and 8 only,
+/// 001 tabulates up to 16. Returns the statistics and the build seconds.
+pub fn tree_statistics(geometry: &Geometry, config: &Config) -> (stats::TreeStats, f64) {
+    fn of<const N: usize>(tree: &BuildTree) -> stats::TreeStats {
+        let flat = flatten::<N>(tree);
+        stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds)
+    }
+    let start = Instant::now();
+    let tree = build_tree(geometry, config);
+    let build_s = start.elapsed().as_secs_f64();
+    let s = match config.width {
+        2 => of::<2>(&tree),
+        4 => of::<4>(&tree),
+        6 => of::<6>(&tree),
+        8 => of::<8>(&tree),
+        10 => of::<10>(&tree),
+        12 => of::<12>(&tree),
+        14 => of::<14>(&tree),
+        16 => of::<16>(&tree),
+        w => unreachable!("width {w} passed Config::parse"),
+    };
+    (s, build_s)
+}
+
 /// Builds a [`Bvh`] and its statistics from geometry and a parsed configuration.
 pub fn build_bvh<const N: usize>(
     geometry: &Geometry,

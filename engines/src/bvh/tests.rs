@@ -269,6 +269,57 @@ fn node_counts_are_consistent() {
     assert!(d4 < 0.6 * d2 && d8 < d4, "{d2} {d4} {d8}");
 }
 
+/// 001's wider branching factors through [`tree_statistics`] (N = 2…16, no engine): the slot
+/// identity holds for every width, a 16-way median of 256 primitives is two full levels, a 6-way
+/// median of 36 likewise, and 001's SAH at N = 16 builds.
+#[test]
+fn statistics_for_widths_up_to_16() {
+    let inp = input(Program::Tetra, 4, None);
+    let n = inp.geometry.prims.len();
+    assert!(n >= 256, "{n}");
+    let cfg = |w: usize, builder: &str| {
+        Config::parse(
+            w,
+            Settings::new(
+                "bvh",
+                vec![
+                    ("builder".into(), builder.into()),
+                    ("wide".into(), "direct".into()),
+                    ("leaf".into(), "1".into()),
+                    ("simd".into(), "off".into()),
+                    ("packets".into(), "off".into()),
+                ],
+            ),
+        )
+        .unwrap()
+    };
+    for w in [2usize, 4, 6, 8, 10, 12, 14, 16] {
+        let (s, _) = tree_statistics(&inp.geometry, &cfg(w, "median"));
+        assert_eq!(s.width, w);
+        assert_eq!(s.leaf_nodes, n as u64, "N={w}");
+        assert_eq!(
+            s.leaf_nodes + s.internal_nodes - 1 + s.empty_nodes,
+            w as u64 * s.internal_nodes,
+            "N={w}: {s:?}"
+        );
+    }
+    let (s16, _) = tree_statistics(&inp.geometry, &cfg(16, "sah-sweep"));
+    assert_eq!(s16.leaf_nodes, n as u64);
+    let (s8, _) = tree_statistics(&inp.geometry, &cfg(8, "sah-sweep"));
+    assert!(s16.avg_leaf_depth < s8.avg_leaf_depth, "{s16:?} {s8:?}");
+    for (w, m) in [(16usize, 256usize), (6, 36)] {
+        let mut g = (*inp.geometry).clone();
+        g.prims.truncate(m);
+        g.prim_object.truncate(m);
+        let (s, _) = tree_statistics(&g, &cfg(w, "median"));
+        assert_eq!(
+            (s.internal_nodes, s.empty_nodes, s.max_leaf_depth),
+            (1 + w as u64, 0, 2),
+            "N={w}"
+        );
+    }
+}
+
 /// A 4-ary object median over 16 primitives (001 §1.3's example, cut from a tetra scene):
 /// depth 2, 5 internal nodes, no empty node.
 #[test]

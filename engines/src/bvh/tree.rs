@@ -6,8 +6,9 @@ use crate::geometry::aabb::Aabb;
 use crate::geometry::Geometry;
 use glam::Vec3;
 
-/// Widest node any builder makes (bvh8).
-pub const MAX_WIDTH: usize = 8;
+/// Widest node any builder makes: 8 for the engines (bvh8), 16 for 001's statistics
+/// ([`super::tree_statistics`]).
+pub const MAX_WIDTH: usize = 16;
 
 /// Depth at which the SAH builders stop minimising cost and split at the object median (a tree
 /// of at most 2^27 primitives then ends within 27 more levels), so every tree is at most
