@@ -49,7 +49,8 @@ pub enum Command {
 /// What run and sweep share.
 #[derive(Args, Debug, Clone)]
 pub struct PlanArgs {
-    /// Engines, comma-separated, or `all` (every available engine but `reference`).
+    /// Engines, comma-separated, or `all` (every available engine but `reference`). An entry may
+    /// carry settings after colons, `bvh4:simd=off`, to run variants of one engine side by side.
     #[arg(long)]
     pub engines: String,
     /// SPD programs, comma-separated, or `standard` (the seven of the SPD tables).

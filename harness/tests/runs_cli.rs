@@ -111,6 +111,57 @@ fn killed_run_leaves_valid_results_and_resume_completes_it() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Variants of one engine side by side: `bvh4:simd=off` is its own run with its own key, and
+/// `--set bvh4.…` reaches both; a variant without `=` is bad usage.
+#[test]
+fn engine_variants_run_side_by_side() {
+    let _one_at_a_time = serial();
+    let dir = tmp("variants");
+    let out = rtbench()
+        .args([
+            "run",
+            "--engines",
+            "bvh4,bvh4:simd=off",
+            "--scenes",
+            "tetra",
+            "--sf",
+            "2",
+            "--repeat",
+            "1",
+            "--size",
+            "32",
+            "--no-check",
+            "--set",
+            "bvh4.leaf=2",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ok(&out));
+    let recs = records(&dir);
+    assert_eq!(recs.len(), 2);
+    assert_ne!(recs[0]["key"], recs[1]["key"]);
+    let simd: Vec<&Value> = recs.iter().map(|r| &r["settings"]["simd"]).collect();
+    assert!(simd.contains(&&Value::from("off")), "{simd:?}");
+    assert!(recs.iter().all(|r| r["settings"]["leaf"] == "2"));
+    std::fs::remove_dir_all(&dir).unwrap();
+    let bad = rtbench()
+        .args([
+            "run",
+            "--engines",
+            "bvh4:simd",
+            "--scenes",
+            "tetra",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected engine:key=value"));
+}
+
 #[test]
 fn crashing_and_memory_hungry_runs_fail_and_the_sweep_goes_on() {
     let _one_at_a_time = serial();

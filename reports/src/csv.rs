@@ -33,6 +33,7 @@ const FIXED: &[&str] = &[
     "mrays_per_s",
     "ratio_to_embree",
     "structure_bytes",
+    "structure_bytes_per_primitive",
     "peak_rss_bytes",
     "check_against",
     "hit_agreement",
@@ -91,6 +92,8 @@ pub fn results(records: &[RunRecord]) -> String {
             r.mrays_per_s.to_string(),
             opt(anchors.ratio(r).map(|v| v.to_string())),
             r.structure_bytes.to_string(),
+            opt((r.scene.primitives > 0)
+                .then(|| (r.structure_bytes as f64 / r.scene.primitives as f64).to_string())),
             r.peak_rss_bytes.to_string(),
             opt(c.map(|c| c.against.clone())),
             opt(c.map(|c| c.hit_agreement.to_string())),

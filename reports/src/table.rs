@@ -13,7 +13,7 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
-const HEADER: [(&str, bool); 10] = [
+const HEADER: [(&str, bool); 11] = [
     ("scene", false),
     ("engine", false),
     ("build s", true),
@@ -21,6 +21,7 @@ const HEADER: [(&str, bool); 10] = [
     ("Mrays/s", true),
     ("× Embree", true),
     ("structure MB", true),
+    ("B/prim", true),
     ("peak RSS MB", true),
     ("hit agreement", true),
     ("PSNR dB", true),
@@ -62,6 +63,7 @@ fn cells(r: &Row) -> Vec<String> {
             .map(number::ratio)
             .unwrap_or_else(|| "–".to_string()),
         number::megabytes(r.structure_bytes),
+        bytes_per_primitive(r),
         number::megabytes(r.peak_rss_bytes),
         r.check
             .as_ref()
@@ -72,6 +74,14 @@ fn cells(r: &Row) -> Vec<String> {
             .map(|c| number::psnr(c.image_psnr_db))
             .unwrap_or_else(|| "–".to_string()),
     ]
+}
+
+/// Structure bytes per primitive of the scene as the engine sees it (after tessellation).
+fn bytes_per_primitive(r: &Row) -> String {
+    if r.primitives == 0 {
+        return "–".to_string();
+    }
+    format!("{:.1}", r.structure_bytes as f64 / r.primitives as f64)
 }
 
 /// The failed runs: key, then why.
@@ -116,5 +126,6 @@ pub fn environment_lines(env: &Environment) -> Vec<(&'static str, String)> {
 
 /// What the columns mean, printed under the tables.
 pub const NOTES: &str = "Times are medians over the repeats, with min–max. × Embree is the trace time over Embree's on \
-the same scene and threads in this results set (– without an Embree run). MB are 10^6 bytes. Hit agreement and PSNR \
+the same scene and threads in this results set (– without an Embree run). MB are 10^6 bytes; B/prim is the \
+structure's bytes per primitive (Embree: what its memory monitor reports, BVH and its copies of the geometry). Hit agreement and PSNR \
 compare each engine's hits and image with Embree's (`rtbench check`); ∞ dB means identical images.";

@@ -62,10 +62,12 @@ pub fn parse_bytes(s: &str) -> Result<u64> {
 /// An engine's name and its `key=value` settings.
 type EngineSettings = (String, Vec<(String, String)>);
 
-/// Engines of a plan with their settings (`engine.key=value`), checked against the registry.
+/// Engines of a plan with their settings, checked against the registry. An entry of `--engines`
+/// may carry its own settings after colons, `bvh4:simd=off:leaf=1`, so variants of one engine run
+/// side by side; `--set engine.key=value` applies to every entry of that engine.
 fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
     let registry = rtbench_engines::registry();
-    let names: Vec<String> = if p.engines.trim() == "all" {
+    let entries: Vec<String> = if p.engines.trim() == "all" {
         registry
             .iter()
             .filter(|e| e.name != "reference" && (e.available)().is_ok())
@@ -78,17 +80,31 @@ fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
             .filter(|s| !s.is_empty())
             .collect()
     };
-    if names.is_empty() {
+    if entries.is_empty() {
         return Err(input("--engines: no engine given"));
     }
-    let mut out = Vec::new();
-    for n in &names {
+    let mut out: Vec<EngineSettings> = Vec::new();
+    for entry in &entries {
+        let mut parts = entry.split(':');
+        let n = parts.next().unwrap_or_default().trim();
         let info = registry
             .iter()
             .find(|e| e.name == n)
             .ok_or_else(|| input(format!("unknown engine '{n}' (see `rtbench engines`)")))?;
         (info.available)().map_err(|r| input(format!("engine '{n}' is not available: {r}")))?;
-        out.push((n.clone(), Vec::new()));
+        let mut settings = Vec::new();
+        for kv in parts {
+            let (k, v) = kv
+                .split_once('=')
+                .filter(|(k, _)| !k.trim().is_empty())
+                .ok_or_else(|| input(format!("--engines '{entry}': expected engine:key=value")))?;
+            settings.push((k.trim().to_string(), v.trim().to_string()));
+        }
+        let planned = (n.to_string(), settings);
+        if out.contains(&planned) {
+            return Err(input(format!("--engines: '{entry}' given twice")));
+        }
+        out.push(planned);
     }
     for s in &p.set {
         let (lhs, v) = s
@@ -97,11 +113,16 @@ fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
         let (e, k) = lhs
             .split_once('.')
             .ok_or_else(|| input(format!("--set '{s}': expected engine.key=value")))?;
-        let slot = out
-            .iter_mut()
-            .find(|(n, _)| n == e)
-            .ok_or_else(|| input(format!("--set '{s}': engine '{e}' is not in --engines")))?;
-        slot.1.push((k.to_string(), v.to_string()));
+        let mut found = false;
+        for slot in out.iter_mut().filter(|(n, _)| n == e) {
+            slot.1.push((k.to_string(), v.to_string()));
+            found = true;
+        }
+        if !found {
+            return Err(input(format!(
+                "--set '{s}': engine '{e}' is not in --engines"
+            )));
+        }
     }
     Ok(out)
 }
