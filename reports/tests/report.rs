@@ -33,7 +33,7 @@ fn md_row(md: &str, scene: &str, engine: &str) -> Vec<String> {
                 .map(|c| c.trim().to_string())
                 .collect::<Vec<_>>()
         })
-        .find(|cells| cells.len() == 10 && cells[0] == scene && cells[1] == engine)
+        .find(|cells| cells.len() == 11 && cells[0] == scene && cells[1] == engine)
         .unwrap_or_else(|| panic!("no row for {scene} / {engine} in:\n{md}"))
 }
 
@@ -56,15 +56,16 @@ fn markdown_table_has_ratio_to_embree_and_failures() {
     let bvh2 = md_row(&md, "balls4", "bvh2");
     assert_eq!(bvh2[5], "2.50");
     assert_eq!(bvh2[3], "0.750 (0.743–0.758)");
-    assert_eq!(bvh2[8], "99.998%");
-    assert_eq!(bvh2[9], "48.3");
+    assert_eq!(bvh2[7], "2000.0", "structure bytes per primitive");
+    assert_eq!(bvh2[9], "99.998%");
+    assert_eq!(bvh2[10], "48.3");
     let grid = md_row(&md, "balls5", "grid");
     assert_eq!(grid[5], "0.80");
-    assert_eq!(grid[8], "100%");
-    assert_eq!(grid[9], "∞");
+    assert_eq!(grid[9], "100%");
+    assert_eq!(grid[10], "∞");
     let embree = md_row(&md, "balls3", "embree");
     assert_eq!(embree[5], "1.00");
-    assert_eq!(embree[8], "–", "Embree has no check against itself");
+    assert_eq!(embree[9], "–", "Embree has no check against itself");
     // No Embree run on teapot3: no ratio.
     assert_eq!(md_row(&md, "teapot3", "bvh2")[5], "–");
     // Embree first within a scene.
