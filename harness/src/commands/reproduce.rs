@@ -494,8 +494,21 @@ const SIMD_ENGINES: &[SimdEngine] = &[
     ("embree", "embree", &[]),
 ];
 
-/// One engine's result: label, median CPU seconds, median wall seconds, counters, hits.
-type Timed = (&'static str, f64, f64, Counters, usize);
+/// The second table of `kimura-simd`: the engines as users run them (their default trees and
+/// leaves), with obvhs's two layouts, on 001's rays: issue 5's side-by-side benchmark.
+const DEFAULT_ENGINES: &[SimdEngine] = &[
+    ("bvh2 scalar", "bvh2", &[]),
+    ("bvh4 scalar", "bvh4", &[("simd", "off")]),
+    ("bvh4 SIMD", "bvh4", &[]),
+    ("bvh8 SIMD", "bvh8", &[]),
+    ("obvhs cwbvh", "obvhs", &[]),
+    ("obvhs bvh2", "obvhs", &[("layout", "bvh2")]),
+    ("embree", "embree", &[]),
+];
+
+/// One engine's result: label, median CPU seconds, median wall seconds, counters, hits, build
+/// seconds, structure bytes per primitive.
+type Timed = (&'static str, f64, f64, Counters, usize, f64, f64);
 
 /// A counter per ray, or "-" when the engine counts nothing (Embree).
 fn per_ray(count: u64, rays: f64) -> String {
@@ -516,6 +529,109 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
+/// Times every available engine of `engines` on `rays` (closest hit, the calling thread): one
+/// warm-up, then the median of `repeats` CPU and wall times; the build time is the median wall
+/// time of `builds` builds. Appends a JSON row per engine.
+fn time_engines(
+    engines: &[SimdEngine],
+    input: &rtbench_engines::BuildInput,
+    rays: &[rtbench_engines::Ray],
+    repeats: usize,
+    builds: usize,
+    (scene, sf): (&str, u32),
+    rows: &mut Vec<Value>,
+) -> Result<Vec<Timed>> {
+    let mut times: Vec<Timed> = Vec::new();
+    for &(label, engine, kv) in engines {
+        let available = rtbench_engines::registry()
+            .into_iter()
+            .find(|e| e.name == engine)
+            .map(|e| (e.available)().is_ok())
+            .unwrap_or(false);
+        if !available {
+            eprintln!("kimura-simd: {engine} is not available here; skipped");
+            continue;
+        }
+        eprintln!("kimura-simd: {scene}{sf} {label} …");
+        let (mut e, build_s) = workload::build(engine, input, settings(kv))?;
+        let mut build_times = vec![build_s];
+        for _ in 1..builds {
+            drop(e);
+            let (again, s) = workload::build(engine, input, settings(kv))?;
+            e = again;
+            build_times.push(s);
+        }
+        let build_s = median(&mut build_times);
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let mut counters = Counters::default();
+        e.intersect(rays, &mut hits, &mut counters);
+        let n_hits = hits.iter().filter(|x| x.t.is_finite()).count();
+        let (mut cpu, mut wall) = (Vec::new(), Vec::new());
+        for _ in 0..repeats {
+            let mut c = Counters::default();
+            let t = Instant::now();
+            let c0 = workload::thread_cpu_seconds();
+            e.intersect(rays, &mut hits, &mut c);
+            cpu.push(workload::thread_cpu_seconds() - c0);
+            wall.push(t.elapsed().as_secs_f64());
+        }
+        let (cpu, wall) = (median(&mut cpu), median(&mut wall));
+        rows.push(json!({"scene": scene, "sf": sf, "engine": label, "engine_name": engine, "settings": settings(kv),
+            "build_s": build_s, "cpu_s": cpu, "wall_s": wall, "repeats": repeats, "rays": rays.len(), "hits": n_hits,
+            "structure_bytes": e.structure_bytes(), "primitives": input.geometry.prims.len(),
+            "counters": {"nodes_visited": counters.nodes_visited, "box_tests": counters.box_tests, "primitive_tests": counters.primitive_tests}}));
+        let bytes_per_prim = e.structure_bytes() as f64 / input.geometry.prims.len().max(1) as f64;
+        times.push((label, cpu, wall, counters, n_hits, build_s, bytes_per_prim));
+    }
+    Ok(times)
+}
+
+/// Table rows of timed engines, with the time ratio to Embree's.
+fn write_timed(md: &mut String, scene: &str, times: &[Timed], n: f64) {
+    let embree = times.iter().find(|t| t.0 == "embree").map(|t| t.1);
+    for (label, cpu, wall, c, n_hits, build_s, bpp) in times {
+        let _ = writeln!(
+            md,
+            "| {scene} | {label} | {:.1} ({:.1}) | {} | {} | {} | {n_hits} | {} | {:.0} | {bpp:.1} |",
+            cpu * 1e3,
+            wall * 1e3,
+            per_ray(c.nodes_visited, n),
+            per_ray(c.box_tests, n),
+            per_ray(c.primitive_tests, n),
+            embree.map_or("-".into(), |e| format!("{:.2}", cpu / e)),
+            build_s * 1e3
+        );
+    }
+}
+
+/// Issue 5's goals on one scene: bvh4/bvh8 SIMD at ≥ 0.8× Embree's rays per second and ≥ 1.5×
+/// the faster obvhs layout's; builds ≤ 3× Embree's build time.
+fn engine_goals(scene: &str, times: &[Timed]) -> Vec<Value> {
+    let get = |l: &str| times.iter().find(|t| t.0 == l);
+    let mut out = Vec::new();
+    let obvhs = ["obvhs cwbvh", "obvhs bvh2"]
+        .iter()
+        .filter_map(|l| get(l).map(|t| t.1))
+        .min_by(|a, b| a.total_cmp(b));
+    for l in ["bvh4 SIMD", "bvh8 SIMD"] {
+        let Some(t) = get(l) else { continue };
+        let mut goal = |ratio: String, goal: &str, measured: f64, met: bool| {
+            out.push(json!({"scene": scene, "ratio": ratio, "goal": goal, "measured": measured, "met": met}));
+        };
+        if let Some(e) = get("embree") {
+            let r = e.1 / t.1;
+            goal(format!("{l} rays/s ÷ Embree's"), "≥ 0.8", r, r >= 0.8);
+            let b = t.5 / e.5;
+            goal(format!("{l} build s ÷ Embree's"), "≤ 3", b, b <= 3.0);
+        }
+        if let Some(o) = obvhs {
+            let r = o / t.1;
+            goal(format!("{l} rays/s ÷ fastest obvhs'"), "≥ 1.5", r, r >= 1.5);
+        }
+    }
+    out
+}
+
 /// `kimura-simd`: 001 §4.3's experiment. 800×600 eye rays through pixel centres, one thread
 /// (the calling one), the same rays for every engine; median of several timed repeats.
 fn kimura_simd(id: &str, quick: bool, out: &Path, as_json: bool) -> Result<()> {
@@ -525,7 +641,7 @@ fn kimura_simd(id: &str, quick: bool, out: &Path, as_json: bool) -> Result<()> {
         published["speedup_simd"]["min"].as_f64().unwrap(),
         published["speedup_simd"]["max"].as_f64().unwrap(),
     );
-    let repeats = if quick { 3 } else { 7 };
+    let repeats: usize = if quick { 3 } else { 7 };
     let (w, h) = (800u32, 600u32);
     let mut md = String::new();
     let _ = writeln!(
@@ -540,61 +656,42 @@ fn kimura_simd(id: &str, quick: bool, out: &Path, as_json: bool) -> Result<()> {
     );
     let _ = writeln!(md, "Published: SIMD made rendering {lo}-{hi}x faster (Core Duo T2050, 4 scenes incl. cloister; baseline 'without SIMD', binary or 4-ary tree not stated).");
     let _ = writeln!(md, "Measured: `rtbench reproduce kimura-simd` ({}), {w}x{h} eye rays through pixel centres (NFF angle vertical, square pixels), intersect only (no shading), one thread, trees `builder=sah-sweep leaf=1 packets=off` (`wide=direct` for bvh4/bvh8), Embree with its defaults. Times: median of {repeats} repeats after one warm-up, CPU time of the calling thread (wall in brackets). Absolute times are not compared with 2006's.\n", if quick { "--quick: gears4 only, fewer repeats" } else { "full" });
-    let _ = writeln!(md, "| scene | engine | CPU ms (wall) | nodes/ray | box tests/ray | tri tests/ray | hits | x Embree |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| scene | engine | CPU ms (wall) | nodes/ray | box tests/ray | tri tests/ray | hits | x Embree | build ms | B/prim |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     let mut rows = Vec::new();
     let mut speedups = Vec::new();
+    let (mut default_rows, mut default_md, mut goals) = (Vec::new(), String::new(), Vec::new());
     for &(scene, sf) in kimura_scenes(quick) {
         let src = Source::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
         let camera = Camera::new(&prepared.input.scene.view);
         let rays = camera.pixel_centre_rays(w, h);
-        let mut times: Vec<Timed> = Vec::new();
-        for &(label, engine, kv) in SIMD_ENGINES {
-            let available = rtbench_engines::registry()
-                .into_iter()
-                .find(|e| e.name == engine)
-                .map(|e| (e.available)().is_ok())
-                .unwrap_or(false);
-            if !available {
-                eprintln!("kimura-simd: {engine} is not available here; skipped");
-                continue;
-            }
-            eprintln!("kimura-simd: {scene}{sf} {label} …");
-            let (e, build_s) = workload::build(engine, &prepared.input, settings(kv))?;
-            let mut hits = vec![Hit::MISS; rays.len()];
-            let mut counters = Counters::default();
-            e.intersect(&rays, &mut hits, &mut counters);
-            let n_hits = hits.iter().filter(|x| x.t.is_finite()).count();
-            let (mut cpu, mut wall) = (Vec::new(), Vec::new());
-            for _ in 0..repeats {
-                let mut c = Counters::default();
-                let t = Instant::now();
-                let c0 = workload::thread_cpu_seconds();
-                e.intersect(&rays, &mut hits, &mut c);
-                cpu.push(workload::thread_cpu_seconds() - c0);
-                wall.push(t.elapsed().as_secs_f64());
-            }
-            let (cpu, wall) = (median(&mut cpu), median(&mut wall));
-            rows.push(json!({"scene": scene, "sf": sf, "engine": label, "engine_name": engine, "settings": settings(kv),
-                "build_s": build_s, "cpu_s": cpu, "wall_s": wall, "repeats": repeats, "rays": rays.len(), "hits": n_hits,
-                "counters": {"nodes_visited": counters.nodes_visited, "box_tests": counters.box_tests, "primitive_tests": counters.primitive_tests}}));
-            times.push((label, cpu, wall, counters, n_hits));
-        }
-        let embree = times.iter().find(|t| t.0 == "embree").map(|t| t.1);
-        let n = rays.len() as f64;
-        for (label, cpu, wall, c, n_hits) in &times {
-            let _ = writeln!(
-                md,
-                "| {scene}{sf} | {label} | {:.1} ({:.1}) | {} | {} | {} | {n_hits} | {} |",
-                cpu * 1e3,
-                wall * 1e3,
-                per_ray(c.nodes_visited, n),
-                per_ray(c.box_tests, n),
-                per_ray(c.primitive_tests, n),
-                embree.map_or("-".into(), |e| format!("{:.2}", cpu / e))
-            );
-        }
+        let times = time_engines(
+            SIMD_ENGINES,
+            &prepared.input,
+            &rays,
+            repeats,
+            1,
+            (scene, sf),
+            &mut rows,
+        )?;
+        write_timed(&mut md, &format!("{scene}{sf}"), &times, rays.len() as f64);
+        let defaults = time_engines(
+            DEFAULT_ENGINES,
+            &prepared.input,
+            &rays,
+            repeats,
+            3,
+            (scene, sf),
+            &mut default_rows,
+        )?;
+        write_timed(
+            &mut default_md,
+            &format!("{scene}{sf}"),
+            &defaults,
+            rays.len() as f64,
+        );
+        goals.extend(engine_goals(&format!("{scene}{sf}"), &defaults));
         let get = |l: &str| times.iter().find(|t| t.0 == l).map(|t| t.1);
         if let Some(simd) = get("bvh4 SIMD") {
             for base in ["bvh2 scalar", "bvh4 scalar"] {
@@ -627,7 +724,32 @@ fn kimura_simd(id: &str, quick: bool, out: &Path, as_json: bool) -> Result<()> {
             s["compares"].as_str().unwrap()
         );
     }
+    let _ = writeln!(
+        md,
+        "\n## The engines at their defaults, same rays (issue 5's side-by-side)\n"
+    );
+    let _ = writeln!(md, "Default trees and leaves (bvh2: binned SAH, leaf 1; bvh4/bvh8: binned SAH collapsed, leaf 4, triangle packets; obvhs: PLOC, `medium` preset), one thread, same rays and timing as above; build: median wall time of 3 builds (Embree builds with its own threads).\n");
+    let _ = writeln!(md, "| scene | engine | CPU ms (wall) | nodes/ray | box tests/ray | tri tests/ray | hits | x Embree | build ms | B/prim |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    md.push_str(&default_md);
+    let _ = writeln!(md, "\n| scene | ratio | goal | measured | met |");
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for g in &goals {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.2} | {} |",
+            g["scene"].as_str().unwrap(),
+            g["ratio"].as_str().unwrap(),
+            g["goal"].as_str().unwrap(),
+            g["measured"].as_f64().unwrap(),
+            if g["met"].as_bool().unwrap() {
+                "yes"
+            } else {
+                "no"
+            }
+        );
+    }
     let doc = json!({"id": id, "published": published, "measured": rows, "speedups": speedups, "quick": quick,
-        "image": [w, h], "environment": environment(1)});
+        "defaults": default_rows, "goals": goals, "image": [w, h], "environment": environment(1)});
     write_report(id, out, &doc, &md, as_json)
 }
