@@ -200,6 +200,7 @@ fn build_engine<const N: usize>(
     settings: Settings,
     simd_kernels: fn() -> Option<Kernels<N>>,
 ) -> Result<Box<dyn Engine>, EngineError> {
+    const { assert!(N <= traverse::MAX_TRAVERSAL_WIDTH) };
     let config = Config::parse(N, settings)?;
     let start = Instant::now();
     let (bvh, tree_stats) = build_bvh::<N>(&input.geometry, &config)?;

@@ -21,7 +21,7 @@
 use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
 use super::simd::ChildTest;
-use super::tree::{MAX_DEPTH, MAX_WIDTH};
+use super::tree::MAX_DEPTH;
 use crate::engine::{Counters, TriangleTest};
 use crate::geometry::aabb::SlabRay;
 use crate::geometry::kernels::f32::WatertightRay;
@@ -29,8 +29,10 @@ use crate::geometry::triangle_simd::{LaneHits, PacketKernel};
 use crate::geometry::Prim;
 use crate::ray::{Hit, Ray};
 
+/// The widest tree traversed (bvh8; wider trees are built for statistics only).
+pub const MAX_TRAVERSAL_WIDTH: usize = 8;
 /// A traversal holds at most N − 1 pending siblings per level of the tree.
-pub const STACK_SIZE: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
+pub const STACK_SIZE: usize = (MAX_TRAVERSAL_WIDTH - 1) * MAX_DEPTH + 1;
 
 /// A built BVH as traversal reads it: flat node array, root reference, and the primitives in
 /// leaf order with their scene objects: triangle packets (packet leaves index `packets`) and

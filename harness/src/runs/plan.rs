@@ -36,6 +36,19 @@ impl Job {
         s
     }
 
+    /// The engine with its settings, as reports name it: `bvh4[simd=off]`.
+    fn label(&self) -> String {
+        if self.settings.is_empty() {
+            return self.engine.clone();
+        }
+        let s: Vec<String> = self
+            .settings
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        format!("{}[{}]", self.engine, s.join(","))
+    }
+
     fn threads_count(&self) -> usize {
         self.threads.unwrap_or_else(|| {
             std::thread::available_parallelism()
@@ -345,7 +358,7 @@ impl Progress {
             "[{}/{}] {} {} @{}: {what} (elapsed {}, left ~{})",
             self.done,
             self.total,
-            job.engine,
+            job.label(),
             job.scene_label(),
             job.threads_count(),
             fmt_secs(elapsed),
