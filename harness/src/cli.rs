@@ -261,22 +261,34 @@ pub struct TreeStatsArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct CheckArgs {
-    #[command(flatten)]
-    pub scene: SceneFlag,
+    /// An SPD program or an NFF file (required unless --suite is given).
     #[arg(long)]
-    pub engine: String,
+    pub scene: Option<String>,
+    #[command(flatten)]
+    pub opts: SceneOpts,
+    /// The engine to check; with --suite, engines comma-separated (default: every available one).
+    #[arg(long)]
+    pub engine: Option<String>,
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// The engine to check against: embree or reference.
-    #[arg(long, default_value = "embree")]
-    pub against: String,
-    #[arg(long, default_value_t = 512)]
-    pub size: u32,
-    /// Minimum hit agreement (fraction of rays) for the check to pass.
-    #[arg(long, default_value_t = 0.9999)]
-    pub threshold: f64,
+    /// The engine to check against: embree (default) or reference.
+    #[arg(long)]
+    pub against: Option<String>,
+    /// Image size (default 512; with --suite tessellation, 128).
+    #[arg(long)]
+    pub size: Option<u32>,
+    /// Minimum hit agreement (fraction of rays) for the check to pass (default 0.9999).
+    #[arg(long)]
+    pub threshold: Option<f64>,
     #[arg(long)]
     pub threads: Option<usize>,
     #[arg(long)]
     pub json: bool,
+    /// Run a suite instead of one scene: `hard` (hard cases, acne, speed against error) or
+    /// `tessellation` (curved against --tessellate 1…8).
+    #[arg(long)]
+    pub suite: Option<String>,
+    /// Folder for the suite's report (SUITE.md, SUITE.json, plots/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }

@@ -6,6 +6,7 @@ mod error;
 mod output;
 mod runs;
 mod source;
+mod suite;
 mod workload;
 
 use clap::Parser;

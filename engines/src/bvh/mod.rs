@@ -165,6 +165,7 @@ pub fn build_bvh<const N: usize>(
             prims: Vec::new(),
             objects: Vec::new(),
             packets: Vec::new(),
+            extent: 0.0,
         };
         return Ok((bvh, s));
     }
@@ -176,6 +177,12 @@ pub fn build_bvh<const N: usize>(
     );
     let mut flat = flatten::<N>(&tree);
     let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
+    let extent = flat
+        .root_bounds
+        .lo
+        .abs()
+        .max(flat.root_bounds.hi.abs())
+        .max_element();
     let leaves = leaf::lay_out(
         &mut flat.nodes,
         &mut flat.root,
@@ -190,6 +197,7 @@ pub fn build_bvh<const N: usize>(
             prims: leaves.prims,
             objects: leaves.objects,
             packets: leaves.packets,
+            extent: if extent.is_finite() { extent } else { 0.0 },
         },
         s,
     ))

@@ -2,7 +2,8 @@
 //! fallback), SSE (N = 4) and AVX2 + FMA (N = 8), with `std::arch` intrinsics.
 //!
 //! All three compute, for each child box, `t_near = max(tmin, near planes · rdir − org·rdir)`
-//! and `t_far = min(tmax, far planes · rdir − org·rdir)` and report the children with
+//! and `t_far = min(tmax, far planes · rdir − org·rdir)` (`org·rdir` widened by a rounding
+//! bound, lower for near planes and higher for far ones: `SlabRay`) and report the children with
 //! `t_near ≤ t_far` (001 §1.8, thesis Ch. 4.2.3, with the per-ray precomputation of §1.7; near
 //! and far planes picked once per ray by the direction's signs, as Embree's `TravRay` does, so
 //! no per-box min/max swap). Empty slots hold the empty box, which every form misses.
@@ -107,7 +108,8 @@ pub struct Scalar;
 #[derive(Clone, Copy)]
 pub struct ScalarRay {
     rdir: [f32; 3],
-    org_rdir: [f32; 3],
+    org_near: [f32; 3],
+    org_far: [f32; 3],
     near: [usize; 3],
     far: [usize; 3],
 }
@@ -119,7 +121,8 @@ impl<const N: usize> ChildTest<N> for Scalar {
     fn prepare(r: &SlabRay) -> ScalarRay {
         ScalarRay {
             rdir: r.rdir.to_array(),
-            org_rdir: r.org_rdir.to_array(),
+            org_near: r.org_rdir_near.to_array(),
+            org_far: r.org_rdir_far.to_array(),
             near: [r.near_plane(0), r.near_plane(1), r.near_plane(2)],
             far: [r.far_plane(0), r.far_plane(1), r.far_plane(2)],
         }
@@ -132,13 +135,13 @@ impl<const N: usize> ChildTest<N> for Scalar {
         let (fx, fy, fz) = (&p[r.far[0]], &p[r.far[1]], &p[r.far[2]]);
         let mut mask = 0;
         for i in 0..(node.len as usize).min(N) {
-            let t_near = (nx[i] * r.rdir[0] - r.org_rdir[0])
-                .max(ny[i] * r.rdir[1] - r.org_rdir[1])
-                .max(nz[i] * r.rdir[2] - r.org_rdir[2])
+            let t_near = (nx[i] * r.rdir[0] - r.org_near[0])
+                .max(ny[i] * r.rdir[1] - r.org_near[1])
+                .max(nz[i] * r.rdir[2] - r.org_near[2])
                 .max(tmin);
-            let t_far = (fx[i] * r.rdir[0] - r.org_rdir[0])
-                .min(fy[i] * r.rdir[1] - r.org_rdir[1])
-                .min(fz[i] * r.rdir[2] - r.org_rdir[2])
+            let t_far = (fx[i] * r.rdir[0] - r.org_far[0])
+                .min(fy[i] * r.rdir[1] - r.org_far[1])
+                .min(fz[i] * r.rdir[2] - r.org_far[2])
                 .min(tmax);
             if t_near <= t_far {
                 mask |= 1 << i;
@@ -186,7 +189,8 @@ mod x86 {
     #[derive(Clone, Copy)]
     pub struct Sse4Ray {
         rdir: [__m128; 3],
-        org_rdir: [__m128; 3],
+        org_near: [__m128; 3],
+        org_far: [__m128; 3],
         near: [usize; 3],
         far: [usize; 3],
     }
@@ -219,10 +223,11 @@ mod x86 {
                 // the local `lanes`.
                 unsafe { _mm_loadu_ps(lanes.as_ptr()) }
             };
-            let (d, o) = (r.rdir, r.org_rdir);
+            let (d, on, of) = (r.rdir, r.org_rdir_near, r.org_rdir_far);
             Sse4Ray {
                 rdir: [splat(d.x), splat(d.y), splat(d.z)],
-                org_rdir: [splat(o.x), splat(o.y), splat(o.z)],
+                org_near: [splat(on.x), splat(on.y), splat(on.z)],
+                org_far: [splat(of.x), splat(of.y), splat(of.z)],
                 near,
                 far,
             }
@@ -237,21 +242,22 @@ mod x86 {
             // `row < 6` (`plane_offsets`), so each unaligned load reads 4 floats inside the
             // node; the store writes exactly the 4 floats of `dist`.
             unsafe {
-                let plane = |off: usize, a: usize| {
+                let plane = |off: usize, a: usize, org: &[__m128; 3]| {
                     let p = _mm_loadu_ps(base.add(off));
                     if FMA {
-                        _mm_fmsub_ps(p, r.rdir[a], r.org_rdir[a])
+                        _mm_fmsub_ps(p, r.rdir[a], org[a])
                     } else {
-                        _mm_sub_ps(_mm_mul_ps(p, r.rdir[a]), r.org_rdir[a])
+                        _mm_sub_ps(_mm_mul_ps(p, r.rdir[a]), org[a])
                     }
                 };
+                let (on, of) = (&r.org_near, &r.org_far);
                 let t_near = _mm_max_ps(
-                    _mm_max_ps(plane(r.near[0], 0), plane(r.near[1], 1)),
-                    _mm_max_ps(plane(r.near[2], 2), _mm_set1_ps(tmin)),
+                    _mm_max_ps(plane(r.near[0], 0, on), plane(r.near[1], 1, on)),
+                    _mm_max_ps(plane(r.near[2], 2, on), _mm_set1_ps(tmin)),
                 );
                 let t_far = _mm_min_ps(
-                    _mm_min_ps(plane(r.far[0], 0), plane(r.far[1], 1)),
-                    _mm_min_ps(plane(r.far[2], 2), _mm_set1_ps(tmax)),
+                    _mm_min_ps(plane(r.far[0], 0, of), plane(r.far[1], 1, of)),
+                    _mm_min_ps(plane(r.far[2], 2, of), _mm_set1_ps(tmax)),
                 );
                 _mm_storeu_ps(dist.as_mut_ptr(), t_near);
                 _mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32
@@ -266,7 +272,8 @@ mod x86 {
     #[derive(Clone, Copy)]
     pub struct Avx8Ray {
         rdir: [__m256; 3],
-        org_rdir: [__m256; 3],
+        org_near: [__m256; 3],
+        org_far: [__m256; 3],
         near: [usize; 3],
         far: [usize; 3],
     }
@@ -282,7 +289,7 @@ mod x86 {
         #[inline(always)]
         fn prepare(r: &SlabRay) -> Avx8Ray {
             let (near, far) = plane_offsets(r, 8);
-            let (d, o) = (r.rdir, r.org_rdir);
+            let (d, on, of) = (r.rdir, r.org_rdir_near, r.org_rdir_far);
             // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`), which run
             // only on CPUs with both; `set1` only broadcasts a value.
             unsafe {
@@ -292,10 +299,15 @@ mod x86 {
                         _mm256_set1_ps(d.y),
                         _mm256_set1_ps(d.z),
                     ],
-                    org_rdir: [
-                        _mm256_set1_ps(o.x),
-                        _mm256_set1_ps(o.y),
-                        _mm256_set1_ps(o.z),
+                    org_near: [
+                        _mm256_set1_ps(on.x),
+                        _mm256_set1_ps(on.y),
+                        _mm256_set1_ps(on.z),
+                    ],
+                    org_far: [
+                        _mm256_set1_ps(of.x),
+                        _mm256_set1_ps(of.y),
+                        _mm256_set1_ps(of.z),
                     ],
                     near,
                     far,
@@ -312,16 +324,17 @@ mod x86 {
             // inside the node; the store writes exactly the 8 floats of `dist`.
             unsafe {
                 // t = plane · rdir − org · rdir in one rounding (Embree's `madd` form).
-                let plane = |off: usize, a: usize| {
-                    _mm256_fmsub_ps(_mm256_loadu_ps(base.add(off)), r.rdir[a], r.org_rdir[a])
+                let plane = |off: usize, a: usize, org: &[__m256; 3]| {
+                    _mm256_fmsub_ps(_mm256_loadu_ps(base.add(off)), r.rdir[a], org[a])
                 };
+                let (on, of) = (&r.org_near, &r.org_far);
                 let t_near = _mm256_max_ps(
-                    _mm256_max_ps(plane(r.near[0], 0), plane(r.near[1], 1)),
-                    _mm256_max_ps(plane(r.near[2], 2), _mm256_set1_ps(tmin)),
+                    _mm256_max_ps(plane(r.near[0], 0, on), plane(r.near[1], 1, on)),
+                    _mm256_max_ps(plane(r.near[2], 2, on), _mm256_set1_ps(tmin)),
                 );
                 let t_far = _mm256_min_ps(
-                    _mm256_min_ps(plane(r.far[0], 0), plane(r.far[1], 1)),
-                    _mm256_min_ps(plane(r.far[2], 2), _mm256_set1_ps(tmax)),
+                    _mm256_min_ps(plane(r.far[0], 0, of), plane(r.far[1], 1, of)),
+                    _mm256_min_ps(plane(r.far[2], 2, of), _mm256_set1_ps(tmax)),
                 );
                 _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
                 _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32

@@ -43,6 +43,9 @@ pub struct Bvh<const N: usize> {
     pub prims: Vec<Prim>,
     pub objects: Vec<u32>,
     pub packets: Vec<LeafPacket>,
+    /// The largest absolute coordinate of the root's bounds (0 when empty): the conservative
+    /// slab test's bound on plane magnitudes (`SlabRay`).
+    pub extent: f32,
 }
 
 /// Where child reference `c` points: its node, or its leaf's first packet or primitive. Only
@@ -164,7 +167,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bo
     stack: &mut [Entry; STACK_SIZE],
     tally: &mut Tally,
 ) -> Hit {
-    let tr = T::prepare(&SlabRay::new(ray));
+    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();
@@ -289,7 +292,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
     stack: &mut [u32; STACK_SIZE],
     tally: &mut Tally,
 ) -> bool {
-    let tr = T::prepare(&SlabRay::new(ray));
+    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();

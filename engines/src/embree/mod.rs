@@ -16,7 +16,8 @@
 //! - `threads` (default 1): Embree's build threads (`threads=N` in the device configuration;
 //!   0 lets Embree use every core). Tracing runs on the caller's threads either way.
 //! - `quality` (default `medium`, Embree's default): `low`, `medium` or `high` (`rtcSetSceneBuildQuality`).
-//! - `robust` (default false): `RTC_SCENE_FLAG_ROBUST` (Embree's watertight-ish triangle test).
+//! - `robust` (default `off`): `on` sets `RTC_SCENE_FLAG_ROBUST` (Embree's watertight-ish
+//!   triangle test and robust traversal); `on|off` (also `true|false`).
 //! - `compact` (default false): `RTC_SCENE_FLAG_COMPACT`.
 //! - `isa` (default: the best the CPU has): `sse2`, `sse4.2`, `avx`, `avx2` or `avx512`.
 //! - `verbose` (default 0): Embree's verbosity (1 prints the device and the BVH chosen, on stdout).
@@ -29,6 +30,7 @@
 //!
 //! Without the cargo feature `embree` the engine is listed but unavailable.
 
+use crate::bvh::config::OnOff;
 use crate::engine::{BuildInput, Engine, EngineError, EngineInfo, Settings};
 #[cfg(feature = "embree")]
 mod engine;
@@ -100,7 +102,7 @@ impl EmbreeConfig {
         let d = EmbreeConfig::default();
         let threads = s.get("threads", d.threads)?;
         let quality = s.get("quality", d.quality)?;
-        let robust = s.get("robust", d.robust)?;
+        let robust = s.get("robust", OnOff(d.robust))?.0;
         let compact = s.get("compact", d.compact)?;
         let isa: String = s.get("isa", String::new())?;
         let verbose = s.get("verbose", d.verbose)?;

@@ -104,10 +104,22 @@ impl Aabb {
 
 /// A ray prepared for slab tests (Embree's `TravRay`): the inverse direction, `origin × inverse`
 /// and, per axis, whether the direction is negative (then the box's upper plane is the near one).
+///
+/// Conservative (after Ize 2013, "Robust BVH Ray Traversal"): `plane · rdir − org · rdir` in
+/// f32 is off by a few roundings of `(|plane| + |origin|) · |rdir|`, and with the plain products
+/// a ray through a box's edge or corner — a ray aimed at a shared edge or vertex of a mesh —
+/// could find the box missed and leak through the mesh (the hard-case suite measured 39 leaks of
+/// 26 461 such rays in bvh4). So each axis' near distance is lowered and its far distance raised
+/// by `4ε (extent + |origin|) |rdir|`, with `extent` the largest coordinate any box can have:
+/// folded into two `origin × inverse` terms, one for near planes and one for far planes, it costs
+/// the traversal nothing, and widens boxes by about 1e-6 of the scene's size.
 #[derive(Clone, Copy, Debug)]
 pub struct SlabRay {
     pub rdir: Vec3,
-    pub org_rdir: Vec3,
+    /// `origin × rdir` plus the rounding bound (subtracted on near planes) …
+    pub org_rdir_near: Vec3,
+    /// … and minus it (subtracted on far planes).
+    pub org_rdir_far: Vec3,
     pub negative: [bool; 3],
 }
 
@@ -116,9 +128,15 @@ pub struct SlabRay {
 /// `rcp_safe`).
 const MIN_RCP_INPUT: f32 = 1e-18;
 
+/// Roundings covered by the conservative bound (see [`SlabRay`]): the inverse, `origin × inverse`
+/// and the plane distance each round once; one more for safety.
+const ROUNDINGS: f32 = 4.0 * f32::EPSILON;
+
 impl SlabRay {
+    /// `extent`: the largest absolute coordinate of any box the ray will be tested against
+    /// (the scene's bounds).
     #[inline]
-    pub fn new(ray: &Ray) -> SlabRay {
+    pub fn new(ray: &Ray, extent: f32) -> SlabRay {
         let safe = |d: f32| {
             if d.abs() < MIN_RCP_INPUT {
                 MIN_RCP_INPUT.copysign(d)
@@ -131,9 +149,12 @@ impl SlabRay {
             1.0 / safe(ray.dir.y),
             1.0 / safe(ray.dir.z),
         );
+        let org_rdir = ray.origin * rdir;
+        let pad = (Vec3::splat(extent.abs()) + ray.origin.abs()) * rdir.abs() * ROUNDINGS;
         SlabRay {
             rdir,
-            org_rdir: ray.origin * rdir,
+            org_rdir_near: org_rdir + pad,
+            org_rdir_far: org_rdir - pad,
             negative: [rdir.x < 0.0, rdir.y < 0.0, rdir.z < 0.0],
         }
     }
@@ -159,8 +180,8 @@ impl SlabRay {
             (lo[axis], hi[axis])
         };
         (
-            a * self.rdir[axis] - self.org_rdir[axis],
-            b * self.rdir[axis] - self.org_rdir[axis],
+            a * self.rdir[axis] - self.org_rdir_near[axis],
+            b * self.rdir[axis] - self.org_rdir_far[axis],
         )
     }
 }
@@ -173,28 +194,65 @@ mod tests {
     fn slab_hits_misses_and_empty() {
         let b = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
         let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 0.0, f32::INFINITY);
-        let s = SlabRay::new(&r);
-        assert!((b.slab(&s, 0.0, f32::INFINITY).unwrap() - 4.0).abs() < 1e-6);
+        let s = SlabRay::new(&r, 5.0);
+        // The entry is lowered by the rounding bound, 4ε·(5 + 5) ≈ 5e-6.
+        assert!((b.slab(&s, 0.0, f32::INFINITY).unwrap() - 4.0).abs() < 1e-5);
         // Segment ends before the box.
         assert!(b.slab(&s, 0.0, 3.9).is_none());
         // Axis-parallel ray beside the box (zero direction components).
         let r = Ray::new(Vec3::new(2.0, 0.0, -5.0), Vec3::Z, 0.0, f32::INFINITY);
-        assert!(b.slab(&SlabRay::new(&r), 0.0, f32::INFINITY).is_none());
+        assert!(b.slab(&SlabRay::new(&r, 5.0), 0.0, f32::INFINITY).is_none());
         // Backwards direction: near plane is the upper one.
         let r = Ray::new(Vec3::new(0.5, 0.5, 5.0), -Vec3::Z, 0.0, f32::INFINITY);
-        assert!((b.slab(&SlabRay::new(&r), 0.0, 100.0).unwrap() - 4.0).abs() < 1e-6);
+        assert!((b.slab(&SlabRay::new(&r, 5.0), 0.0, 100.0).unwrap() - 4.0).abs() < 1e-5);
         // Inside: entry clamps to tmin.
         let r = Ray::new(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY);
-        assert_eq!(b.slab(&SlabRay::new(&r), 0.0, 10.0), Some(0.0));
+        assert_eq!(b.slab(&SlabRay::new(&r, 5.0), 0.0, 10.0), Some(0.0));
         // The empty box is never hit, from any side.
         for d in [Vec3::X, -Vec3::Y, Vec3::new(1.0, -1.0, 0.0)] {
             let r = Ray::new(Vec3::ZERO, d, 0.0, f32::INFINITY);
-            assert!(Aabb::EMPTY.slab(&SlabRay::new(&r), 0.0, 1e30).is_none());
+            assert!(Aabb::EMPTY
+                .slab(&SlabRay::new(&r, 5.0), 0.0, 1e30)
+                .is_none());
         }
         // A flat box (a square in z = 0) is hit head on.
         let f = Aabb::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0));
         let r = Ray::new(Vec3::new(0.3, 0.2, 2.0), -Vec3::Z, 0.0, f32::INFINITY);
-        assert!((f.slab(&SlabRay::new(&r), 0.0, 10.0).unwrap() - 2.0).abs() < 1e-6);
+        assert!((f.slab(&SlabRay::new(&r, 5.0), 0.0, 10.0).unwrap() - 2.0).abs() < 1e-5);
+    }
+
+    /// Rays aimed exactly at corners and edge points of boxes, from far and near, in random
+    /// directions that enter the box: every one must find the box (the conservative bound).
+    #[test]
+    fn rays_through_corners_and_edges_find_the_box() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut f = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut missed = 0;
+        for _ in 0..20_000 {
+            let lo = Vec3::new(f() * 4.0 - 2.0, f() * 4.0 - 2.0, f() * 4.0 - 2.0);
+            let b = Aabb::new(lo, lo + Vec3::new(f() + 0.1, f() + 0.1, f() + 0.1));
+            // A corner, or a point on an edge along x.
+            let mut p = Vec3::new(
+                if f() < 0.5 { b.lo.x } else { b.hi.x },
+                if f() < 0.5 { b.lo.y } else { b.hi.y },
+                if f() < 0.5 { b.lo.z } else { b.hi.z },
+            );
+            if f() < 0.5 {
+                p.x = b.lo.x + (b.hi.x - b.lo.x) * f();
+            }
+            // A direction from outside into the box through p: towards its centre.
+            let d = (b.centre() - p).normalize() + Vec3::new(f(), f(), f()) * 0.2;
+            let r = Ray::new(p - d * (1.0 + 30.0 * f()), d, 0.0, f32::INFINITY);
+            if b.slab(&SlabRay::new(&r, 4.0), 0.0, f32::INFINITY).is_none() {
+                missed += 1;
+            }
+        }
+        assert_eq!(missed, 0);
     }
 
     #[test]

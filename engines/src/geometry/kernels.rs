@@ -1,6 +1,9 @@
 //! The ray–primitive kernels, written once and instantiated for `f32` (every engine) and `f64`
-//! (the reference engine): sphere, open cone/cylinder, polygon (convex or concave), triangle
-//! (watertight and Möller–Trumbore).
+//! (the reference engine): sphere, open cone/cylinder, triangle (watertight and
+//! Möller–Trumbore), and the polygon normal. Polygons are cut into triangles
+//! (`rtbench_scenes::triangulate`) and meet rays through the watertight triangle test, in f32
+//! and in f64 alike: a crossing-number polygon test is not consistent along edges shared with
+//! neighbouring polygons.
 //!
 //! Every kernel returns the nearest intersection with `tmin < t < tmax`, or `None`. Rays may
 //! start inside a sphere or cone (refraction rays do): both surfaces count.
@@ -274,45 +277,6 @@ macro_rules! kernels {
             }
             n.normalize_or_zero()
         }
-
-        /// Ray–polygon, convex or concave: the plane, then the crossing-number test in the
-        /// projection that drops the normal's largest axis.
-        pub fn polygon(o: V, d: V, tmin: T, tmax: T, verts: &[V], normal: V) -> Option<T> {
-            let denom = normal.dot(d);
-            if denom == 0.0 {
-                return None;
-            }
-            let t = normal.dot(verts[0] - o) / denom;
-            if !(t > tmin && t < tmax) {
-                return None;
-            }
-            let p = o + d * t;
-            let an = normal.abs();
-            let (i, j) = if an.x >= an.y && an.x >= an.z {
-                (1, 2)
-            } else if an.y >= an.z {
-                (2, 0)
-            } else {
-                (0, 1)
-            };
-            let (px, py) = (p[i], p[j]);
-            let mut inside = false;
-            let n = verts.len();
-            let mut k = n - 1;
-            for m in 0..n {
-                let (xi, yi) = (verts[m][i], verts[m][j]);
-                let (xk, yk) = (verts[k][i], verts[k][j]);
-                if (yi > py) != (yk > py) && px < (xk - xi) * (py - yi) / (yk - yi) + xi {
-                    inside = !inside;
-                }
-                k = m;
-            }
-            if inside {
-                Some(t)
-            } else {
-                None
-            }
-        }
     };
 }
 
@@ -439,8 +403,8 @@ mod tests {
     }
 
     #[test]
-    fn concave_polygon() {
-        // An L shape: the notch at (1.5, 1.5) is outside.
+    fn polygon_normal_follows_the_winding() {
+        // An L shape, counter-clockwise seen from +z.
         let l: Vec<DVec3> = [
             (0.0, 0.0),
             (2.0, 0.0),
@@ -452,13 +416,8 @@ mod tests {
         .iter()
         .map(|&(x, y)| DVec3::new(x, y, 0.0))
         .collect();
-        let n = super::f64::polygon_normal(&l);
-        assert!((n - DVec3::Z).length() < 1e-12);
-        let hit = |x: f64, y: f64| {
-            super::f64::polygon(DVec3::new(x, y, 1.0), -DVec3::Z, 0.0, 10.0, &l, n)
-        };
-        assert!(hit(0.5, 0.5).is_some());
-        assert!(hit(0.5, 1.5).is_some());
-        assert!(hit(1.5, 1.5).is_none());
+        assert!((super::f64::polygon_normal(&l) - DVec3::Z).length() < 1e-12);
+        let rev: Vec<DVec3> = l.iter().rev().copied().collect();
+        assert!((super::f64::polygon_normal(&rev) + DVec3::Z).length() < 1e-12);
     }
 }

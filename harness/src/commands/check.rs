@@ -1,44 +1,62 @@
 //! `rtbench check`: an engine's answers against Embree's or the reference engine's on the same
-//! rays (see `workload/crosscheck.rs` for what agreement and t error mean).
+//! rays (see `workload/crosscheck.rs` for what agreement and t error mean); with `--suite`, the
+//! hard-case and tessellation suites (`suite/`).
 
 use crate::cli::CheckArgs;
 use crate::error::{input, Failure, Result};
 use crate::output::print_json;
 use crate::source::Source;
+use crate::suite;
 use crate::workload::{self, crosscheck};
 use serde_json::json;
 
 pub fn run(a: &CheckArgs) -> Result<()> {
-    workload::check_size(a.size)?;
-    if !(0.0..=1.0).contains(&a.threshold) {
+    if let Some(name) = &a.suite {
+        return run_suite(a, name);
+    }
+    let scene = a
+        .scene
+        .as_deref()
+        .ok_or_else(|| input("check: give --scene (or --suite hard|tessellation)"))?;
+    let engine = a
+        .engine
+        .as_deref()
+        .ok_or_else(|| input("check: give --engine"))?;
+    if a.engine.as_deref().is_some_and(|e| e.contains(',')) {
         return Err(input(format!(
-            "--threshold {}: must be from 0 to 1",
-            a.threshold
+            "--engine {engine}: one engine with --scene (lists are for --suite)"
+        )));
+    }
+    if a.out.is_some() {
+        return Err(input("--out applies to --suite only"));
+    }
+    let against = a.against.as_deref().unwrap_or("embree");
+    let size = a.size.unwrap_or(512);
+    let threshold = a.threshold.unwrap_or(0.9999);
+    workload::check_size(size)?;
+    if !(0.0..=1.0).contains(&threshold) {
+        return Err(input(format!(
+            "--threshold {threshold}: must be from 0 to 1"
         )));
     }
     let settings = workload::parse_settings(&a.set)?;
-    let src = Source::resolve(
-        &a.scene.scene,
-        a.scene.opts.sf,
-        a.scene.opts.tessellate,
-        a.scene.opts.hash,
-    )?;
+    let src = Source::resolve(scene, a.opts.sf, a.opts.tessellate, a.opts.hash)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
-    let (tested, _) = workload::build(&a.engine, &prepared.input, settings)?;
-    let (yardstick, _) = workload::build(&a.against, &prepared.input, vec![])?;
+    let (tested, _) = workload::build(engine, &prepared.input, settings)?;
+    let (yardstick, _) = workload::build(against, &prepared.input, vec![])?;
     let c = pool.install(|| {
         crosscheck::cross_check(
             &prepared.input.scene,
             tested.as_ref(),
             yardstick.as_ref(),
-            a.size,
+            size,
         )
     });
     let agreement = c.agreement();
     let v = json!({
-        "engine": a.engine,
-        "against": a.against,
+        "engine": engine,
+        "against": against,
         "scene": src.label(),
         "rays": c.rays(),
         "closest_rays": c.closest_rays,
@@ -53,8 +71,8 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             "pixels_differing": c.pixels_same_hits_differing,
             "max_abs_diff": c.pixels_same_hits_max_diff,
         },
-        "threshold": a.threshold,
-        "pass": agreement >= a.threshold,
+        "threshold": threshold,
+        "pass": agreement >= threshold,
         "mismatches": c.mismatches,
     });
     if a.json {
@@ -62,8 +80,8 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     } else {
         println!(
             "{} vs {} on {}: {} rays, agreement {:.6} ({} differ), t rel err p99 {:.2e} max {:.2e}, image PSNR {}",
-            a.engine,
-            a.against,
+            engine,
+            against,
             src.label(),
             c.rays(),
             agreement,
@@ -73,15 +91,67 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             c.image_psnr_db.map(|p| format!("{p:.1} dB")).unwrap_or_else(|| "inf (identical)".into())
         );
     }
-    if agreement < a.threshold {
+    if agreement < threshold {
         return Err(Failure::Check(format!(
             "{} vs {} on {}: hit agreement {:.6} is under the threshold {}",
-            a.engine,
-            a.against,
+            engine,
+            against,
             src.label(),
             agreement,
-            a.threshold
+            threshold
         )));
     }
     Ok(())
+}
+
+/// `check --suite hard|tessellation [--engine a,b] [--out DIR] [--json]`.
+fn run_suite(a: &CheckArgs, name: &str) -> Result<()> {
+    let given = [
+        ("--scene", a.scene.is_some()),
+        ("--sf", a.opts.sf.is_some()),
+        ("--tessellate", a.opts.tessellate.is_some()),
+        ("--hash", a.opts.hash.is_some()),
+        ("--set", !a.set.is_empty()),
+        ("--against", a.against.is_some()),
+        ("--threshold", a.threshold.is_some()),
+        ("--size", a.size.is_some() && name != "tessellation"),
+    ];
+    if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+        return Err(input(format!(
+            "{flag} does not apply to --suite {name} (the suite chooses its scenes, rays and settings)"
+        )));
+    }
+    let engines = suite::engines(a.engine.as_deref())?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| input(format!("--out {}: cannot create: {e}", dir.display())))?;
+    }
+    let pool = workload::pool(a.threads)?;
+    match name {
+        "hard" => {
+            let probe = suite::probe_input();
+            let variants = suite::variants(&engines, &probe)?;
+            let h = pool.install(|| suite::hard::run(&variants, a.out.as_deref()))?;
+            if a.json {
+                print_json(&suite::report_json_hard(&h));
+            } else {
+                print!("{}", suite::report_markdown_hard(&h));
+            }
+            suite::hard::verdict(&h)
+        }
+        "tessellation" => {
+            let size = a.size.unwrap_or(128);
+            workload::check_size(size)?;
+            let t = pool.install(|| suite::tessellation::run(&engines, size, a.out.as_deref()))?;
+            if a.json {
+                print_json(&suite::report_json_tess(&t));
+            } else {
+                print!("{}", suite::report_markdown_tess(&t));
+            }
+            Ok(())
+        }
+        other => Err(input(format!(
+            "--suite {other}: unknown suite (known: hard, tessellation)"
+        ))),
+    }
 }

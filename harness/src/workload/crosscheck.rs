@@ -28,7 +28,7 @@ pub struct ErrorQuantiles {
 }
 
 impl ErrorQuantiles {
-    fn of(mut v: Vec<f64>) -> ErrorQuantiles {
+    pub fn of(mut v: Vec<f64>) -> ErrorQuantiles {
         v.sort_by(|a, b| a.total_cmp(b));
         let q = |p: f64| {
             if v.is_empty() {

@@ -1,0 +1,130 @@
+//! `rtbench check --suite tessellation`: what tessellating the curved primitives costs in image
+//! error and buys or costs in time. balls, rings and tree (spheres, cylinders, cones) are traced
+//! curved and at `--tessellate RES` for RES 1…8 with every engine; the image error is the RMSE
+//! of the pixel-corner colours (clamped to 0…1) against the same engine's curved render, the time
+//! is the render's query time.
+//!
+//! An engine whose render takes longer than `BUDGET_S` stops its curve there (the brute-force
+//! reference would take minutes at RES 8); the report says where.
+
+use super::report;
+use crate::error::Result;
+use crate::workload::trace;
+use rtbench_engines::geometry::Geometry;
+use rtbench_engines::{build_engine, BuildInput};
+use rtbench_scenes::generate_scene;
+use rtbench_scenes::spd::{Options, Program};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The scenes and size factors (small enough that RES 8, about 100 000 triangles, builds fast).
+const SCENES: [(Program, u32); 3] = [(Program::Balls, 2), (Program::Rings, 2), (Program::Tree, 6)];
+const MAX_RES: u32 = 8;
+/// A render slower than this ends the engine's curve on that scene.
+const BUDGET_S: f64 = 10.0;
+
+pub struct TessPoint {
+    pub res: u32,
+    pub rmse: f64,
+    pub time_s: f64,
+    pub triangles: usize,
+}
+
+pub struct Curve {
+    pub scene: String,
+    pub engine: String,
+    pub curved_s: f64,
+    pub points: Vec<TessPoint>,
+    pub stopped: Option<String>,
+}
+
+pub struct TessResults {
+    pub size: u32,
+    pub curves: Vec<Curve>,
+    pub seconds: f64,
+}
+
+fn input(p: Program, sf: u32, tessellate: Option<u32>) -> BuildInput {
+    let scene = generate_scene(
+        p,
+        &Options {
+            size_factor: sf,
+            tessellate,
+            ..Options::standard(p)
+        },
+    )
+    .expect("the tessellation scenes are valid");
+    BuildInput {
+        geometry: Arc::new(Geometry::from_scene(&scene)),
+        scene: Arc::new(scene),
+    }
+}
+
+fn rmse(a: &[glam::Vec3], b: &[glam::Vec3]) -> f64 {
+    let c = |v: glam::Vec3| v.clamp(glam::Vec3::ZERO, glam::Vec3::ONE).as_dvec3();
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (c(*x) - c(*y)).length_squared())
+        .sum();
+    (sum / (3 * a.len().max(1)) as f64).sqrt()
+}
+
+pub fn run(engines: &[String], size: u32, out: Option<&Path>) -> Result<TessResults> {
+    let t0 = Instant::now();
+    let mut curves = Vec::new();
+    for (p, sf) in SCENES {
+        let curved = input(p, sf, None);
+        let tess: Vec<BuildInput> = (1..=MAX_RES).map(|r| input(p, sf, Some(r))).collect();
+        for name in engines {
+            let e = build_engine(name, &curved, vec![])?;
+            let reference = trace::render(&curved.scene, e.as_ref(), size, None);
+            let mut c = Curve {
+                scene: format!("{}{sf}", p.name()),
+                engine: name.clone(),
+                curved_s: reference.intersect_s,
+                points: Vec::new(),
+                stopped: None,
+            };
+            for (i, input) in tess.iter().enumerate() {
+                let res = i as u32 + 1;
+                let e = build_engine(name, input, vec![])?;
+                let r = trace::render(&input.scene, e.as_ref(), size, None);
+                c.points.push(TessPoint {
+                    res,
+                    rmse: rmse(&r.corners, &reference.corners),
+                    time_s: r.intersect_s,
+                    triangles: input.geometry.prims.len(),
+                });
+                if r.trace_s > BUDGET_S && res < MAX_RES {
+                    c.stopped = Some(format!(
+                        "RES {res} took {:.1} s, over the {BUDGET_S} s budget",
+                        r.trace_s
+                    ));
+                    break;
+                }
+            }
+            eprintln!(
+                "tessellation {} {}: {}",
+                c.scene,
+                c.engine,
+                c.points
+                    .iter()
+                    .map(|p| format!("{}:{:.1e}", p.res, p.rmse))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            );
+            curves.push(c);
+        }
+    }
+    let t = TessResults {
+        size,
+        curves,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    if let Some(dir) = out {
+        report::write_tessellation(dir, &t)?;
+    }
+    Ok(t)
+}
