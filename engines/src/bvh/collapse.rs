@@ -15,18 +15,43 @@
 
 use super::tree::{BuildKind, BuildTree, MAX_WIDTH};
 
-/// `split_leaves`: spend free slots on splitting leaf-sized subtrees (worth it when each
-/// primitive is tested on its own; not with triangle packets, which test a whole leaf of up to
-/// 4 triangles for the price of one, see `leaf.rs`).
-pub fn collapse(bin: &BuildTree, width: usize, leaf: usize, split_leaves: bool) -> BuildTree {
-    assert!((2..=MAX_WIDTH).contains(&width) && leaf >= 1);
+/// How leaves are formed.
+#[derive(Clone, Copy)]
+pub struct Leaves<'a> {
+    /// Most primitives per leaf.
+    pub leaf: usize,
+    /// Spend free slots on splitting leaf-sized subtrees (worth it when each primitive is tested
+    /// on its own; not with triangle packets, which test a whole leaf of up to 4 triangles for
+    /// the price of one, see `leaf.rs`).
+    pub split_leaves: bool,
+    /// With triangle packets: `scalar_before[i]` counts the primitives at order positions
+    /// `< i` that are not triangles. A subtree holding one of those is tested primitive by
+    /// primitive, so it becomes a leaf only when it has a single primitive (curved SPD
+    /// primitives thus get 001's one-per-leaf tree, triangles Embree's packets).
+    pub scalar_before: Option<&'a [u32]>,
+}
+
+impl Leaves<'_> {
+    fn is_leaf(&self, (first, count): (u32, u32)) -> bool {
+        if count as usize > self.leaf {
+            return false;
+        }
+        match self.scalar_before {
+            Some(s) if count > 1 => s[(first + count) as usize] == s[first as usize],
+            _ => true,
+        }
+    }
+}
+
+pub fn collapse(bin: &BuildTree, width: usize, leaves: Leaves) -> BuildTree {
+    assert!((2..=MAX_WIDTH).contains(&width) && leaves.leaf >= 1);
     let mut span = vec![(0u32, 0u32); bin.nodes.len()];
     spans(bin, 0, &mut span);
     let mut out = BuildTree {
         nodes: Vec::with_capacity(bin.nodes.len() / (width - 1) + 1),
         order: bin.order.clone(),
     };
-    node(bin, &span, 0, width, leaf, split_leaves, &mut out);
+    node(bin, &span, 0, width, &leaves, &mut out);
     out
 }
 
@@ -53,14 +78,13 @@ fn node(
     span: &[(u32, u32)],
     i: u32,
     width: usize,
-    leaf: usize,
-    split_leaves: bool,
+    leaves: &Leaves,
     out: &mut BuildTree,
 ) -> u32 {
     let n = &bin.nodes[i as usize];
     let (first, count) = span[i as usize];
     let children = match n.kind {
-        BuildKind::Inner { children, len } if count as usize > leaf => {
+        BuildKind::Inner { children, len } if !leaves.is_leaf((first, count)) => {
             children[..len as usize].to_vec()
         }
         _ => return out.push(n.bounds, BuildKind::Leaf { first, count }),
@@ -78,10 +102,10 @@ fn node(
                     if kids.len() - 1 + len as usize <= width)
             })
             .map(|(slot, &k)| {
-                let big = span[k as usize].1 as usize > leaf;
+                let big = !leaves.is_leaf(span[k as usize]);
                 (slot, big, bin.nodes[k as usize].bounds.half_area())
             })
-            .filter(|&(_, big, _)| big || split_leaves)
+            .filter(|&(_, big, _)| big || leaves.split_leaves)
             .max_by(|a, b| a.1.cmp(&b.1).then(a.2.total_cmp(&b.2)));
         let Some((slot, _, _)) = best else { break };
         let grand = bin.children(kids[slot]).to_vec();
@@ -90,7 +114,7 @@ fn node(
     let me = out.push(n.bounds, n.kind);
     let mut wide = [0u32; MAX_WIDTH];
     for (slot, &k) in kids.iter().enumerate() {
-        wide[slot] = node(bin, span, k, width, leaf, split_leaves, out);
+        wide[slot] = node(bin, span, k, width, leaves, out);
     }
     out.nodes[me as usize].kind = BuildKind::Inner {
         children: wide,
@@ -106,6 +130,14 @@ mod tests {
     use super::*;
     use crate::geometry::aabb::Aabb;
     use glam::Vec3;
+
+    fn plain(leaf: usize) -> Leaves<'static> {
+        Leaves {
+            leaf,
+            split_leaves: true,
+            scalar_before: None,
+        }
+    }
 
     fn row(n: usize) -> BuildPrims {
         let bounds: Vec<Aabb> = (0..n)
@@ -135,15 +167,15 @@ mod tests {
         // no empty slot; 8-wide: 9 inner nodes (the root's 8 children hold 2 leaves each).
         let p = row(16);
         let bin = build_median::binary(&p, 1);
-        let w4 = collapse(&bin, 4, 1, true);
+        let w4 = collapse(&bin, 4, plain(1));
         w4.validate(&p, 4).unwrap();
         assert_eq!(inner(&w4), 5);
         assert_eq!(w4.children(0).len(), 4);
-        let w8 = collapse(&bin, 8, 1, true);
+        let w8 = collapse(&bin, 8, plain(1));
         w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
         assert_eq!(w8.children(0).len(), 8);
-        let w2 = collapse(&bin, 2, 1, true);
+        let w2 = collapse(&bin, 2, plain(1));
         assert_eq!(w2.nodes.len(), bin.nodes.len());
     }
 
@@ -153,7 +185,7 @@ mod tests {
         // opened into 3 + 3, then (slots still free) into 1 + 2 + 1 + 2.
         let p = row(24);
         let bin = build_median::binary(&p, 1);
-        let w4 = collapse(&bin, 4, 2, true);
+        let w4 = collapse(&bin, 4, plain(2));
         w4.validate(&p, 4).unwrap();
         let mut leaves: Vec<u32> = w4
             .nodes
@@ -168,7 +200,7 @@ mod tests {
         assert_eq!(inner(&w4), 5);
         // With room to spare every leaf ends up with one primitive: 64 primitives, 8-wide.
         let p = row(64);
-        let w8 = collapse(&build_median::binary(&p, 1), 8, 4, true);
+        let w8 = collapse(&build_median::binary(&p, 1), 8, plain(4));
         w8.validate(&p, 8).unwrap();
         assert_eq!(inner(&w8), 9);
         assert_eq!(w8.nodes.len() - inner(&w8), 64);

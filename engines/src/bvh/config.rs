@@ -8,7 +8,7 @@
 //! | `simd` | `on`, `off` (bvh4: SSE, with FMA when the CPU has AVX2 + FMA; bvh8: AVX2 + FMA) | `on` (bvh2: `off`) |
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
-//! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
+//! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when

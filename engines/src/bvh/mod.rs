@@ -26,7 +26,7 @@ pub mod tree;
 mod tests;
 
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, Prim};
 use crate::ray::{Hit, Ray};
 use config::{Builder, Config, WideMethod};
 use node::{flatten, WideNode, MAX_TRAVERSAL_PRIMS};
@@ -102,7 +102,23 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     if width == 2 {
         binary
     } else {
-        collapse::collapse(&binary, width, leaf, config.split_leaves)
+        // With packets, leaves of several primitives are for triangles only (collapse.rs).
+        let scalar_before: Option<Vec<u32>> = config.packets.then(|| {
+            let mut acc = 0u32;
+            let mut v = Vec::with_capacity(binary.order.len() + 1);
+            v.push(0);
+            for &p in &binary.order {
+                acc += !matches!(geometry.prims[p as usize], Prim::Triangle(_)) as u32;
+                v.push(acc);
+            }
+            v
+        });
+        let leaves = collapse::Leaves {
+            leaf,
+            split_leaves: config.split_leaves,
+            scalar_before: scalar_before.as_deref(),
+        };
+        collapse::collapse(&binary, width, leaves)
     }
 }
 

@@ -320,6 +320,24 @@ fn statistics_for_widths_up_to_16() {
     }
 }
 
+/// With triangle packets (the default), only triangles share leaves: curved primitives get one
+/// leaf each, so balls (spheres and a floor of two triangles) has at least n − 1 leaves, while a
+/// triangle-only scene keeps leaves of up to four.
+#[test]
+fn only_triangles_share_leaves() {
+    let balls = input(Program::Balls, 2, None);
+    let n = balls.geometry.prims.len() as f64;
+    for width in [4usize, 8] {
+        let s = stats_of(engine(&balls, width, &[]).as_ref());
+        assert!(s["leaf_nodes"] >= n - 1.0, "bvh{width}: {s:?}");
+        let s = stats_of(engine(&balls, width, &[("packets", "off")]).as_ref());
+        assert!(s["leaf_nodes"] < n, "bvh{width} without packets: {s:?}");
+    }
+    let tetra = input(Program::Tetra, 4, None);
+    let s = stats_of(engine(&tetra, 4, &[]).as_ref());
+    assert!(s["avg_leaf_prims"] > 2.0, "{s:?}");
+}
+
 /// A 4-ary object median over 16 primitives (001 §1.3's example, cut from a tetra scene):
 /// depth 2, 5 internal nodes, no empty node.
 #[test]
