@@ -19,7 +19,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Eye rays through the corners of a `SIZE`×`SIZE` image on each standard scene, for acne.
-const ACNE_SIZE: u32 = 40;
+const ACNE_SIZE: u32 = 64;
 
 /// The seven scenes of the SPD tables, at their standard size factors.
 const STANDARD: [Program; 7] = [
