@@ -290,3 +290,32 @@ fn bad_render_and_check_input_exits_2() {
         "--threads",
     );
 }
+
+/// `check --suite`: bad suites, flags that do not apply, unknown engines and unwritable folders
+/// are input errors (exit 2, one line), found before any tracing.
+#[test]
+fn bad_suite_input_exits_2() {
+    expect_input_error(&["check", "--suite", "soft"], "unknown suite");
+    expect_input_error(
+        &["check", "--suite", "hard", "--scene", "tetra"],
+        "--scene does not apply",
+    );
+    expect_input_error(
+        &["check", "--suite", "hard", "--size", "64"],
+        "--size does not apply",
+    );
+    expect_input_error(
+        &["check", "--suite", "hard", "--engine", "bvh4,warp-drive"],
+        "unknown engine 'warp-drive'",
+    );
+    expect_input_error(
+        &["check", "--suite", "tessellation", "--size", "0"],
+        "--size 0",
+    );
+    expect_input_error(
+        &["check", "--suite", "hard", "--out", "/proc/no/such/dir"],
+        "--out /proc/no/such/dir",
+    );
+    expect_input_error(&["check", "--engine", "bvh4"], "give --scene");
+    expect_input_error(&["check", "--scene", "tetra"], "give --engine");
+}

@@ -22,7 +22,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         .engine
         .as_deref()
         .ok_or_else(|| input("check: give --engine"))?;
-    if a.engine.as_deref().is_some_and(|e| e.contains(',')) {
+    if engine.contains(',') {
         return Err(input(format!(
             "--engine {engine}: one engine with --scene (lists are for --suite)"
         )));

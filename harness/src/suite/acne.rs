@@ -11,6 +11,10 @@
 //! acne when it hits the surface it starts from: for a flat primitive any hit on it (a ray off a
 //! plane cannot meet that plane again), for a sphere or cone a hit on it closer than 1e-4 of its
 //! size (a legitimate second hit, e.g. through a sphere, is much further away).
+//!
+//! The offset grows with the hit point's magnitude, so far from the origin it can outgrow the
+//! objects: a ray that starts further off its surface than 1% of the surface's size is counted
+//! as *displaced* (its shadow or reflection may skip what lies next to the surface).
 
 use crate::workload::surface::Surfaces;
 use crate::workload::trace::{self, offset_origin};
@@ -21,38 +25,51 @@ use serde_json::{json, Value};
 
 /// Fraction of a curved primitive's size under which a hit on itself is acne.
 const NEAR: f32 = 1e-4;
+/// Offset, as a fraction of the object's size, beyond which a secondary ray is displaced.
+const DISPLACED: f32 = 1e-2;
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Acne {
     pub secondary: u64,
     pub acne: u64,
+    pub displaced: u64,
 }
 
 impl Acne {
     pub fn add(&mut self, o: &Acne) {
         self.secondary += o.secondary;
         self.acne += o.acne;
+        self.displaced += o.displaced;
     }
     pub fn rate(&self) -> f64 {
         self.acne as f64 / self.secondary.max(1) as f64
     }
     pub fn to_json(self) -> Value {
-        json!({"secondary": self.secondary, "acne": self.acne, "rate": self.rate()})
+        json!({"secondary": self.secondary, "acne": self.acne, "rate": self.rate(),
+            "displaced": self.displaced})
     }
 }
 
 /// Acne of the secondary rays spawned from `engine`'s hits on `primary`.
 pub fn measure(scene: &Scene, engine: &dyn Engine, primary: &[Ray]) -> Acne {
     let surfaces = Surfaces::new(scene);
+    // Per object: its size, and whether it is flat.
+    let size: Vec<f32> = scene
+        .objects
+        .iter()
+        .map(|o| o.shape.bounds().extent().length() as f32)
+        .collect();
     // Per object: flat, or the size under which a hit on itself is acne.
     let near: Vec<Option<f32>> = scene
         .objects
         .iter()
-        .map(|o| match &o.shape {
+        .zip(&size)
+        .map(|(o, s)| match &o.shape {
             Shape::Polygon(_) | Shape::Patch { .. } => None,
-            s => Some((s.bounds().extent().length() as f32) * NEAR),
+            _ => Some(s * NEAR),
         })
         .collect();
+    let mut displaced = 0u64;
     let mut counters = Counters::default();
     let mut hits = Vec::new();
     trace::query_all(primary, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
@@ -74,6 +91,10 @@ pub fn measure(scene: &Scene, engine: &dyn Engine, primary: &[Ray]) -> Acne {
             ng = -ng;
         }
         let above = offset_origin(p, ng);
+        if (above - p).length() > DISPLACED * size[hit.object as usize] {
+            // Every secondary ray of this hit starts that far off.
+            displaced += 2 + lights.iter().filter(|lp| ng.dot(**lp - p) > 0.0).count() as u64;
+        }
         let r = (d - ng * (2.0 * d.dot(ng))).normalize();
         rays.push(Ray::new(above, r, 0.0, f32::INFINITY));
         rays.push(Ray::new(offset_origin(p, -ng), d, 0.0, f32::INFINITY));
@@ -110,5 +131,6 @@ pub fn measure(scene: &Scene, engine: &dyn Engine, primary: &[Ray]) -> Acne {
     Acne {
         secondary: rays.len() as u64,
         acne: acne as u64,
+        displaced,
     }
 }

@@ -19,7 +19,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Eye rays through the corners of a `SIZE`×`SIZE` image on each standard scene, for acne.
-const ACNE_SIZE: u32 = 40;
+const ACNE_SIZE: u32 = 64;
 
 /// The seven scenes of the SPD tables, at their standard size factors.
 const STANDARD: [Program; 7] = [
@@ -252,5 +252,112 @@ pub fn verdict(h: &HardResults) -> Result<()> {
             "hits outside (tmin, tmax), NaN or naming no object: {}",
             bad.join(", ")
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The suite's machinery on planted faults: a triangle test that drops rays on edges must
+    //! show leaks, a tracer without the offset policy must show acne, and the shared watertight
+    //! kernel must show neither.
+
+    use super::*;
+    use rtbench_engines::geometry::kernels::f32 as k;
+    use rtbench_engines::geometry::Prim;
+    use rtbench_engines::{Engine, TriangleTest};
+
+    /// Brute force over the prepared triangles; `strict_edges` plants the classic bug (a hit
+    /// needs every barycentric strictly inside), `no_offset` makes rays start behind where the
+    /// offset put them (as a tracer without an offset would).
+    struct Planted {
+        prims: Vec<Prim>,
+        objects: Vec<u32>,
+        strict_edges: bool,
+        no_offset: bool,
+    }
+
+    impl Planted {
+        fn build(set: &CaseSet, strict_edges: bool, no_offset: bool) -> Planted {
+            Planted {
+                prims: set.geometry.prims.clone(),
+                objects: set.geometry.prim_object.clone(),
+                strict_edges,
+                no_offset,
+            }
+        }
+
+        fn trace(&self, ray: &Ray) -> Hit {
+            let mut r = *ray;
+            if self.no_offset {
+                r.origin -= r.dir * 1e-3;
+                r.tmin = 0.0;
+            }
+            let wt = k::WatertightRay::new(r.dir);
+            let mut best = Hit::MISS;
+            for (i, p) in self.prims.iter().enumerate() {
+                let found = p.intersect(&r, TriangleTest::Watertight, &wt);
+                if let Some((t, u, v)) = found {
+                    let on_edge = u <= 0.0 || v <= 0.0 || u + v >= 1.0;
+                    if t < best.t && !(self.strict_edges && on_edge) {
+                        best = Hit {
+                            t,
+                            object: self.objects[i],
+                            u,
+                            v,
+                        };
+                    }
+                }
+            }
+            best
+        }
+    }
+
+    impl Engine for Planted {
+        fn intersect(&self, rays: &[Ray], hits: &mut [Hit], _: &mut Counters) {
+            for (r, h) in rays.iter().zip(hits) {
+                *h = self.trace(r);
+            }
+        }
+        fn occluded(&self, rays: &[Ray], o: &mut [bool], _: &mut Counters) {
+            for (r, x) in rays.iter().zip(o) {
+                *x = self.trace(r).is_hit();
+            }
+        }
+        fn structure_bytes(&self) -> u64 {
+            0
+        }
+    }
+
+    fn leaks_and_acne(set: &CaseSet, e: &Planted) -> (u64, u64, u64) {
+        let truth = truth::answers(&set.scene, &set.rays);
+        let mut hits = vec![Hit::MISS; set.rays.len()];
+        e.intersect(&set.rays, &mut hits, &mut Counters::default());
+        let t = score::score(
+            &set.rays,
+            &hits,
+            &truth,
+            &set.must_hit_by,
+            set.scene.objects.len(),
+        );
+        let a = acne::measure(&set.scene, e, &set.rays);
+        (t.leaks, t.must_hit, a.acne)
+    }
+
+    #[test]
+    fn planted_leaks_and_acne_are_found_and_the_watertight_kernel_has_neither() {
+        let tetra = cases::watertight().swap_remove(0);
+        let (leaks, must, acne) = leaks_and_acne(&tetra, &Planted::build(&tetra, false, false));
+        assert!(must > 50, "too few must-hit rays: {must}");
+        assert_eq!((leaks, acne), (0, 0), "the watertight kernel");
+        let (leaks, _, _) = leaks_and_acne(&tetra, &Planted::build(&tetra, true, false));
+        assert!(
+            leaks > 10,
+            "a kernel that drops edges leaked only {leaks} times"
+        );
+        let (_, _, acne) = leaks_and_acne(&tetra, &Planted::build(&tetra, false, true));
+        assert!(
+            acne > 10,
+            "a tracer without an offset showed only {acne} acne"
+        );
     }
 }

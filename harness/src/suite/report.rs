@@ -141,7 +141,13 @@ pub fn hard_markdown(h: &HardResults) -> String {
                 .iter()
                 .chain(&r.acne_cases)
                 .find(|(n, _)| n == row)
-                .map(|(_, a)| format!("{} / {}", a.acne, a.secondary))
+                .map(|(_, a)| {
+                    if a.displaced > 0 {
+                        format!("{} / {}, displaced {}", a.acne, a.secondary, a.displaced)
+                    } else {
+                        format!("{} / {}", a.acne, a.secondary)
+                    }
+                })
                 .unwrap_or_else(|| "-".into());
             let _ = write!(s, " {a} |");
         }
@@ -266,7 +272,7 @@ fn hard_charts(h: &HardResults) -> Vec<Chart> {
             y_log: true,
             x_ticks: Vec::new(),
             lines: false,
-            legend: LegendAt::UpperRight,
+            legend: LegendAt::LowerRight,
             series,
         })
     };
@@ -346,7 +352,7 @@ pub fn tess_markdown(t: &TessResults) -> String {
         t.size + 1,
         t.seconds
     );
-    s.push_str("| scene | engine | curved trace s | RES: RMSE (time ×) | first RES under 1e-3 RMSE | its time × |\n|---|---|---|---|---|---|\n");
+    s.push_str("| scene | engine | curved query s | RES: RMSE (query time ×) | first RES under 1e-3 RMSE | its time × | RES for 1e-3 by a power-law fit |\n|---|---|---|---|---|---|---|\n");
     for c in &t.curves {
         let pts: Vec<String> = c
             .points
@@ -363,7 +369,7 @@ pub fn tess_markdown(t: &TessResults) -> String {
         let under = c.points.iter().find(|p| p.rmse < 1e-3);
         let _ = writeln!(
             s,
-            "| {} | {} | {:.3} | {}{} | {} | {} |",
+            "| {} | {} | {:.3} | {}{} | {} | {} | {} |",
             c.scene,
             c.engine,
             c.curved_s,
@@ -377,6 +383,9 @@ pub fn tess_markdown(t: &TessResults) -> String {
                 .unwrap_or_else(|| "none ≤ 8".into()),
             under
                 .map(|p| format!("{:.2}×", p.time_s / c.curved_s.max(1e-12)))
+                .unwrap_or_else(|| "-".into()),
+            super::tessellation::extrapolate(&c.points, 1e-3)
+                .map(|r| format!("{r:.0}"))
                 .unwrap_or_else(|| "-".into())
         );
     }
@@ -391,6 +400,7 @@ pub fn tess_json(t: &TessResults) -> Value {
             "scene": c.scene, "engine": c.engine, "curved_trace_s": c.curved_s,
             "points": c.points.iter().map(|p| json!({"res": p.res, "rmse": p.rmse, "trace_s": p.time_s, "triangles": p.triangles})).collect::<Vec<_>>(),
             "first_res_under_1e-3": c.points.iter().find(|p| p.rmse < 1e-3).map(|p| p.res),
+            "res_for_1e-3_power_law": super::tessellation::extrapolate(&c.points, 1e-3),
             "stopped": c.stopped,
         })).collect::<Vec<_>>(),
     })

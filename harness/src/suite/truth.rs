@@ -43,11 +43,14 @@ pub fn is_degenerate(shape: &Shape) -> bool {
     }
 }
 
+/// A primitive ready for the f64 tests: polygons as their triangles (empty for other shapes).
+type Prepared<'a> = Option<(&'a Shape, Vec<[glam::DVec3; 3]>)>;
+
 /// The right answers for `rays` in `scene`.
 pub fn answers(scene: &Scene, rays: &[Ray]) -> Vec<Truth> {
     use rayon::prelude::*;
     // Polygons as their triangles (the same ear clipping as every engine's), tested watertight.
-    let shapes: Vec<Option<(&Shape, Vec<[glam::DVec3; 3]>)>> = scene
+    let shapes: Vec<Prepared> = scene
         .objects
         .iter()
         .map(|o| match &o.shape {
