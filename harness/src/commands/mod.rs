@@ -6,3 +6,4 @@ pub mod render;
 pub mod reproduce;
 pub mod runs;
 pub mod scene;
+pub mod yamauchi;

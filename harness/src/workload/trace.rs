@@ -161,7 +161,7 @@ pub(crate) fn query_all<T: Clone + Send>(
     cpu
 }
 
-fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
+pub(crate) fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
     let scale = p.abs().max_element().max(OFFSET_MIN / OFFSET_REL) * OFFSET_REL;
     p + n * scale
 }
