@@ -123,7 +123,13 @@ fn bad(key: &str, value: &str, reason: &str) -> EngineError {
 
 /// `S` or `X,Y,Z`, each from 1.
 fn parse_subspaces(s: &str) -> Result<[u32; 3], EngineError> {
-    let err = || bad("subspaces", s, "expected S or X,Y,Z (subspaces per axis, from 1)");
+    let err = || {
+        bad(
+            "subspaces",
+            s,
+            "expected S or X,Y,Z (subspaces per axis, from 1)",
+        )
+    };
     let parts: Vec<u32> = s
         .split(',')
         .map(|p| p.trim().parse::<u32>().map_err(|_| err()))
@@ -244,7 +250,11 @@ impl ObjectSpaceConfig {
             }
         };
         if pes.iter().map(|&v| v as u64).product::<u64>() * rp_blocks as u64 > 1 << 22 {
-            return Err(bad("pes", &pes_text, "more than 2^22 ray-processing blocks"));
+            return Err(bad(
+                "pes",
+                &pes_text,
+                "more than 2^22 ray-processing blocks",
+            ));
         }
         Ok(ObjectSpaceConfig {
             subspaces,

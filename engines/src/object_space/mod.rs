@@ -84,17 +84,19 @@ pub struct ObjectSpace {
 impl ObjectSpace {
     /// Registers every primitive in each subspace its (padded) bounding box overlaps, using the
     /// grid engine's builder at the configured resolution.
-    pub fn build(input: &BuildInput, config: ObjectSpaceConfig) -> Result<ObjectSpace, EngineError> {
+    pub fn build(
+        input: &BuildInput,
+        config: ObjectSpaceConfig,
+    ) -> Result<ObjectSpace, EngineError> {
         let grid = GridConfig {
             resolution: Resolution::Explicit(config.subspaces),
             ..GridConfig::default()
         };
-        let built = build::build(&input.scene, &input.geometry, &grid).map_err(|e| {
-            EngineError::Build {
+        let built =
+            build::build(&input.scene, &input.geometry, &grid).map_err(|e| EngineError::Build {
                 engine: "object-space".into(),
                 reason: e.to_string(),
-            }
-        })?;
+            })?;
         let mut subspaces = built.cells;
         if subspaces.res != config.subspaces {
             // A scene with nothing to register: one empty subspace grid of the asked shape.

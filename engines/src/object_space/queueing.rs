@@ -135,7 +135,11 @@ pub fn simulate(model: &Model, lambda: f64, packets: usize, seed: u64) -> f64 {
     for stage in 1..=model.stages {
         // C_i: one link per source, deterministic.
         items.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let sources = items.iter().map(|i| i.1).max().map_or(0, |s| s as usize + 1);
+        let sources = items
+            .iter()
+            .map(|i| i.1)
+            .max()
+            .map_or(0, |s| s as usize + 1);
         let mut free = vec![0.0f64; sources];
         let tc = model.t_c(stage);
         for it in items.iter_mut() {

@@ -18,7 +18,7 @@
 //! - Intensity packets go to the frame buffer ([`super::framebuffer`]); the PEs do not wait.
 //!
 //! The image time is when the last RP block and the frame buffer are both done. Events are
-//! ordered by (time, ray, segment), which is unique, so a run is deterministic.
+//! ordered by (time, ray, segment, kind), which is unique, so a run is deterministic.
 
 use super::config::{Costs, FrameBuffer};
 use super::framebuffer::{self, Emission, FrameBufferStats};
@@ -26,7 +26,7 @@ use super::machine::Machine;
 use super::trace::{Trace, NO_PIXEL};
 use serde::Serialize;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, VecDeque};
 
 /// What one simulated run measured.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -35,6 +35,8 @@ pub struct SimResult {
     pub clocks: u64,
     /// When the last RP block finished.
     pub pe_clocks: u64,
+    /// When the busiest FRGU had made its last initial ray.
+    pub frgu_clocks: u64,
     /// Clocks the RP blocks were busy, in all and on the busiest PE.
     pub busy: u64,
     pub busy_max_pe: u64,
@@ -60,6 +62,61 @@ impl SimResult {
     }
 }
 
+/// What a heap entry stands for. Arrivals wait in the heap; a ray's completion in an RP block
+/// waits in that block's FIFO (completions there come in the order the work was queued), and
+/// only each FIFO's head, and each FRGU's next initial ray, is in the heap: the heap stays as
+/// small as the machine, not as the rays in flight.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Source {
+    /// A ray packet reaching the RD of the PE owning its subspace (from a link or its own PE).
+    Arrival,
+    /// The head of RP block `b`'s FIFO of completions.
+    Done(u32),
+    /// The next initial ray of PE `p`'s FRGU.
+    Frgu(u32),
+}
+
+/// One segment as the event loop needs it, made in one pass before the loop so that an event
+/// touches one place in memory: the owning PE (top bit: the ray's last segment) and the clocks
+/// of the whole packet's work in its RP block.
+#[derive(Clone, Copy)]
+struct Step {
+    pe: u32,
+    cost: u32,
+}
+
+const LAST: u32 = 1 << 31;
+const NONE: u32 = u32::MAX;
+
+fn steps(trace: &Trace, owner: &[u32], costs: &Costs) -> Vec<Step> {
+    let mut v = Vec::with_capacity(trace.segs.len());
+    for ray in &trace.rays {
+        let n = ray.seg_count;
+        for (s, seg) in trace.segments(ray).iter().enumerate() {
+            let last = s as u32 + 1 == n;
+            let dda = if s == 0 { costs.dda_init } else { costs.dda };
+            let tail = if !last {
+                dda + costs.packet
+            } else if ray.hit {
+                let icu = if ray.pixel != NO_PIXEL {
+                    costs.intensity
+                } else {
+                    0
+                };
+                icu.max(costs.secondary * ray.children)
+            } else {
+                // The DDA finds no next subspace: the ray leaves the space and vanishes.
+                dda
+            };
+            v.push(Step {
+                pe: owner[seg.subspace as usize] | if last { LAST } else { 0 },
+                cost: seg.work.saturating_add(tail),
+            });
+        }
+    }
+    v
+}
+
 /// Simulates `trace` on `machine`; `owner[s]` is the PE of subspace s, `width` the image width
 /// (pixels index the frame buffer row by row).
 pub fn simulate(
@@ -72,11 +129,14 @@ pub fn simulate(
 ) -> SimResult {
     let pes = machine.pe_count();
     let rpb = machine.rp_blocks as usize;
+    let steps = steps(trace, owner, costs);
     let mut rp_free = vec![0u64; pes * rpb];
+    // Per RP block: (end, ray, segment, PE of the ray's next segment or NONE).
+    let mut fifo: Vec<VecDeque<(u64, u32, u32, u32)>> = vec![VecDeque::new(); pes * rpb];
     let mut busy = vec![0u64; pes];
-    let mut frgu = vec![0u64; pes];
     let mut link_free = vec![0u64; pes * 6];
-    let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+    // Entries (time, ray, global segment index, source): unique, so the order is total.
+    let mut heap: BinaryHeap<Reverse<(u64, u32, u32, Source)>> = BinaryHeap::new();
     let mut r = SimResult {
         pes: pes as u64,
         rp_blocks: rpb as u64,
@@ -84,15 +144,28 @@ pub fn simulate(
     };
     let mut emissions: Vec<Emission> = Vec::new();
 
+    // Each FRGU's initial rays, in ray order.
+    let mut roots: Vec<Vec<u32>> = vec![Vec::new(); pes];
     for (i, ray) in trace.rays.iter().enumerate() {
         if ray.root && ray.seg_count > 0 {
-            let pe = owner[trace.segs[ray.seg_start as usize].subspace as usize] as usize;
-            frgu[pe] += if ray.initial {
-                costs.primary
-            } else {
-                costs.secondary
-            } as u64;
-            heap.push(Reverse((frgu[pe], i as u32, 0)));
+            let pe = steps[ray.seg_start as usize].pe & !LAST;
+            roots[pe as usize].push(i as u32);
+        }
+    }
+    let gen_cost = |ri: u32| -> u64 {
+        if trace.rays[ri as usize].initial {
+            costs.primary as u64
+        } else {
+            costs.secondary as u64
+        }
+    };
+    let mut frgu_next = vec![0usize; pes];
+    let mut frgu_time = vec![0u64; pes];
+    for (pe, list) in roots.iter().enumerate() {
+        if let Some(&ri) = list.first() {
+            frgu_time[pe] = gen_cost(ri);
+            let k = trace.rays[ri as usize].seg_start;
+            heap.push(Reverse((frgu_time[pe], ri, k, Source::Frgu(pe as u32))));
         }
     }
 
@@ -106,75 +179,93 @@ pub fn simulate(
         start + hops as u64 * costs.hop as u64
     };
 
-    while let Some(Reverse((t, ri, s))) = heap.pop() {
+    while let Some(Reverse((t, ri, k, src))) = heap.pop() {
+        match src {
+            Source::Frgu(p) => {
+                let p = p as usize;
+                frgu_next[p] += 1;
+                if let Some(&next) = roots[p].get(frgu_next[p]) {
+                    frgu_time[p] += gen_cost(next);
+                    let kn = trace.rays[next as usize].seg_start;
+                    heap.push(Reverse((frgu_time[p], next, kn, Source::Frgu(p as u32))));
+                }
+            }
+            Source::Done(b) => {
+                let q = &mut fifo[b as usize];
+                let (_, _, _, next) = q.pop_front().expect("a FIFO head is in the heap");
+                if let Some(&(te, rn, kn, _)) = q.front() {
+                    heap.push(Reverse((te, rn, kn, Source::Done(b))));
+                }
+                let pe = b / rpb as u32;
+                // The ray leaves the RP block: on to its next subspace, or its hit's results.
+                if next != NONE {
+                    let at = if next == pe {
+                        t
+                    } else {
+                        send(pe, next, t, &mut r)
+                    };
+                    heap.push(Reverse((at, ri, k + 1, Source::Arrival)));
+                    continue;
+                }
+                let ray = &trace.rays[ri as usize];
+                if !ray.hit {
+                    continue;
+                }
+                if ray.pixel != NO_PIXEL {
+                    emissions.push(Emission {
+                        time: t,
+                        pe,
+                        pixel: ray.pixel,
+                    });
+                }
+                for c in ray.first_child..ray.first_child + ray.children {
+                    let child = &trace.rays[c as usize];
+                    if child.seg_count == 0 {
+                        continue;
+                    }
+                    let kc = child.seg_start;
+                    let next = steps[kc as usize].pe & !LAST;
+                    let at = if next == pe {
+                        t
+                    } else {
+                        send(pe, next, t, &mut r)
+                    };
+                    heap.push(Reverse((at, c, kc, Source::Arrival)));
+                }
+                continue;
+            }
+            Source::Arrival => {}
+        }
+        // An arrival (or a ray the FRGU has just made): the RD dispatches it to the PE's
+        // least-loaded RP block.
         r.events += 1;
-        let ray = &trace.rays[ri as usize];
-        let segs = trace.segments(ray);
-        let seg = segs[s as usize];
-        let pe = owner[seg.subspace as usize];
-        let last = s + 1 == ray.seg_count;
-        let dda = if s == 0 { costs.dda_init } else { costs.dda };
-        let tail = if !last {
-            dda + costs.packet
-        } else if ray.hit {
-            let icu = if ray.pixel != NO_PIXEL {
-                costs.intensity
-            } else {
-                0
-            };
-            icu.max(costs.secondary * ray.children)
+        let step = steps[k as usize];
+        let pe = step.pe & !LAST;
+        let next = if step.pe & LAST != 0 {
+            NONE
         } else {
-            // The DDA finds no next subspace: the ray leaves the space and vanishes.
-            dda
+            steps[k as usize + 1].pe & !LAST
         };
-        let cost = (seg.work + tail) as u64;
-        // The RD: least-loaded RP block of this PE.
-        let blocks = &mut rp_free[pe as usize * rpb..(pe as usize + 1) * rpb];
+        let cost = step.cost as u64;
+        let base = pe as usize * rpb;
+        let blocks = &mut rp_free[base..base + rpb];
         let mut best = 0;
-        for (k, &f) in blocks.iter().enumerate().skip(1) {
+        for (j, &f) in blocks.iter().enumerate().skip(1) {
             if f < blocks[best] {
-                best = k;
+                best = j;
             }
         }
         let end = t.max(blocks[best]) + cost;
         blocks[best] = end;
         busy[pe as usize] += cost;
         r.pe_clocks = r.pe_clocks.max(end);
-
-        if !last {
-            let next = owner[segs[s as usize + 1].subspace as usize];
-            let at = if next == pe {
-                end
-            } else {
-                send(pe, next, end, &mut r)
-            };
-            heap.push(Reverse((at, ri, s + 1)));
-            continue;
+        let b = base + best;
+        if fifo[b].is_empty() {
+            heap.push(Reverse((end, ri, k, Source::Done(b as u32))));
         }
-        if !ray.hit {
-            continue;
-        }
-        if ray.pixel != NO_PIXEL {
-            emissions.push(Emission {
-                time: end,
-                pe,
-                pixel: ray.pixel,
-            });
-        }
-        for c in ray.first_child..ray.first_child + ray.children {
-            let child = &trace.rays[c as usize];
-            if child.seg_count == 0 {
-                continue;
-            }
-            let next = owner[trace.segs[child.seg_start as usize].subspace as usize];
-            let at = if next == pe {
-                end
-            } else {
-                send(pe, next, end, &mut r)
-            };
-            heap.push(Reverse((at, c, 0)));
-        }
+        fifo[b].push_back((end, ri, k, next));
     }
+    r.frgu_clocks = frgu_time.iter().copied().max().unwrap_or(0);
     r.busy = busy.iter().sum();
     r.busy_max_pe = busy.iter().copied().max().unwrap_or(0);
     r.frame_buffer = framebuffer::simulate(&mut emissions, pes as u32, costs, frame_buffer, width);

@@ -14,8 +14,8 @@ use crate::geometry::Geometry;
 use crate::ray::{Hit, Ray};
 use crate::{build_engine, EngineError};
 use glam::Vec3;
-use rtbench_scenes::spd::{Options, Program};
 use rtbench_scenes::generate_scene;
+use rtbench_scenes::spd::{Options, Program};
 use std::sync::Arc;
 
 fn spd(program: Program, sf: u32) -> BuildInput {
@@ -47,7 +47,9 @@ fn rays(input: &BuildInput, n: usize) -> Vec<Ray> {
     let (lo, hi) = (input.geometry.bounds_min, input.geometry.bounds_max);
     let mut s = 0x1234_5678u64;
     let mut unit = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 40) as f32 / (1u64 << 24) as f32
     };
     (0..n)
@@ -79,7 +81,12 @@ fn bad_settings_are_errors() {
     assert!(config(&[("subspaces", "0")]).is_err());
     assert!(config(&[("frame_buffer", "cfbs:1")]).is_err());
     assert!(config(&[("nonsense", "1")]).is_err());
-    let c = config(&[("pes", "8x4"), ("subspaces", "16,8,4"), ("cost.sphere", "2000")]).unwrap();
+    let c = config(&[
+        ("pes", "8x4"),
+        ("subspaces", "16,8,4"),
+        ("cost.sphere", "2000"),
+    ])
+    .unwrap();
     assert_eq!(c.machine.pes, [8, 4, 1]);
     assert_eq!(c.machine.dims, 2);
     assert_eq!(c.costs.sphere, 2000);
@@ -146,7 +153,11 @@ fn hits_equal_the_reference_engine() {
                 same += 1;
             }
         }
-        assert!(same >= rs.len() - 2, "{program:?}: {same} of {} agree", rs.len());
+        assert!(
+            same >= rs.len() - 2,
+            "{program:?}: {same} of {} agree",
+            rs.len()
+        );
         let (mut oa, mut ob) = (vec![false; rs.len()], vec![false; rs.len()]);
         let short: Vec<Ray> = rs.iter().map(|r| Ray { tmax: 2.0, ..*r }).collect();
         os.occluded(&short, &mut oa, &mut Counters::default());

@@ -95,7 +95,9 @@ pub fn run(
         )));
     }
     match id {
-        "yamauchi-static-lb" => return yamauchi::static_lb(id, quick, limits, out, threads, as_json),
+        "yamauchi-static-lb" => {
+            return yamauchi::static_lb(id, quick, limits, out, threads, as_json)
+        }
         "yamauchi-dynamic-lb" => {
             return yamauchi::dynamic_lb(id, quick, limits, out, threads, as_json)
         }

@@ -207,7 +207,7 @@ fn pass_json(t: &Traced) -> Value {
 fn sim_json(r: &SimResult, t1: u64, blocks: u64, wall: f64) -> Value {
     let speedup = t1 as f64 / r.clocks as f64;
     json!({"clocks": r.clocks, "speedup": speedup, "efficiency": speedup / blocks as f64,
-        "utilisation": r.utilisation(), "imbalance": r.imbalance(), "events": r.events,
+        "utilisation": r.utilisation(), "imbalance": r.imbalance(), "frgu_clocks": r.frgu_clocks, "events": r.events,
         "packets": r.packets, "hops": r.hops, "frame_buffer": r.frame_buffer, "wall_s": wall,
         "events_per_s": r.events as f64 / wall.max(1e-9)})
 }
@@ -238,8 +238,17 @@ pub fn static_lb(
     let pool = workload::pool(threads)?;
     let traced = trace_scenes(&scenes, size, out)?;
     let mut md = String::new();
-    let _ = writeln!(md, "# yamauchi-static-lb: (Mπ)² static load balancing on SPD scenes\n");
-    let _ = writeln!(md, "Source: {}; {}. {}\n", published["source"]["document"].as_str().unwrap_or(""), published["source"]["sections"].as_str().unwrap_or(""), published["source"]["note"].as_str().unwrap_or(""));
+    let _ = writeln!(
+        md,
+        "# yamauchi-static-lb: (Mπ)² static load balancing on SPD scenes\n"
+    );
+    let _ = writeln!(
+        md,
+        "Source: {}; {}. {}\n",
+        published["source"]["document"].as_str().unwrap_or(""),
+        published["source"]["sections"].as_str().unwrap_or(""),
+        published["source"]["note"].as_str().unwrap_or("")
+    );
     let _ = writeln!(md, "Measured: `rtbench reproduce {id}{}` — 003's ray-tracing pass (1 primary ray per pixel centre, ≤ 3 reflections, no shadow rays) at {size}×{size}, 32³ subspaces, 1 RP block per PE, Table 4 costs, direct frame buffer; PEs up to {max_pes} (a 1D machine's PE count must divide the 32 subspaces of its axis, so 1D stops at 32; 3D has no skewed allocation in 003). Efficiency = T(1 PE) / (T × PEs).\n", if quick { " --quick" } else { "" });
     let mut rows = Vec::new();
     let mut findings = Vec::new();
@@ -247,8 +256,16 @@ pub fn static_lb(
         let mut machines = vec![(machine(1, 1, Allocation::Block, 1), FrameBuffer::Direct)];
         let mut keys = vec![(1u8, Allocation::Block, 1u32)];
         for dims in 1..=3u8 {
-            let cap = if dims == 1 { max_pes.min(32) } else { max_pes.min(1024) };
-            for alloc in [Allocation::Block, Allocation::Distributed, Allocation::Skewed] {
+            let cap = if dims == 1 {
+                max_pes.min(32)
+            } else {
+                max_pes.min(1024)
+            };
+            for alloc in [
+                Allocation::Block,
+                Allocation::Distributed,
+                Allocation::Skewed,
+            ] {
                 if dims == 3 && alloc == Allocation::Skewed {
                     continue;
                 }
@@ -270,12 +287,27 @@ pub fn static_lb(
                 .map(|i| t1 as f64 / (results[i].0.clocks as f64 * p as f64))
         };
         // Table and JSON.
-        let _ = writeln!(md, "## {} (T(1 PE) = {t1} clocks; {} rays, {} subspace visits)\n", t.label, t.pass.primary + t.pass.secondary, t.pass.trace.segs.len());
+        let _ = writeln!(
+            md,
+            "## {} (T(1 PE) = {t1} clocks; {} rays, {} subspace visits)\n",
+            t.label,
+            t.pass.primary + t.pass.secondary,
+            t.pass.trace.segs.len()
+        );
         let _ = writeln!(md, "| PEs | 1D block | 1D distributed | 1D skewed | 2D block | 2D distributed | 2D skewed | 3D block | 3D distributed |");
         let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
         for p in powers(max_pes.min(1024)) {
             let mut cells = Vec::new();
-            for (d, a) in [(1, Allocation::Block), (1, Allocation::Distributed), (1, Allocation::Skewed), (2, Allocation::Block), (2, Allocation::Distributed), (2, Allocation::Skewed), (3, Allocation::Block), (3, Allocation::Distributed)] {
+            for (d, a) in [
+                (1, Allocation::Block),
+                (1, Allocation::Distributed),
+                (1, Allocation::Skewed),
+                (2, Allocation::Block),
+                (2, Allocation::Distributed),
+                (2, Allocation::Skewed),
+                (3, Allocation::Block),
+                (3, Allocation::Distributed),
+            ] {
                 cells.push(eff(d, a, p).map_or("–".to_string(), |e| format!("{:.1}%", e * 100.0)));
             }
             let _ = writeln!(md, "| {p} | {} |", cells.join(" | "));
@@ -294,10 +326,16 @@ pub fn static_lb(
         let mut order_md = Vec::new();
         let mut ordering_holds = true;
         for dims in 1..=3u8 {
-            let cap = if dims == 1 { max_pes.min(32) } else { max_pes.min(1024) };
+            let cap = if dims == 1 {
+                max_pes.min(32)
+            } else {
+                max_pes.min(1024)
+            };
             let ps: Vec<u32> = powers(cap).into_iter().filter(|&p| p > 1).collect();
             let count = |a: Allocation, b: Allocation| {
-                ps.iter().filter(|&&p| eff(dims, a, p) < eff(dims, b, p)).count()
+                ps.iter()
+                    .filter(|&&p| eff(dims, a, p) < eff(dims, b, p))
+                    .count()
             };
             let bd = count(Allocation::Block, Allocation::Distributed);
             if dims < 3 {
@@ -307,18 +345,40 @@ pub fn static_lb(
                 order_md.push(format!("{dims}D: block < distributed at {bd}/{n}, distributed < skewed at {ds}/{n}, block < skewed at {bs}/{n} PE counts", n = ps.len()));
                 order.insert(format!("{dims}d"), json!({"pe_counts": ps, "block_lt_distributed": bd, "distributed_lt_skewed": ds, "block_lt_skewed": bs}));
             } else {
-                order_md.push(format!("3D: block < distributed at {bd}/{} PE counts", ps.len()));
-                order.insert("3d".into(), json!({"pe_counts": ps, "block_lt_distributed": bd}));
+                order_md.push(format!(
+                    "3D: block < distributed at {bd}/{} PE counts",
+                    ps.len()
+                ));
+                order.insert(
+                    "3d".into(),
+                    json!({"pe_counts": ps, "block_lt_distributed": bd}),
+                );
             }
         }
-        let ps23: Vec<u32> = powers(max_pes.min(1024)).into_iter().filter(|&p| p > 1).collect();
-        let skew_ge = ps23.iter().filter(|&&p| eff(2, Allocation::Skewed, p) >= eff(3, Allocation::Distributed, p)).count();
+        let ps23: Vec<u32> = powers(max_pes.min(1024))
+            .into_iter()
+            .filter(|&p| p > 1)
+            .collect();
+        let skew_ge = ps23
+            .iter()
+            .filter(|&&p| eff(2, Allocation::Skewed, p) >= eff(3, Allocation::Distributed, p))
+            .count();
         let e256 = eff(2, Allocation::Skewed, 256);
         let b256 = eff(2, Allocation::Block, 256);
         let verdict = |b: bool| if b { "holds" } else { "does not hold" };
         let _ = writeln!(md, "\nFindings on {}:\n", t.label);
-        let _ = writeln!(md, "- Ordering block < distributed < skewed: skewed above both {}; {}.", verdict(ordering_holds), order_md.join("; "));
-        let _ = writeln!(md, "- 2D skewed ≥ 3D distributed: at {skew_ge}/{} PE counts ({}).", ps23.len(), verdict(skew_ge == ps23.len()));
+        let _ = writeln!(
+            md,
+            "- Ordering block < distributed < skewed: skewed above both {}; {}.",
+            verdict(ordering_holds),
+            order_md.join("; ")
+        );
+        let _ = writeln!(
+            md,
+            "- 2D skewed ≥ 3D distributed: at {skew_ge}/{} PE counts ({}).",
+            ps23.len(),
+            verdict(skew_ge == ps23.len())
+        );
         match e256 {
             Some(e) => {
                 let _ = writeln!(md, "- 2D, 256 PEs, skewed above 60%: {:.1}% ({}); 2D block at 256 PEs: {:.1}% (003, radiosity: about 20%).\n", e * 100.0, verdict(e > 0.6), b256.unwrap_or(0.0) * 100.0);
@@ -327,28 +387,72 @@ pub fn static_lb(
                 let _ = writeln!(md, "- 2D, 256 PEs: not run (--max-pes below 256).\n");
             }
         }
-        findings.push(json!({"scene": t.label, "ordering": order, "skewed_above_both": ordering_holds,
+        findings.push(
+            json!({"scene": t.label, "ordering": order, "skewed_above_both": ordering_holds,
             "2d_skewed_ge_3d_distributed": {"pe_counts": ps23.len(), "holds_at": skew_ge},
             "2d_skewed_256_efficiency": e256, "2d_block_256_efficiency": b256,
-            "2d_256_above_60": e256.map(|e| e > 0.6)}));
+            "2d_256_above_60": e256.map(|e| e > 0.6)}),
+        );
         rows.push(json!({"pass": pass_json(t), "t1_clocks": t1, "runs": sims}));
         // Plots: efficiency and speed-up vs PEs, a panel per dimension, and 2D skewed vs 3D distributed.
         let pts = |dims: u8, a: Allocation, speed: bool| -> Vec<(f64, f64)> {
-            let cap = if dims == 1 { max_pes.min(32) } else { max_pes.min(1024) };
-            powers(cap).into_iter().filter_map(|p| eff(dims, a, p).map(|e| (p as f64, if speed { e * p as f64 } else { e }))).collect()
+            let cap = if dims == 1 {
+                max_pes.min(32)
+            } else {
+                max_pes.min(1024)
+            };
+            powers(cap)
+                .into_iter()
+                .filter_map(|p| {
+                    eff(dims, a, p).map(|e| (p as f64, if speed { e * p as f64 } else { e }))
+                })
+                .collect()
         };
-        for (what, speed, legend) in [("efficiency", false, LegendAt::UpperRight), ("speedup", true, LegendAt::UpperLeft)] {
-            let panels = (1..=3u8).map(|d| {
-                let mut s = vec![series("block", 1, &pts(d, Allocation::Block, speed)), series("distributed", 2, &pts(d, Allocation::Distributed, speed))];
-                if d < 3 {
-                    s.push(series("skewed", 3, &pts(d, Allocation::Skewed, speed)));
-                }
-                panel(&format!("{d}D torus"), "PEs", what, s, legend)
-            }).collect();
-            write_plot(out, &Chart { stem: format!("{id}-{}-{what}", t.label), title: format!("{}: {what} vs PEs (003's pass, {size}x{size}, 1 RP block)", t.label), panels })?;
+        for (what, speed, legend) in [
+            ("efficiency", false, LegendAt::UpperRight),
+            ("speedup", true, LegendAt::UpperLeft),
+        ] {
+            let panels = (1..=3u8)
+                .map(|d| {
+                    let mut s = vec![
+                        series("block", 1, &pts(d, Allocation::Block, speed)),
+                        series("distributed", 2, &pts(d, Allocation::Distributed, speed)),
+                    ];
+                    if d < 3 {
+                        s.push(series("skewed", 3, &pts(d, Allocation::Skewed, speed)));
+                    }
+                    panel(&format!("{d}D torus"), "PEs", what, s, legend)
+                })
+                .collect();
+            write_plot(
+                out,
+                &Chart {
+                    stem: format!("{id}-{}-{what}", t.label),
+                    title: format!(
+                        "{}: {what} vs PEs (003's pass, {size}x{size}, 1 RP block)",
+                        t.label
+                    ),
+                    panels,
+                },
+            )?;
         }
-        write_plot(out, &Chart { stem: format!("{id}-{}-2d-skewed-vs-3d-distributed", t.label), title: format!("{}: 2D skewed vs 3D distributed (003 Fig. 34)", t.label),
-            panels: vec![panel("efficiency", "PEs", "efficiency", vec![series("2D skewed", 3, &pts(2, Allocation::Skewed, false)), series("3D distributed", 2, &pts(3, Allocation::Distributed, false))], LegendAt::UpperRight)] })?;
+        write_plot(
+            out,
+            &Chart {
+                stem: format!("{id}-{}-2d-skewed-vs-3d-distributed", t.label),
+                title: format!("{}: 2D skewed vs 3D distributed (003 Fig. 34)", t.label),
+                panels: vec![panel(
+                    "efficiency",
+                    "PEs",
+                    "efficiency",
+                    vec![
+                        series("2D skewed", 3, &pts(2, Allocation::Skewed, false)),
+                        series("3D distributed", 2, &pts(3, Allocation::Distributed, false)),
+                    ],
+                    LegendAt::UpperRight,
+                )],
+            },
+        )?;
     }
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size, "max_pes": max_pes,
         "measured": rows, "findings": findings,
@@ -381,7 +485,9 @@ pub fn dynamic_lb(
         .filter(|&p| p <= max_pes)
         .collect();
     if pe_counts.is_empty() {
-        return Err(input("--max-pes must be at least 16 for yamauchi-dynamic-lb"));
+        return Err(input(
+            "--max-pes must be at least 16 for yamauchi-dynamic-lb",
+        ));
     }
     let blocks: Vec<u32> = if quick {
         vec![1, 2, 4, 8, 16]
@@ -391,8 +497,17 @@ pub fn dynamic_lb(
     let pool = workload::pool(threads)?;
     let traced = trace_scenes(&scenes, size, out)?;
     let mut md = String::new();
-    let _ = writeln!(md, "# yamauchi-dynamic-lb: (Mπ)² dynamic load balancing on SPD scenes\n");
-    let _ = writeln!(md, "Source: {}; {}. {}\n", published["source"]["document"].as_str().unwrap_or(""), published["source"]["sections"].as_str().unwrap_or(""), published["source"]["note"].as_str().unwrap_or(""));
+    let _ = writeln!(
+        md,
+        "# yamauchi-dynamic-lb: (Mπ)² dynamic load balancing on SPD scenes\n"
+    );
+    let _ = writeln!(
+        md,
+        "Source: {}; {}. {}\n",
+        published["source"]["document"].as_str().unwrap_or(""),
+        published["source"]["sections"].as_str().unwrap_or(""),
+        published["source"]["note"].as_str().unwrap_or("")
+    );
     let _ = writeln!(md, "Measured: `rtbench reproduce {id}{}` — 003's pass at {size}×{size}, 32³ subspaces, 2D torus, skewed allocation, least-loaded dispatch to R RP blocks per PE, direct frame buffer. Efficiency = T(1 PE, 1 RP block) / (T × PEs × R) (003 eq. 25).\n", if quick { " --quick" } else { "" });
     let mut rows = Vec::new();
     let mut findings = Vec::new();
@@ -408,36 +523,72 @@ pub fn dynamic_lb(
         eprintln!("{}: simulating {} machines …", t.label, machines.len());
         let results = pool.install(|| run_all(t, &machines));
         let t1 = results[0].0.clocks;
-        let get = |p: u32, r: u32| keys.iter().position(|k| *k == (p, r)).map(|i| &results[i].0);
+        let get = |p: u32, r: u32| {
+            keys.iter()
+                .position(|k| *k == (p, r))
+                .map(|i| &results[i].0)
+        };
         let speed = |p: u32, r: u32| get(p, r).map(|s| t1 as f64 / s.clocks as f64);
         let eff = |p: u32, r: u32| speed(p, r).map(|s| s / (p * r) as f64);
         let _ = writeln!(md, "## {} (T(1 PE, 1 RP block) = {t1} clocks)\n", t.label);
         let _ = writeln!(md, "Efficiency (speed-up) by PEs × RP blocks per PE:\n");
-        let _ = writeln!(md, "| PEs | {} |", blocks.iter().map(|r| format!("R = {r}")).collect::<Vec<_>>().join(" | "));
+        let _ = writeln!(
+            md,
+            "| PEs | {} |",
+            blocks
+                .iter()
+                .map(|r| format!("R = {r}"))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
         let _ = writeln!(md, "|---|{}", "---|".repeat(blocks.len()));
         let mut stops = serde_json::Map::new();
         for &p in &pe_counts {
-            let cells: Vec<String> = blocks.iter().map(|&r| format!("{:.1}% ({:.0}×)", eff(p, r).unwrap() * 100.0, speed(p, r).unwrap())).collect();
+            let cells: Vec<String> = blocks
+                .iter()
+                .map(|&r| {
+                    format!(
+                        "{:.1}% ({:.0}×)",
+                        eff(p, r).unwrap() * 100.0,
+                        speed(p, r).unwrap()
+                    )
+                })
+                .collect();
             let _ = writeln!(md, "| {p} | {} |", cells.join(" | "));
             // Where gains stop: the first R whose doubling gains under 10% speed-up.
-            let stop = blocks.windows(2).find(|w| speed(p, w[1]).unwrap() / speed(p, w[0]).unwrap() < 1.1).map(|w| w[0]);
+            let stop = blocks
+                .windows(2)
+                .find(|w| speed(p, w[1]).unwrap() / speed(p, w[0]).unwrap() < 1.1)
+                .map(|w| w[0]);
             stops.insert(p.to_string(), json!(stop));
         }
         let pair = |p: u32, r: u32| eff(p, r).map(|e| (e, speed(p, r).unwrap()));
         let e64x16 = pair(64, 16);
         let e256x4 = pair(256, 4);
         let e256x8 = pair(256, 8);
-        let best4096 = [(128u32, 32u32), (256, 16), (1024, 4)].iter().filter_map(|&(p, r)| pair(p, r).map(|v| (p, r, v))).collect::<Vec<_>>();
+        let best4096 = [(128u32, 32u32), (256, 16), (1024, 4)]
+            .iter()
+            .filter_map(|&(p, r)| pair(p, r).map(|v| (p, r, v)))
+            .collect::<Vec<_>>();
         let _ = writeln!(md, "\nFindings on {}:\n", t.label);
         let _ = writeln!(md, "- Gains stop (doubling R gains < 10%) after R = {} by PE count {} (003: about 8 for every PE count).", stops.values().map(|v| v.as_u64().map_or("none in range".to_string(), |x| x.to_string())).collect::<Vec<_>>().join(", "), pe_counts.iter().map(|p| p.to_string()).collect::<Vec<_>>().join(", "));
         if let (Some(a), Some(b)) = (e64x16, e256x4) {
             let _ = writeln!(md, "- Equal total of 1024 RP blocks: 64 × 16 at {:.1}% (003: > 60%), 256 × 4 at {:.1}% (003: > 50%); fewer PEs with more blocks better: {}.", a.0 * 100.0, b.0 * 100.0, if a.0 > b.0 { "yes" } else { "no" });
         }
         if let Some(c) = e256x8 {
-            let _ = writeln!(md, "- 256 × 8 (2048 RP blocks): {:.1}% (003, ray tracing: ≥ 50%).", c.0 * 100.0);
+            let _ = writeln!(
+                md,
+                "- 256 × 8 (2048 RP blocks): {:.1}% (003, ray tracing: ≥ 50%).",
+                c.0 * 100.0
+            );
         }
         for (p, r, v) in &best4096 {
-            let _ = writeln!(md, "- {p} × {r} = 4096 RP blocks: {:.1}%, speed-up {:.0}× (003: > 60%, about 2500×).", v.0 * 100.0, v.1);
+            let _ = writeln!(
+                md,
+                "- {p} × {r} = 4096 RP blocks: {:.1}%, speed-up {:.0}× (003: > 60%, about 2500×).",
+                v.0 * 100.0,
+                v.1
+            );
         }
         let _ = writeln!(md);
         let mut sims = Vec::new();
@@ -451,14 +602,50 @@ pub fn dynamic_lb(
             "64x16": e64x16.map(|v| v.0), "256x4": e256x4.map(|v| v.0), "256x8": e256x8.map(|v| v.0),
             "4096_blocks": best4096.iter().map(|(p, r, v)| json!({"pes": p, "rp_blocks": r, "efficiency": v.0, "speedup": v.1})).collect::<Vec<_>>()}));
         rows.push(json!({"pass": pass_json(t), "t1_clocks": t1, "runs": sims}));
-        let panels = ["efficiency", "speedup"].iter().map(|what| {
-            let s = pe_counts.iter().enumerate().map(|(i, &p)| {
-                let pts: Vec<(f64, f64)> = blocks.iter().map(|&r| (r as f64, if *what == "efficiency" { eff(p, r).unwrap() } else { speed(p, r).unwrap() })).collect();
-                series(&format!("{p} PEs"), i + 1, &pts)
-            }).collect();
-            panel(what, "RP blocks per PE", what, s, if *what == "efficiency" { LegendAt::UpperRight } else { LegendAt::UpperLeft })
-        }).collect();
-        write_plot(out, &Chart { stem: format!("{id}-{}", t.label), title: format!("{}: 2D skewed, vs RP blocks per PE (003 Fig. 35)", t.label), panels })?;
+        let panels = ["efficiency", "speedup"]
+            .iter()
+            .map(|what| {
+                let s = pe_counts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &p)| {
+                        let pts: Vec<(f64, f64)> = blocks
+                            .iter()
+                            .map(|&r| {
+                                (
+                                    r as f64,
+                                    if *what == "efficiency" {
+                                        eff(p, r).unwrap()
+                                    } else {
+                                        speed(p, r).unwrap()
+                                    },
+                                )
+                            })
+                            .collect();
+                        series(&format!("{p} PEs"), i + 1, &pts)
+                    })
+                    .collect();
+                panel(
+                    what,
+                    "RP blocks per PE",
+                    what,
+                    s,
+                    if *what == "efficiency" {
+                        LegendAt::UpperRight
+                    } else {
+                        LegendAt::UpperLeft
+                    },
+                )
+            })
+            .collect();
+        write_plot(
+            out,
+            &Chart {
+                stem: format!("{id}-{}", t.label),
+                title: format!("{}: 2D skewed, vs RP blocks per PE (003 Fig. 35)", t.label),
+                panels,
+            },
+        )?;
     }
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size, "pe_counts": pe_counts, "rp_blocks": blocks,
         "measured": rows, "findings": findings,
@@ -484,17 +671,42 @@ pub fn cfbs(
     let packets = if quick { 50_000 } else { 400_000 };
     let mut md = String::new();
     let _ = writeln!(md, "# yamauchi-cfbs: the cached frame buffer system\n");
-    let _ = writeln!(md, "Source: {}; {}. {}\n", published["source"]["document"].as_str().unwrap_or(""), published["source"]["sections"].as_str().unwrap_or(""), published["source"]["note"].as_str().unwrap_or(""));
-    let _ = writeln!(md, "Measured: `rtbench reproduce {id}{}`.\n", if quick { " --quick" } else { "" });
+    let _ = writeln!(
+        md,
+        "Source: {}; {}. {}\n",
+        published["source"]["document"].as_str().unwrap_or(""),
+        published["source"]["sections"].as_str().unwrap_or(""),
+        published["source"]["note"].as_str().unwrap_or("")
+    );
+    let _ = writeln!(
+        md,
+        "Measured: `rtbench reproduce {id}{}`.\n",
+        if quick { " --quick" } else { "" }
+    );
 
     // 1. The analytic model: saturation by configuration and by miss rate.
     let _ = writeln!(md, "## Queueing model (eqs. 11-21, Table 3)\n\n| m-ary n-stage | P_M | saturation λ_PE (per PE per clock) | digest's derived value |\n|---|---|---|---|");
-    let derived = published["claims"].as_array().unwrap().iter().find(|c| c["id"] == "derived-saturation").unwrap()["rows"].clone();
+    let derived = published["claims"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"] == "derived-saturation")
+        .unwrap()["rows"]
+        .clone();
     let mut model_rows = Vec::new();
     for (m, n) in [(2u32, 10u32), (4, 5), (32, 2), (1024, 1)] {
         let s = Model::table3(m, n, 0.5).saturation();
-        let d = derived.as_array().unwrap().iter().find(|r| r["m"] == m).map(|r| r["saturation"].as_f64().unwrap());
-        let _ = writeln!(md, "| {m}-ary {n}-stage | 0.5 | {s:.4e} | {} |", d.map_or("–".into(), |d| format!("{d:.4e}")));
+        let d = derived
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["m"] == m)
+            .map(|r| r["saturation"].as_f64().unwrap());
+        let _ = writeln!(
+            md,
+            "| {m}-ary {n}-stage | 0.5 | {s:.4e} | {} |",
+            d.map_or("–".into(), |d| format!("{d:.4e}"))
+        );
         model_rows.push(json!({"m": m, "stages": n, "miss": 0.5, "saturation": s, "derived": d}));
     }
     for pm in [0.1, 0.3, 0.7, 0.9, 1.0] {
@@ -508,31 +720,91 @@ pub fn cfbs(
     // 2. Model vs random-arrival simulation, 4-ary 5-stage, P_M = 0.5.
     let model = Model::table3(4, 5, 0.5);
     let sat = model.saturation();
-    let lambdas: Vec<f64> = (0..=16).map(|k| 1e-7 * 10f64.powf(k as f64 * 0.25)).filter(|&l| l < sat * 20.0).collect();
-    let sims: Vec<f64> = pool.install(|| lambdas.par_iter().map(|&l| queueing::simulate(&model, l, packets, 1997)).collect());
+    let lambdas: Vec<f64> = (0..=16)
+        .map(|k| 1e-7 * 10f64.powf(k as f64 * 0.25))
+        .filter(|&l| l < sat * 20.0)
+        .collect();
+    let sims: Vec<f64> = pool.install(|| {
+        lambdas
+            .par_iter()
+            .map(|&l| queueing::simulate(&model, l, packets, 1997))
+            .collect()
+    });
     let _ = writeln!(md, "## 4-ary 5-stage, P_M = 0.5: model vs random-arrival simulation ({packets} packets per point)\n\n| λ_PE | model L_mean as printed | model L_mean normalised | simulated L_mean |\n|---|---|---|---|");
     let mut curve = Vec::new();
     for (&l, &s) in lambdas.iter().zip(&sims) {
         let m = model.latency(l);
-        let _ = writeln!(md, "| {l:.3e} | {} | {} | {s:.1} |", m.map_or("saturated".into(), |v| format!("{:.1}", v.0)), m.map_or("saturated".into(), |v| format!("{:.1}", v.1)));
+        let _ = writeln!(
+            md,
+            "| {l:.3e} | {} | {} | {s:.1} |",
+            m.map_or("saturated".into(), |v| format!("{:.1}", v.0)),
+            m.map_or("saturated".into(), |v| format!("{:.1}", v.1))
+        );
         curve.push(json!({"lambda": l, "model_printed": m.map(|v| v.0), "model_normalised": m.map(|v| v.1), "simulated": s}));
     }
     // Where each doubles its light-load latency.
     let light_sim = sims[0];
     let light_model = model.latency(lambdas[0]).unwrap().1;
-    let knee_sim = lambdas.iter().zip(&sims).find(|(_, &s)| s > 2.0 * light_sim).map(|(l, _)| *l);
-    let knee_model = lambdas.iter().find(|&&l| model.latency(l).is_none_or(|v| v.1 > 2.0 * light_model)).copied();
+    let knee_sim = lambdas
+        .iter()
+        .zip(&sims)
+        .find(|(_, &s)| s > 2.0 * light_sim)
+        .map(|(l, _)| *l);
+    let knee_model = lambdas
+        .iter()
+        .find(|&&l| model.latency(l).is_none_or(|v| v.1 > 2.0 * light_model))
+        .copied();
     let _ = writeln!(md, "\nLatency doubles at λ ≈ {} (model, normalised) and {} (simulation), on this grid of λ; model saturation {sat:.3e}. 003: the simulation saturates about an order of magnitude later.\n", knee_model.map_or("–".into(), |v| format!("{v:.2e}")), knee_sim.map_or("beyond the grid".into(), |v| format!("{v:.2e}")));
-    let mpts: Vec<(f64, f64)> = curve.iter().filter_map(|c| c["model_normalised"].as_f64().map(|v| (c["lambda"].as_f64().unwrap(), v))).collect();
-    let spts: Vec<(f64, f64)> = curve.iter().map(|c| (c["lambda"].as_f64().unwrap(), c["simulated"].as_f64().unwrap())).collect();
-    write_plot(out, &Chart { stem: format!("{id}-model-vs-simulation"), title: "4-ary 5-stage CFBS, P_M = 0.5: mean latency vs λ_PE".into(),
-        panels: vec![Panel::Xy(XyPanel { title: "mean latency".into(), x_label: "λ_PE (packets per PE per clock)".into(), y_label: "clocks".into(), x_log: true, y_log: true, x_ticks: Vec::new(), lines: true, legend: LegendAt::UpperLeft,
-            series: vec![series("model (normalised)", 1, &mpts), series("random simulation", 2, &spts)] })] })?;
+    let mpts: Vec<(f64, f64)> = curve
+        .iter()
+        .filter_map(|c| {
+            c["model_normalised"]
+                .as_f64()
+                .map(|v| (c["lambda"].as_f64().unwrap(), v))
+        })
+        .collect();
+    let spts: Vec<(f64, f64)> = curve
+        .iter()
+        .map(|c| {
+            (
+                c["lambda"].as_f64().unwrap(),
+                c["simulated"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    write_plot(
+        out,
+        &Chart {
+            stem: format!("{id}-model-vs-simulation"),
+            title: "4-ary 5-stage CFBS, P_M = 0.5: mean latency vs λ_PE".into(),
+            panels: vec![Panel::Xy(XyPanel {
+                title: "mean latency".into(),
+                x_label: "λ_PE (packets per PE per clock)".into(),
+                y_label: "clocks".into(),
+                x_log: true,
+                y_log: true,
+                x_ticks: Vec::new(),
+                lines: true,
+                legend: LegendAt::UpperLeft,
+                series: vec![
+                    series("model (normalised)", 1, &mpts),
+                    series("random simulation", 2, &spts),
+                ],
+            })],
+        },
+    )?;
 
     // 3. The caches in the execution-driven runs.
     let traced = trace_scenes(&scenes, size, out)?;
-    let blocks: Vec<u32> = if quick { vec![1, 4, 16] } else { vec![1, 2, 4, 8, 16, 32] };
-    let configs: Vec<(u32, u32)> = [(256u32, 16u32), (1024, 32)].into_iter().filter(|&(p, _)| p <= max_pes).collect();
+    let blocks: Vec<u32> = if quick {
+        vec![1, 4, 16]
+    } else {
+        vec![1, 2, 4, 8, 16, 32]
+    };
+    let configs: Vec<(u32, u32)> = [(256u32, 16u32), (1024, 32)]
+        .into_iter()
+        .filter(|&(p, _)| p <= max_pes)
+        .collect();
     let mut exec = Vec::new();
     for t in &traced {
         let mut machines = Vec::new();
@@ -549,13 +821,32 @@ pub fn cfbs(
         let results = pool.install(|| run_all(t, &machines));
         let _ = writeln!(md, "## {}: execution-driven, 2D skewed, {size}×{size}\n\n| PEs | CFBS | R | speed-up vs R = 1 | FB share of image time | hit rate | λ_PE | interval var/mean | mean latency |\n|---|---|---|---|---|---|---|---|---|", t.label);
         for (k, (r, wall)) in keys.iter().zip(&results) {
-            let base = keys.iter().position(|b| *b == (k.0, 1, k.2)).map(|i| results[i].0.clocks).unwrap_or(r.clocks);
+            let base = keys
+                .iter()
+                .position(|b| *b == (k.0, 1, k.2))
+                .map(|i| results[i].0.clocks)
+                .unwrap_or(r.clocks);
             let f = &r.frame_buffer;
             let lambda = f.packets as f64 / (k.0 as f64 * r.pe_clocks.max(1) as f64);
             let vm = f.interval_var / f.interval_mean.max(1e-9);
-            let fbname = match k.2 { FrameBuffer::Direct => "none (direct GFB)".to_string(), FrameBuffer::Cached { m } => format!("{m}-ary 2-stage") };
-            let _ = writeln!(md, "| {} | {fbname} | {} | {:.2} | {:.3} | {} | {lambda:.2e} | {vm:.0} | {:.1} |", k.0, k.1, base as f64 / r.clocks as f64,
-                f.finish.saturating_sub(r.pe_clocks) as f64 / r.clocks as f64, if matches!(k.2, FrameBuffer::Cached { .. }) { format!("{:.1}%", f.hit_rate() * 100.0) } else { "–".into() }, f.latency_mean);
+            let fbname = match k.2 {
+                FrameBuffer::Direct => "none (direct GFB)".to_string(),
+                FrameBuffer::Cached { m } => format!("{m}-ary 2-stage"),
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {fbname} | {} | {:.2} | {:.3} | {} | {lambda:.2e} | {vm:.0} | {:.1} |",
+                k.0,
+                k.1,
+                base as f64 / r.clocks as f64,
+                f.finish.saturating_sub(r.pe_clocks) as f64 / r.clocks as f64,
+                if matches!(k.2, FrameBuffer::Cached { .. }) {
+                    format!("{:.1}%", f.hit_rate() * 100.0)
+                } else {
+                    "–".into()
+                },
+                f.latency_mean
+            );
             let mut v = sim_json(r, base, 1, *wall);
             v["pes"] = json!(k.0);
             v["rp_blocks"] = json!(k.1);
