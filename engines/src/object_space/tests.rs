@@ -9,7 +9,7 @@ use super::queueing::{self, Model};
 use super::sim::simulate;
 use super::trace::{Trace, TracedRay, NO_PIXEL};
 use super::ObjectSpace;
-use crate::engine::{BuildInput, Counters, Engine as _, Settings};
+use crate::engine::{BuildInput, Counters, Settings};
 use crate::geometry::Geometry;
 use crate::ray::{Hit, Ray};
 use crate::{build_engine, EngineError};

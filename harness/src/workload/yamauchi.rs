@@ -26,6 +26,10 @@ use rtbench_scenes::Scene;
 pub const MAX_REFLECTIONS: u8 = 3;
 const CHUNK: usize = 2048;
 
+/// One chunk of a generation, executed: its segments, each ray's hit and segment count, and the
+/// engine's counters.
+type Executed = (Vec<Segment>, Vec<(Hit, u32)>, Counters);
+
 /// 003's pass, traced: the record, the image it accumulates, and ray counts.
 pub struct Pass {
     pub size: u32,
@@ -92,7 +96,7 @@ pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32) -> Pass {
     let mut root = true;
     while !rays.is_empty() {
         // Execute the generation: per chunk, its segments and each ray's (hit, segment count).
-        let chunks: Vec<(Vec<Segment>, Vec<(Hit, u32)>, Counters)> = rays
+        let chunks: Vec<Executed> = rays
             .par_chunks(CHUNK)
             .map(|chunk| {
                 let (mut segs, mut out, mut c) = (Vec::new(), Vec::new(), Counters::default());
