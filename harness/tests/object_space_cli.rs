@@ -75,3 +75,52 @@ fn simulated_clocks_are_deterministic() {
     assert_eq!(a, b);
     assert_eq!(rays_a, rays_b);
 }
+
+#[test]
+fn yamauchi_static_lb_small_run_reports_every_machine() {
+    let dir = std::env::temp_dir().join(format!("rtbench-yamauchi-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = rtbench(&[
+        "reproduce",
+        "yamauchi-static-lb",
+        "--scenes",
+        "tetra",
+        "--size",
+        "32",
+        "--max-pes",
+        "16",
+        "--threads",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let runs = v["measured"][0]["runs"].as_array().unwrap();
+    // 1 PE, then 1D: 3 allocations × 4 counts, 2D: 3 × 4, 3D: 2 × 4.
+    assert_eq!(runs.len(), 1 + 12 + 12 + 8);
+    let busy: Vec<f64> = runs
+        .iter()
+        .map(|r| {
+            r["utilisation"].as_f64().unwrap()
+                * r["clocks"].as_f64().unwrap()
+                * r["pes"].as_f64().unwrap()
+        })
+        .collect();
+    for (r, b) in runs.iter().zip(&busy) {
+        let e = r["efficiency"].as_f64().unwrap();
+        assert!(e > 0.0 && e <= 1.0 + 1e-9, "{r}");
+        // Every machine does the same work, only spread differently.
+        assert!((b / busy[0] - 1.0).abs() < 1e-9);
+    }
+    assert!(dir.join("yamauchi-static-lb.md").exists());
+    assert!(dir
+        .join("plots/yamauchi-static-lb-tetra6-efficiency.svg")
+        .exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -41,6 +41,16 @@ struct Traced {
 }
 
 fn trace_scenes(scenes: &[String], size: u32, out: &Path) -> Result<Vec<Traced>> {
+    trace_scenes_with(scenes, size, out, Costs::default())
+}
+
+/// As [`trace_scenes`], with the engine's unit costs (the per-test clocks enter the record).
+fn trace_scenes_with(
+    scenes: &[String],
+    size: u32,
+    out: &Path,
+    costs: Costs,
+) -> Result<Vec<Traced>> {
     std::fs::create_dir_all(out.join("images"))
         .map_err(|e| input(format!("{}: cannot create: {e}", out.display())))?;
     let mut v = Vec::new();
@@ -48,8 +58,11 @@ fn trace_scenes(scenes: &[String], size: u32, out: &Path) -> Result<Vec<Traced>>
         let src = Source::resolve(s, None, None, None)?;
         let prepared = workload::prepare(&src)?;
         let label = prepared.input.scene.name.clone();
-        let os = ObjectSpace::build(&prepared.input, ObjectSpaceConfig::default())
-            .map_err(|e| input(e.to_string()))?;
+        let config = ObjectSpaceConfig {
+            costs,
+            ..ObjectSpaceConfig::default()
+        };
+        let os = ObjectSpace::build(&prepared.input, config).map_err(|e| input(e.to_string()))?;
         eprintln!("{label}: tracing 003's pass at {size}x{size} …");
         let t = Instant::now();
         let pass = yamauchi::trace_pass(&os, &prepared.input.scene, size);
@@ -109,7 +122,7 @@ fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f
                 &t.pass.trace,
                 m,
                 &m.owner_map(s),
-                &Costs::default(),
+                &t.os.config().costs,
                 *fb,
                 t.pass.size,
             );
@@ -819,7 +832,7 @@ pub fn cfbs(
         }
         eprintln!("{}: simulating {} machines …", t.label, machines.len());
         let results = pool.install(|| run_all(t, &machines));
-        let _ = writeln!(md, "## {}: execution-driven, 2D skewed, {size}×{size}\n\n| PEs | CFBS | R | speed-up vs R = 1 | FB share of image time | hit rate | λ_PE | interval var/mean | mean latency |\n|---|---|---|---|---|---|---|---|---|", t.label);
+        let _ = writeln!(md, "## {}: execution-driven, 2D skewed, {size}×{size}\n\n| PEs | CFBS | R | speed-up vs R = 1 | FB share of image time | hit rate | λ_PE | interval var/mean | var/mean² | mean latency |\n|---|---|---|---|---|---|---|---|---|---|", t.label);
         for (k, (r, wall)) in keys.iter().zip(&results) {
             let base = keys
                 .iter()
@@ -829,13 +842,14 @@ pub fn cfbs(
             let f = &r.frame_buffer;
             let lambda = f.packets as f64 / (k.0 as f64 * r.pe_clocks.max(1) as f64);
             let vm = f.interval_var / f.interval_mean.max(1e-9);
+            let cv2 = vm / f.interval_mean.max(1e-9);
             let fbname = match k.2 {
                 FrameBuffer::Direct => "none (direct GFB)".to_string(),
                 FrameBuffer::Cached { m } => format!("{m}-ary 2-stage"),
             };
             let _ = writeln!(
                 md,
-                "| {} | {fbname} | {} | {:.2} | {:.3} | {} | {lambda:.2e} | {vm:.0} | {:.1} |",
+                "| {} | {fbname} | {} | {:.2} | {:.3} | {} | {lambda:.2e} | {vm:.0} | {cv2:.1} | {:.1} |",
                 k.0,
                 k.1,
                 base as f64 / r.clocks as f64,
@@ -853,13 +867,69 @@ pub fn cfbs(
             v["cfbs"] = json!(matches!(k.2, FrameBuffer::Cached { .. }));
             v["lambda_pe"] = json!(lambda);
             v["interval_var_over_mean"] = json!(vm);
+            v["interval_var_over_mean_squared"] = json!(cv2);
             exec.push(v);
         }
         let _ = writeln!(md);
     }
+    // 4. Faster processors (003 Fig. 41): the PE units' costs divided by the processor-memory
+    // cycle ratio, links and frame buffer as they were.
+    let (pp, pm) = *configs.last().unwrap_or(&(256, 16));
+    let r_pmcr = if quick { 4 } else { 16 };
+    let _ = writeln!(md, "## Processor-memory cycle ratio (003 Fig. 41): {pp} PEs × {r_pmcr} RP blocks, 2D skewed, {}\n\nEvery PE unit cost (Table 4 but the link's hop) divided by the PMCR; links and frame buffer unchanged.\n\n| PMCR | T direct / T with {pm}-ary CFBS | FB share of image time (direct) | FB share (CFBS) | hit rate | λ_PE | mean latency direct | mean latency CFBS |\n|---|---|---|---|---|---|---|---|", scenes.first().map_or("", |s| s.as_str()));
+    let mut pmcr_rows = Vec::new();
+    for pmcr in if quick {
+        vec![1u32, 64]
+    } else {
+        vec![1u32, 4, 16, 64, 256]
+    } {
+        let traced = trace_scenes_with(&scenes[..1.min(scenes.len())], size, out, faster(pmcr))?;
+        let Some(t) = traced.first() else { break };
+        let m = machine(pp, 2, Allocation::Skewed, r_pmcr);
+        let res = pool.install(|| {
+            run_all(
+                t,
+                &[(m, FrameBuffer::Direct), (m, FrameBuffer::Cached { m: pm })],
+            )
+        });
+        let (d, c) = (&res[0].0, &res[1].0);
+        let share = |r: &SimResult| r.clocks.saturating_sub(r.pe_clocks) as f64 / r.clocks as f64;
+        let lambda = d.frame_buffer.packets as f64 / (pp as f64 * d.pe_clocks.max(1) as f64);
+        let _ = writeln!(
+            md,
+            "| {pmcr} | {:.3} | {:.3} | {:.3} | {:.1}% | {lambda:.2e} | {:.1} | {:.1} |",
+            d.clocks as f64 / c.clocks as f64,
+            share(d),
+            share(c),
+            c.frame_buffer.hit_rate() * 100.0,
+            d.frame_buffer.latency_mean,
+            c.frame_buffer.latency_mean
+        );
+        pmcr_rows.push(json!({"pmcr": pmcr, "pes": pp, "rp_blocks": r_pmcr, "m": pm, "direct": sim_json(d, d.clocks, 1, res[0].1), "cfbs": sim_json(c, d.clocks, 1, res[1].1), "lambda_pe": lambda}));
+    }
+    let _ = writeln!(md);
     let _ = writeln!(md, "003 (4.3.2): FBC hit rate about 60%; λ about 5.9e-6 (1024 PEs × 1 RP block) and 8.3e-5 (× 32); interval variance 100-1000 times the mean; the caches help only at 1024 PEs with about 16 RP blocks or more. 'FB share' is how much of the image time the frame buffer adds after the last RP block finishes.");
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size,
-        "model": model_rows, "model_vs_simulation": curve, "execution_driven": exec,
+        "model": model_rows, "model_vs_simulation": curve, "execution_driven": exec, "pmcr": pmcr_rows,
         "environment": {"os": std::env::consts::OS, "arch": std::env::consts::ARCH, "threads": pool.current_num_threads()}});
     report(id, out, &doc, &md, as_json)
+}
+
+/// Table 4's costs with every PE unit `pmcr` times faster (at least 1 clock); the link's hop and
+/// the frame buffer's costs stay.
+fn faster(pmcr: u32) -> Costs {
+    let c = Costs::default();
+    let f = |v: u32| (v / pmcr).max(1);
+    Costs {
+        primary: f(c.primary),
+        triangle: f(c.triangle),
+        sphere: f(c.sphere),
+        cone: f(c.cone),
+        intensity: f(c.intensity),
+        dda_init: f(c.dda_init),
+        dda: f(c.dda),
+        secondary: f(c.secondary),
+        packet: f(c.packet),
+        ..c
+    }
 }
