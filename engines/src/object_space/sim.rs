@@ -76,6 +76,17 @@ enum Source {
     Frgu(u32),
 }
 
+type Event = (u64, u32, u32, Source);
+
+/// Queues an arrival: as the next event when it precedes everything queued, else in the heap.
+fn arrive(e: Event, heap: &mut BinaryHeap<Reverse<Event>>, next_event: &mut Option<Event>) {
+    if next_event.is_none() && heap.peek().is_none_or(|Reverse(top)| e < *top) {
+        *next_event = Some(e);
+    } else {
+        heap.push(Reverse(e));
+    }
+}
+
 /// One segment as the event loop needs it, made in one pass before the loop so that an event
 /// touches one place in memory: the owning PE (top bit: the ray's last segment) and the clocks
 /// of the whole packet's work in its RP block.
@@ -136,7 +147,7 @@ pub fn simulate(
     let mut busy = vec![0u64; pes];
     let mut link_free = vec![0u64; pes * 6];
     // Entries (time, ray, global segment index, source): unique, so the order is total.
-    let mut heap: BinaryHeap<Reverse<(u64, u32, u32, Source)>> = BinaryHeap::new();
+    let mut heap: BinaryHeap<Reverse<Event>> = BinaryHeap::new();
     let mut r = SimResult {
         pes: pes as u64,
         rp_blocks: rpb as u64,
@@ -179,7 +190,15 @@ pub fn simulate(
         start + hops as u64 * costs.hop as u64
     };
 
-    while let Some(Reverse((t, ri, k, src))) = heap.pop() {
+    // An arrival that comes before everything in the heap is handled next without going
+    // through it (most often a ray stepping to a subspace of the same PE): the order of events
+    // is the heap's all the same.
+    let mut next_event: Option<Event> = None;
+    loop {
+        let Some((t, ri, k, src)) = next_event.take().or_else(|| heap.pop().map(|Reverse(e)| e))
+        else {
+            break;
+        };
         match src {
             Source::Frgu(p) => {
                 let p = p as usize;
@@ -204,7 +223,7 @@ pub fn simulate(
                     } else {
                         send(pe, next, t, &mut r)
                     };
-                    heap.push(Reverse((at, ri, k + 1, Source::Arrival)));
+                    arrive((at, ri, k + 1, Source::Arrival), &mut heap, &mut next_event);
                     continue;
                 }
                 let ray = &trace.rays[ri as usize];
@@ -230,7 +249,7 @@ pub fn simulate(
                     } else {
                         send(pe, next, t, &mut r)
                     };
-                    heap.push(Reverse((at, c, kc, Source::Arrival)));
+                    arrive((at, c, kc, Source::Arrival), &mut heap, &mut next_event);
                 }
                 continue;
             }
