@@ -194,11 +194,7 @@ pub fn simulate(
     // through it (most often a ray stepping to a subspace of the same PE): the order of events
     // is the heap's all the same.
     let mut next_event: Option<Event> = None;
-    loop {
-        let Some((t, ri, k, src)) = next_event.take().or_else(|| heap.pop().map(|Reverse(e)| e))
-        else {
-            break;
-        };
+    while let Some((t, ri, k, src)) = next_event.take().or_else(|| heap.pop().map(|Reverse(e)| e)) {
         match src {
             Source::Frgu(p) => {
                 let p = p as usize;
