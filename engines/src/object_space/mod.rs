@@ -97,11 +97,8 @@ impl ObjectSpace {
                 engine: "object-space".into(),
                 reason: e.to_string(),
             })?;
-        let mut subspaces = built.cells;
-        if subspaces.res != config.subspaces {
-            // A scene with nothing to register: one empty subspace grid of the asked shape.
-            subspaces.res = config.subspaces;
-        }
+        // A scene with nothing to register gets one empty cell: every ray misses before walking.
+        let subspaces = built.cells;
         let c = &config.costs;
         let test_cost = input
             .geometry
