@@ -56,7 +56,7 @@ pub fn list(as_json: bool) -> Result<()> {
             .collect::<Vec<_>>()));
     } else {
         for (id, d) in TABLES {
-            println!("{id:<12} {d}");
+            println!("{id:<20} {d}");
         }
     }
     Ok(())
