@@ -19,6 +19,7 @@ pub mod embree;
 pub mod engine;
 pub mod geometry;
 pub mod grid;
+pub mod object_space;
 pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
@@ -37,6 +38,7 @@ pub fn registry() -> Vec<EngineInfo> {
         bvh::info4(),
         bvh::info8(),
         obvhs_engine::info(),
+        object_space::info(),
     ];
     if testing::enabled() {
         v.extend(testing::infos());

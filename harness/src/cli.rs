@@ -160,6 +160,15 @@ pub struct ReproduceArgs {
     pub engines: Option<String>,
     #[arg(long)]
     pub threads: Option<usize>,
+    /// yamauchi-* only: image size of 003's pass (default 512, 128 with --quick).
+    #[arg(long)]
+    pub size: Option<u32>,
+    /// yamauchi-* only: the largest PE count simulated (default 1024).
+    #[arg(long)]
+    pub max_pes: Option<u32>,
+    /// yamauchi-* only: SPD scenes, comma-separated (standard SFs).
+    #[arg(long)]
+    pub scenes: Option<String>,
     #[arg(long)]
     pub json: bool,
 }

@@ -42,7 +42,20 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
-            commands::reproduce::run(&a.id, a.quick, out, a.engines.as_deref(), a.threads, a.json)
+            let limits = commands::yamauchi::Limits {
+                size: a.size,
+                max_pes: a.max_pes,
+                scenes: a.scenes.clone(),
+            };
+            commands::reproduce::run(
+                &a.id,
+                a.quick,
+                out,
+                a.engines.as_deref(),
+                a.threads,
+                &limits,
+                a.json,
+            )
         }
     }
 }

@@ -111,7 +111,15 @@ proptest! {
 #[test]
 fn every_available_engine_is_tested() {
     let names = engines();
-    for must in ["reference", "grid", "bvh2", "bvh4", "bvh8", "obvhs"] {
+    for must in [
+        "reference",
+        "grid",
+        "bvh2",
+        "bvh4",
+        "bvh8",
+        "obvhs",
+        "object-space",
+    ] {
         assert!(names.contains(&must), "{must} missing from {names:?}");
     }
 }

@@ -7,3 +7,4 @@ pub mod reproduce;
 pub mod runs;
 pub mod scene;
 pub mod tree_stats;
+pub mod yamauchi;

@@ -4,6 +4,7 @@
 //! `spd-stats`: the SPD README's ray statistics of the seven standard scenes, against the ray
 //! counts of our workload with each engine.
 
+use super::yamauchi;
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
@@ -33,6 +34,18 @@ const TABLES: &[(&str, &str)] = &[
         "kimura-simd",
         "001 (Kimura 2007) §4.3: SIMD 4-ary single-ray traversal speed-up (2.32-4.45x)",
     ),
+    (
+        "yamauchi-static-lb",
+        "003 (Yamauchi 1997) §4.2.2: (Mπ)² speed-up/efficiency vs PEs, 3 allocations, 1D/2D/3D",
+    ),
+    (
+        "yamauchi-dynamic-lb",
+        "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
+    ),
+    (
+        "yamauchi-cfbs",
+        "003 (Yamauchi 1997) §3.4, §4.3: cached frame buffer, queueing model vs simulation",
+    ),
 ];
 
 pub fn list(as_json: bool) -> Result<()> {
@@ -43,7 +56,7 @@ pub fn list(as_json: bool) -> Result<()> {
             .collect::<Vec<_>>()));
     } else {
         for (id, d) in TABLES {
-            println!("{id:<12} {d}");
+            println!("{id:<20} {d}");
         }
     }
     Ok(())
@@ -72,9 +85,23 @@ pub fn run(
     out: &Path,
     asked: Option<&str>,
     threads: Option<usize>,
+    limits: &yamauchi::Limits,
     as_json: bool,
 ) -> Result<()> {
+    let limited = limits.size.is_some() || limits.max_pes.is_some() || limits.scenes.is_some();
+    if limited && !id.starts_with("yamauchi-") {
+        return Err(input(format!(
+            "{id}: --size, --max-pes and --scenes are for the yamauchi-* tables only"
+        )));
+    }
     match id {
+        "yamauchi-static-lb" => {
+            return yamauchi::static_lb(id, quick, limits, out, threads, as_json)
+        }
+        "yamauchi-dynamic-lb" => {
+            return yamauchi::dynamic_lb(id, quick, limits, out, threads, as_json)
+        }
+        "yamauchi-cfbs" => return yamauchi::cfbs(id, quick, limits, out, threads, as_json),
         "spd-stats" => {}
         "kimura-3.3" => return kimura_trees(id, quick, out, as_json),
         "kimura-simd" => return kimura_simd(id, quick, out, as_json),

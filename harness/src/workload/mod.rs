@@ -4,6 +4,7 @@ pub mod camera;
 pub mod crosscheck;
 pub mod surface;
 pub mod trace;
+pub mod yamauchi;
 
 use crate::error::{input, Result};
 use crate::source::Source;

@@ -1,0 +1,126 @@
+//! The `object-space` engine from the command line (issue 8): bad machine settings are one-line
+//! input errors, and the simulated clocks of a render are the same on 1 and 2 threads.
+
+mod common;
+
+use common::{expect_input_error, rtbench};
+use serde_json::Value;
+
+#[test]
+fn bad_machine_settings_exit_2() {
+    let render = |set: &str, needle: &str| {
+        expect_input_error(
+            &[
+                "render",
+                "--scene",
+                "tetra",
+                "--sf",
+                "1",
+                "--size",
+                "8",
+                "--engine",
+                "object-space",
+                "--set",
+                set,
+            ],
+            needle,
+        )
+    };
+    render("pes=12", "does not divide the subspaces");
+    render("pes=0", "zero processing elements");
+    render("pes=8x0", "zero processing elements");
+    render("cost.hop=0", "cost.hop");
+    render("cost.sphere=-3", "cost.sphere");
+    render("allocation=sideways", "allocation");
+    expect_input_error(
+        &["reproduce", "spd-stats", "--size", "64", "--out", "/tmp/x"],
+        "yamauchi-* tables only",
+    );
+}
+
+fn sim_clocks(threads: &str) -> (u64, Value) {
+    let out = rtbench(&[
+        "render",
+        "--scene",
+        "rings",
+        "--sf",
+        "1",
+        "--size",
+        "48",
+        "--engine",
+        "object-space",
+        "--set",
+        "pes=4x4",
+        "--threads",
+        threads,
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    (
+        v["counters"]["extra"]["sim_clocks"].as_u64().unwrap(),
+        v["rays"].clone(),
+    )
+}
+
+#[test]
+fn simulated_clocks_are_deterministic() {
+    let (a, rays_a) = sim_clocks("1");
+    let (b, rays_b) = sim_clocks("2");
+    assert!(a > 0);
+    assert_eq!(a, b);
+    assert_eq!(rays_a, rays_b);
+}
+
+#[test]
+fn yamauchi_static_lb_small_run_reports_every_machine() {
+    let dir = std::env::temp_dir().join(format!("rtbench-yamauchi-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = rtbench(&[
+        "reproduce",
+        "yamauchi-static-lb",
+        "--scenes",
+        "tetra",
+        "--size",
+        "32",
+        "--max-pes",
+        "16",
+        "--threads",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let runs = v["measured"][0]["runs"].as_array().unwrap();
+    // 1 PE, then 1D: 3 allocations × 4 counts, 2D: 3 × 4, 3D: 2 × 4.
+    assert_eq!(runs.len(), 1 + 12 + 12 + 8);
+    let busy: Vec<f64> = runs
+        .iter()
+        .map(|r| {
+            r["utilisation"].as_f64().unwrap()
+                * r["clocks"].as_f64().unwrap()
+                * r["pes"].as_f64().unwrap()
+        })
+        .collect();
+    for (r, b) in runs.iter().zip(&busy) {
+        let e = r["efficiency"].as_f64().unwrap();
+        assert!(e > 0.0 && e <= 1.0 + 1e-9, "{r}");
+        // Every machine does the same work, only spread differently.
+        assert!((b / busy[0] - 1.0).abs() < 1e-9);
+    }
+    assert!(dir.join("yamauchi-static-lb.md").exists());
+    assert!(dir
+        .join("plots/yamauchi-static-lb-tetra6-efficiency.svg")
+        .exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
