@@ -21,17 +21,6 @@ use std::time::Instant;
 /// Eye rays through the corners of a `SIZE`×`SIZE` image on each standard scene, for acne.
 const ACNE_SIZE: u32 = 64;
 
-/// The seven scenes of the SPD tables, at their standard size factors.
-const STANDARD: [Program; 7] = [
-    Program::Balls,
-    Program::Gears,
-    Program::Mount,
-    Program::Rings,
-    Program::Teapot,
-    Program::Tetra,
-    Program::Tree,
-];
-
 /// What one engine variant gave.
 pub struct VariantResult {
     pub variant: Variant,
@@ -165,7 +154,7 @@ pub fn run(variants: &[Variant], out: Option<&Path>) -> Result<HardResults> {
         sets.iter().map(|(s, _)| s.rays.len()).sum::<usize>(),
         t0.elapsed().as_secs_f64()
     );
-    let standard: Vec<(String, BuildInput, Vec<Ray>)> = STANDARD
+    let standard: Vec<(String, BuildInput, Vec<Ray>)> = Program::STANDARD
         .iter()
         .map(|&p| {
             let scene =
