@@ -22,6 +22,7 @@ pub mod grid;
 pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
+pub mod store;
 pub mod testing;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest};

@@ -176,6 +176,18 @@ pub enum SceneCommand {
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
     },
+    /// Write a scene store for the breadth-first engine (bounding-box and geometry files,
+    /// header.json), streaming from the generator without holding the scene.
+    Store {
+        #[command(flatten)]
+        scene: SceneArg,
+        /// Directory to create (must not exist, or be empty); written under a temporary name and
+        /// renamed when complete.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
     /// Count a scene's primitives by streaming it.
     Stats {
         #[command(flatten)]

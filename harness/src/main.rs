@@ -23,6 +23,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene(SceneCommand::Gen { scene, output }) => {
             commands::scene::gen(&scene_source(&scene.scene, &scene.opts)?, output.as_deref())
         }
+        Command::Scene(SceneCommand::Store {
+            scene,
+            output,
+            json,
+        }) => commands::scene::store(&scene_source(&scene.scene, &scene.opts)?, &output, json),
         Command::Scene(SceneCommand::Stats { scene, json }) => {
             commands::scene::stats(&scene_source(&scene.scene, &scene.opts)?, json)
         }
