@@ -14,6 +14,7 @@
 //! assert!(hits[0].is_hit());
 //! ```
 
+pub mod breadth_first;
 pub mod bvh;
 pub mod embree;
 pub mod engine;
@@ -32,6 +33,7 @@ pub use ray::{Hit, Ray};
 pub fn registry() -> Vec<EngineInfo> {
     let mut v = vec![
         reference::info(),
+        breadth_first::info(),
         embree::info(),
         grid::info(),
         bvh::info2(),

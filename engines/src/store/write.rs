@@ -6,7 +6,7 @@ use super::io::{IoCounters, IoFile};
 use super::{Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE, VERSION};
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
-use rtbench_scenes::{Light, Material, ShapeRef, Sink, View};
+use rtbench_scenes::{Light, Material, Scene, ShapeRef, Sink, View};
 use serde_json::json;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -83,12 +83,20 @@ impl StoreWriter {
         })
     }
 
-    fn write_object(&mut self, shape: ShapeRef<'_>) -> io::Result<()> {
-        if self.materials.is_empty() {
-            // NFF allows primitives before any `f`: they get the default material (as
-            // `SceneCollector` does).
-            self.materials.push(Material::default());
+    /// Writes a scene already in memory (the breadth-first engine built from a `BuildInput`):
+    /// each object keeps its own material index.
+    pub fn write_scene(mut self, scene: &Scene) -> io::Result<IoCounters> {
+        self.background = scene.background;
+        self.view = scene.view.clone();
+        self.lights = scene.lights.clone();
+        self.materials = scene.materials.clone();
+        for o in &scene.objects {
+            self.write_object(o.material, o.shape.as_ref())?;
         }
+        self.finish()
+    }
+
+    fn write_object(&mut self, material: u32, shape: ShapeRef<'_>) -> io::Result<()> {
         self.prims.clear();
         prims_of(shape, &mut self.prims, &mut self.tris);
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
@@ -100,7 +108,7 @@ impl StoreWriter {
         let r = &mut self.record;
         r.clear();
         r.extend_from_slice(&[0; 4]);
-        r.extend_from_slice(&((self.materials.len() - 1) as u32).to_le_bytes());
+        r.extend_from_slice(&material.to_le_bytes());
         encode_surface(r, &Surface::of(shape));
         r.extend_from_slice(&(self.prims.len() as u32).to_le_bytes());
         for p in &self.prims {
@@ -227,8 +235,14 @@ impl Sink for StoreWriter {
         self.materials.push(material.clone());
     }
     fn shape(&mut self, shape: ShapeRef<'_>) {
+        if self.materials.is_empty() {
+            // NFF allows primitives before any `f`: they get the default material (as
+            // `SceneCollector` does).
+            self.materials.push(Material::default());
+        }
+        let material = (self.materials.len() - 1) as u32;
         if self.error.is_none() {
-            if let Err(e) = self.write_object(shape) {
+            if let Err(e) = self.write_object(material, shape) {
                 self.error = Some(e);
             }
         }

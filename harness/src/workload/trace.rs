@@ -34,8 +34,6 @@ pub const MAX_DEPTH: u8 = 5;
 pub const OFFSET_REL: f32 = 1.0 / 32768.0;
 /// Floor of the offset, for hit points at the origin.
 const OFFSET_MIN: f32 = 1e-7;
-/// Rays per engine call: large enough to amortise the call, small enough to split across threads.
-const BATCH: usize = 4096;
 
 /// What one ray of a generation carries besides the ray.
 #[derive(Clone, Copy)]
@@ -130,11 +128,13 @@ fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
     }
 }
 
-/// Answers a batch of queries (`engine.intersect` or `engine.occluded`) split into chunks over
-/// the pool's threads, each chunk with its own counters, summed into `counters`. `out` is resized
-/// to the batch and filled with `fill` first. Returns the CPU seconds used on threads other than
-/// the caller's.
+/// Answers a batch of queries (`engine.intersect` or `engine.occluded`) split into chunks of
+/// `batch` rays (the engine's [`Engine::batch_hint`]; `None`: all in one call, for engines that
+/// answer a whole generation at once) over the pool's threads, each chunk with its own
+/// counters, summed into `counters`. `out` is resized to the batch and filled with `fill` first.
+/// Returns the CPU seconds used on threads other than the caller's.
 pub(crate) fn query_all<T: Clone + Send>(
+    batch: Option<usize>,
     rays: &[Ray],
     out: &mut Vec<T>,
     fill: T,
@@ -144,9 +144,10 @@ pub(crate) fn query_all<T: Clone + Send>(
     out.clear();
     out.resize(rays.len(), fill);
     let me = rayon::current_thread_index();
+    let chunk = batch.unwrap_or(rays.len()).max(1);
     let sums: Vec<(Counters, f64)> = rays
-        .par_chunks(BATCH)
-        .zip(out.par_chunks_mut(BATCH))
+        .par_chunks(chunk)
+        .zip(out.par_chunks_mut(chunk))
         .map(|(r, o)| {
             let mut c = Counters::default();
             let cpu = other_thread_cpu(me, || query(r, o, &mut c));
@@ -177,6 +178,7 @@ pub fn render(
     let start = Instant::now();
     let cpu_start = super::thread_cpu_seconds();
     let mut other_cpu = 0.0;
+    let batch = engine.batch_hint();
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
     let w = size + 1;
@@ -229,9 +231,14 @@ pub fn render(
             ..Default::default()
         };
         let t0 = Instant::now();
-        other_cpu += query_all(&rays, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
-            engine.intersect(r, h, c)
-        });
+        other_cpu += query_all(
+            batch,
+            &rays,
+            &mut hits,
+            Hit::MISS,
+            &mut counters,
+            |r, h, c| engine.intersect(r, h, c),
+        );
         intersect_s += t0.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.closest
@@ -326,6 +333,7 @@ pub fn render(
 
         let t2 = Instant::now();
         other_cpu += query_all(
+            batch,
             &shadow_rays,
             &mut blocked,
             false,
