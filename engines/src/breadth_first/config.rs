@@ -90,7 +90,12 @@ pub struct BreadthFirstConfig {
     /// Bytes of each file buffer (bbox and geometry file).
     pub buffer: u64,
     pub triangle: TriangleTest,
+    /// Floor and backdrop polygons in their own group, out of the grid (seed 000 §1.2: "for
+    /// balls and tree the base plate was excluded"), or in it.
+    pub floor: Floor,
 }
+
+pub use crate::grid::config::Floor;
 
 pub const DEFAULT_MEMORY: u64 = 1 << 30;
 pub const DEFAULT_BUFFER: u64 = 1 << 16;
@@ -111,6 +116,7 @@ impl BreadthFirstConfig {
         let registration = s.get("registration", Registration::Inverse)?;
         let buffer = s.get("buffer", Bytes(DEFAULT_BUFFER))?.0;
         let triangle = s.get("triangle", TriangleTest::Watertight)?;
+        let floor = s.get("floor", Floor::Out)?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -121,6 +127,7 @@ impl BreadthFirstConfig {
             registration,
             buffer,
             triangle,
+            floor,
         })
     }
 }

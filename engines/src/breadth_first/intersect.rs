@@ -117,19 +117,44 @@ impl Work {
                     break;
                 };
                 c.rays += 1;
+                let wt = WatertightRay::new(ray.dir);
+                // The floor group first: a near floor hit shortens the walk.
+                let mut best = Hit::MISS;
+                let mut seg = ray;
+                'floor: for (fid, rec) in &self.floor {
+                    for prim in &rec.prims {
+                        c.primitive_tests += 1;
+                        if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
+                            c.primitive_hits += 1;
+                            seg.tmax = t;
+                            best = Hit {
+                                t,
+                                object: *fid,
+                                u,
+                                v,
+                            };
+                            if any {
+                                break 'floor;
+                            }
+                        }
+                    }
+                }
                 let g = &self.voxels;
-                let found = Dda::start(&ray, g)
-                    .and_then(|mut d| first_candidate(g, &mut d, c).then_some(d));
+                let found = if any && best.is_hit() {
+                    None
+                } else {
+                    Dda::start(&seg, g).and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
+                };
                 match found {
-                    None => out(id, Hit::MISS),
+                    None => out(id, best),
                     Some(dda) => self.slots.push(Slot {
                         id,
                         ray,
                         slab: SlabRay::new(&ray),
-                        wt: WatertightRay::new(ray.dir),
+                        wt,
                         dda,
-                        best: Hit::MISS,
-                        best_t: ray.tmax,
+                        best,
+                        best_t: seg.tmax,
                         mailbox: u32::MAX,
                         prev: [u32::MAX; 3],
                         last: [u32::MAX; 3],
@@ -210,8 +235,9 @@ impl Work {
         self.bbox.rewind()?;
         self.geometry.rewind()?;
         let (mut prev_skips, mut loads) = (0u64, 0u64);
+        let mut next_floor = self.floor.iter().map(|f| f.0).peekable();
         while let Some((id, b)) = self.bbox.next_record()? {
-            if !(b.lo.is_finite() && b.hi.is_finite()) {
+            if next_floor.next_if_eq(&id).is_some() || !(b.lo.is_finite() && b.hi.is_finite()) {
                 continue;
             }
             let (a, z) = g.range(b.lo, b.hi);

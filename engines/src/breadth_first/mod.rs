@@ -21,6 +21,7 @@
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
 //! | `buffer` | bytes | `64KiB` | each file buffer |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
+//! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
 //! of the sweep), `mailbox_skips`, `cells_visited` (voxels walked); in `extra`: `bf_passes`
@@ -38,11 +39,13 @@ pub mod voxels;
 mod tests;
 
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::grid::build::{FLOOR_FLAT, FLOOR_SPAN};
 use crate::ray::{Hit, Ray};
 use crate::store::{
-    BboxReader, GeometryReader, IoCounters, ObjectRecord, StoreHeader, StoreWriter,
+    BboxReader, GeometryReader, IoCounters, ObjectRecord, StoreHeader, StoreWriter, Surface,
 };
-use config::{BreadthFirstConfig, Registration};
+use config::{BreadthFirstConfig, Floor, Registration};
+use glam::Vec3;
 use intersect::{Reg, Slot};
 use spill::SpillDir;
 use std::collections::BTreeMap;
@@ -89,6 +92,8 @@ pub struct Work {
     bbox: BboxReader,
     geometry: GeometryReader,
     record: ObjectRecord,
+    /// The floor group: (object id, its record), held in memory.
+    floor: Vec<(u32, ObjectRecord)>,
 }
 
 impl Work {
@@ -97,6 +102,16 @@ impl Work {
         io.add(&self.geometry.file.io);
         io
     }
+}
+
+/// The `grid` engine's floor test ([`crate::grid::build::floor_objects`]) on a bounding box:
+/// spanning [`FLOOR_SPAN`] of the scene along two axes, and flat across the third.
+fn is_floor_box(lo: Vec3, hi: Vec3, scene_extent: Vec3) -> bool {
+    let e = hi - lo;
+    let spans = (0..3)
+        .filter(|&i| scene_extent[i] > 0.0 && e[i] as f64 >= FLOOR_SPAN * scene_extent[i] as f64)
+        .count();
+    spans >= 2 && e.min_element() as f64 <= FLOOR_FLAT * e.max_element() as f64
 }
 
 pub struct BreadthFirst {
@@ -140,7 +155,34 @@ impl BreadthFirst {
     pub fn open(dir: &Path, config: BreadthFirstConfig) -> Result<BreadthFirst, EngineError> {
         let t = Instant::now();
         let header = StoreHeader::read(dir).map_err(|e| err(e.to_string()))?;
-        let mut voxels = Voxels::new(header.bounds, header.primitives);
+        let open_err = |e: std::io::Error| err(format!("{}: {e}", dir.display()));
+        let mut bbox =
+            BboxReader::open(dir, header.objects, config.buffer as usize).map_err(open_err)?;
+        let mut geometry = GeometryReader::open(dir, config.buffer as usize).map_err(open_err)?;
+        // The floor group, and the box and primitive count of the rest (one sweep).
+        let (mut floor, mut bounds, mut grid_prims) =
+            (Vec::new(), header.bounds, header.primitives);
+        if config.floor == Floor::Out {
+            let ext = header.bounds[1] - header.bounds[0];
+            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+                if is_floor_box(b.lo, b.hi, ext) {
+                    let mut rec = ObjectRecord::default();
+                    geometry.read_at(b.offset, &mut rec).map_err(open_err)?;
+                    if matches!(rec.surface, Some(Surface::Flat { .. })) {
+                        grid_prims -= rec.prims.len() as u64;
+                        floor.push((id, rec));
+                        continue;
+                    }
+                }
+                lo = lo.min(b.lo);
+                hi = hi.max(b.hi);
+            }
+            bounds = [lo, hi];
+            bbox.rewind().map_err(open_err)?;
+            geometry.rewind().map_err(open_err)?;
+        }
+        let mut voxels = Voxels::new(bounds, grid_prims);
         let nvox = voxels.count() as u64;
         let grid_bytes = nvox * 5;
         let buffers = 2 * config.buffer;
@@ -158,15 +200,16 @@ impl BreadthFirst {
                 per_ray
             )));
         }
-        let open_err = |e: std::io::Error| err(format!("{}: {e}", dir.display()));
-        let mut bbox =
-            BboxReader::open(dir, header.objects, config.buffer as usize).map_err(open_err)?;
-        let geometry = GeometryReader::open(dir, config.buffer as usize).map_err(open_err)?;
-        while let Some((_, b)) = bbox.next_record().map_err(open_err)? {
-            voxels.mark(b.lo, b.hi);
+        let mut next_floor = floor.iter().map(|f| f.0).peekable();
+        while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+            if next_floor.next_if_eq(&id).is_none() {
+                voxels.mark(b.lo, b.hi);
+            }
         }
-        let pre_io = bbox.file.io;
+        let mut pre_io = bbox.file.io;
+        pre_io.add(&geometry.file.io);
         bbox.file.io = IoCounters::default();
+        geometry.file.io = IoCounters::default();
         let preprocess_s = t.elapsed().as_secs_f64();
 
         let mut stats = BTreeMap::new();
@@ -184,6 +227,7 @@ impl BreadthFirst {
         stats.insert("bytes_per_ray".into(), per_ray as f64);
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
+        stats.insert("floor_objects".into(), floor.len() as f64);
         let work = Work {
             head: vec![u32::MAX; voxels.count()],
             voxels,
@@ -196,6 +240,7 @@ impl BreadthFirst {
             bbox,
             geometry,
             record: ObjectRecord::default(),
+            floor,
         };
         Ok(BreadthFirst {
             config,
