@@ -23,7 +23,7 @@ use super::surface::Surfaces;
 use glam::Vec3;
 use rayon::prelude::*;
 use rtbench_engines::{Counters, Engine, Hit, Ray};
-use rtbench_scenes::Scene;
+use rtbench_scenes::{Material, Scene};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -37,11 +37,11 @@ const OFFSET_MIN: f32 = 1e-7;
 
 /// What one ray of a generation carries besides the ray.
 #[derive(Clone, Copy)]
-struct Path {
-    corner: u32,
-    weight: Vec3,
-    depth: u8,
-    inside: bool,
+pub(crate) struct Path {
+    pub corner: u32,
+    pub weight: Vec3,
+    pub depth: u8,
+    pub inside: bool,
 }
 
 /// Ray counts of one generation.
@@ -167,6 +167,102 @@ fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
     p + n * scale
 }
 
+/// Shades one hit (NFF Phong, SPD spawning rules; see the module's policies): returns the
+/// ambient term for the ray's corner, emits a shadow ray with its gain per light the shading
+/// normal faces, and the reflection and refraction rays of the next generation. Shared by the
+/// in-memory tracer and the out-of-core one (`super::out_of_core`), so images agree.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shade_hit(
+    ray: &Ray,
+    hit: &Hit,
+    path: &Path,
+    m: &Material,
+    normals: (Vec3, Vec3),
+    lights: &[(Vec3, Vec3)],
+    g: &mut GenerationStats,
+    shadow: &mut dyn FnMut(Ray, u32, Vec3),
+    next: &mut dyn FnMut(Ray, Path),
+) -> Vec3 {
+    let color = m.color.as_vec3();
+    let d = ray.dir;
+    let p = ray.at(hit.t);
+    let (mut ns, mut ng) = normals;
+    if ng.dot(d) > 0.0 {
+        ng = -ng;
+        ns = -ns;
+    }
+    if ns.dot(d) > 0.0 {
+        // A smooth normal turned away from the viewer: fall back to the facing flat one.
+        ns = ng;
+    }
+    let above = offset_origin(p, ng);
+    for (lp, lc) in lights {
+        let to_light = *lp - p;
+        if ns.dot(to_light) <= 0.0 {
+            continue;
+        }
+        let dist = to_light.length();
+        let l = to_light / dist;
+        let diffuse = color * (m.kd as f32 * ns.dot(l));
+        let h = (l - d).normalize_or_zero();
+        let spec = if m.ks > 0.0 {
+            m.ks as f32 * ns.dot(h).max(0.0).powf(m.shine as f32)
+        } else {
+            0.0
+        };
+        let gain = path.weight * *lc * (diffuse + Vec3::splat(spec));
+        let o = above;
+        shadow(
+            Ray::new(o, l, 0.0, (*lp - o).length() * (1.0 - 1e-6)),
+            path.corner,
+            gain,
+        );
+    }
+    // Ambient term for every object.
+    let ambient = path.weight * color * 0.1;
+    if path.depth >= MAX_DEPTH {
+        return ambient;
+    }
+    let (ks, kt) = (m.ks as f32, m.t as f32);
+    if ks > 0.0 || kt > 0.0 {
+        let r = (d - ns * (2.0 * d.dot(ns))).normalize();
+        let wr = if ks > 0.0 { ks } else { kt };
+        next(
+            Ray::new(above, r, 0.0, f32::INFINITY),
+            Path {
+                corner: path.corner,
+                weight: path.weight * wr,
+                depth: path.depth + 1,
+                inside: path.inside,
+            },
+        );
+        g.reflect += 1;
+    }
+    if kt > 0.0 {
+        let ior = m.ior as f32;
+        let inside = path.inside;
+        let eta = if inside { ior } else { 1.0 / ior };
+        let cos_i = -d.dot(ns);
+        let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        if k >= 0.0 {
+            let t = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
+            next(
+                Ray::new(offset_origin(p, -ng), t, 0.0, f32::INFINITY),
+                Path {
+                    corner: path.corner,
+                    weight: path.weight * kt * color,
+                    depth: path.depth + 1,
+                    inside: !inside,
+                },
+            );
+            g.refract += 1;
+        } else {
+            g.total_internal_reflections += 1;
+        }
+    }
+    ambient
+}
+
 /// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels. With `record`,
 /// every query and its answer is kept.
 pub fn render(
@@ -258,76 +354,25 @@ pub fn render(
             }
             g.hits += 1;
             let m = &scene.materials[surfaces.material[hit.object as usize] as usize];
-            let color = m.color.as_vec3();
-            let d = ray.dir;
             let p = ray.at(hit.t);
-            let (mut ns, mut ng) = surfaces.normals(hit, p);
-            if ng.dot(d) > 0.0 {
-                ng = -ng;
-                ns = -ns;
-            }
-            if ns.dot(d) > 0.0 {
-                // A smooth normal turned away from the viewer: fall back to the facing flat one.
-                ns = ng;
-            }
-            // Ambient term for every object.
-            corners[path.corner as usize] += path.weight * color * 0.1;
-            let above = offset_origin(p, ng);
-            for (lp, lc) in &lights {
-                let to_light = *lp - p;
-                if ns.dot(to_light) <= 0.0 {
-                    continue;
-                }
-                let dist = to_light.length();
-                let l = to_light / dist;
-                let diffuse = color * (m.kd as f32 * ns.dot(l));
-                let h = (l - d).normalize_or_zero();
-                let spec = if m.ks > 0.0 {
-                    m.ks as f32 * ns.dot(h).max(0.0).powf(m.shine as f32)
-                } else {
-                    0.0
-                };
-                let gain = path.weight * *lc * (diffuse + Vec3::splat(spec));
-                let o = above;
-                shadow_rays.push(Ray::new(o, l, 0.0, (*lp - o).length() * (1.0 - 1e-6)));
-                shadow_gain.push((path.corner, gain));
-            }
-            if path.depth >= MAX_DEPTH {
-                continue;
-            }
-            let (ks, kt) = (m.ks as f32, m.t as f32);
-            if ks > 0.0 || kt > 0.0 {
-                let r = (d - ns * (2.0 * d.dot(ns))).normalize();
-                next_rays.push(Ray::new(above, r, 0.0, f32::INFINITY));
-                let wr = if ks > 0.0 { ks } else { kt };
-                next_paths.push(Path {
-                    corner: path.corner,
-                    weight: path.weight * wr,
-                    depth: path.depth + 1,
-                    inside: path.inside,
-                });
-                g.reflect += 1;
-            }
-            if kt > 0.0 {
-                let ior = m.ior as f32;
-                let inside = path.inside;
-                let eta = if inside { ior } else { 1.0 / ior };
-                let cos_i = -d.dot(ns);
-                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                if k >= 0.0 {
-                    let t = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
-                    next_rays.push(Ray::new(offset_origin(p, -ng), t, 0.0, f32::INFINITY));
-                    next_paths.push(Path {
-                        corner: path.corner,
-                        weight: path.weight * kt * color,
-                        depth: path.depth + 1,
-                        inside: !inside,
-                    });
-                    g.refract += 1;
-                } else {
-                    g.total_internal_reflections += 1;
-                }
-            }
+            let normals = surfaces.normals(hit, p);
+            corners[path.corner as usize] += shade_hit(
+                ray,
+                hit,
+                path,
+                m,
+                normals,
+                &lights,
+                &mut g,
+                &mut |r, corner, gain| {
+                    shadow_rays.push(r);
+                    shadow_gain.push((corner, gain));
+                },
+                &mut |r, p| {
+                    next_rays.push(r);
+                    next_paths.push(p);
+                },
+            );
         }
         shade_s += t1.elapsed().as_secs_f64();
 
