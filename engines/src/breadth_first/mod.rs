@@ -257,6 +257,10 @@ impl BreadthFirst {
         &self.header
     }
 
+    pub fn config(&self) -> &BreadthFirstConfig {
+        &self.config
+    }
+
     /// Answers `rays` (ids are their positions) through `out`; the shared body of `intersect`
     /// and `occluded`, and the entry of the out-of-core workload.
     pub fn trace_stream(

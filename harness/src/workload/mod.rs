@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod out_of_core;
 pub mod surface;
 pub mod trace;
 
