@@ -4,5 +4,6 @@ pub mod check;
 pub mod engines;
 pub mod render;
 pub mod reproduce;
+pub mod reproduce_nakamaru;
 pub mod runs;
 pub mod scene;
