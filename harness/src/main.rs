@@ -45,6 +45,16 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            if a.id == "nakamaru-3.2" {
+                return commands::reproduce_thrashing::run(
+                    &a.id,
+                    a.quick,
+                    out,
+                    a.max_sf.as_deref(),
+                    a.fault_ms,
+                    a.json,
+                );
+            }
             commands::reproduce::run(&a.id, a.quick, out, a.engines.as_deref(), a.threads, a.json)
         }
     }

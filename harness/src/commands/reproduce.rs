@@ -34,6 +34,10 @@ const TABLES: &[(&str, &str)] = &[
         "000 (Nakamaru 2002) Table 3.1: breadth-first vs Rayshade (rss, rss-r) times on small data",
     ),
     (
+        "nakamaru-3.2",
+        "000 (Nakamaru 2002) Table 3.2, Figs. 3.5-3.7: grid thrashing onset (Mattson page model) vs breadth-first, 32 MB",
+    ),
+    (
         "kimura-simd",
         "001 (Kimura 2007) §4.3: SIMD 4-ary single-ray traversal speed-up (2.32-4.45x)",
     ),
