@@ -155,8 +155,8 @@ pub struct ReproduceArgs {
     /// Engines, comma-separated (default: every available engine but `reference`).
     #[arg(long)]
     pub engines: Option<String>,
-    /// nakamaru-3.2: the largest size factor to run, `N` for every scene or `balls=6,tree=14`
-    /// (the full ranges take long).
+    /// nakamaru-3.2: the largest size factor to run, `N` for every scene, `balls=6,tree=14`, or
+    /// a range `tree=17..18` (the full ranges take long).
     #[arg(long)]
     pub max_sf: Option<String>,
     /// nakamaru-3.2: cost of a page fault and of a seek in ms for an extra modelled disk

@@ -35,6 +35,9 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             a.size,
         )
     });
+    if let Some(f) = tested.failure() {
+        return Err(input(f));
+    }
     let agreement = c.agreement();
     let v = json!({
         "engine": a.engine,

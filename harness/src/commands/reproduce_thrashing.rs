@@ -234,18 +234,30 @@ fn plot(scene: &str, pts: &[Point], d: &Disk, onset: Option<u32>) -> String {
     s
 }
 
-/// `--max-sf N` (every scene) or `--max-sf balls=6,tree=14` (those scenes).
-fn parse_caps(s: Option<&str>) -> Result<Vec<(Option<String>, u32)>> {
+/// A limit on the SFs run: (scene or every scene, lowest, highest).
+type Cap = (Option<String>, Option<u32>, u32);
+
+/// `--max-sf N` (every scene), `--max-sf balls=6,tree=14` (those scenes), or with a range
+/// `tree=17..18` (only those SFs of that scene): (scene, lowest, highest).
+fn parse_caps(s: Option<&str>) -> Result<Vec<Cap>> {
     let Some(s) = s else { return Ok(Vec::new()) };
-    let bad = || input(format!("--max-sf '{s}': expected N or scene=N,scene=N"));
+    let bad = || {
+        input(format!(
+            "--max-sf '{s}': expected N or scene=N,scene=LO..HI"
+        ))
+    };
     if let Ok(n) = s.parse::<u32>() {
-        return Ok(vec![(None, n)]);
+        return Ok(vec![(None, None, n)]);
     }
     s.split(',')
         .map(|kv| {
             let (k, v) = kv.split_once('=').ok_or_else(bad)?;
-            let n = v.trim().parse::<u32>().map_err(|_| bad())?;
-            Ok((Some(k.trim().to_string()), n))
+            let num = |t: &str| t.trim().parse::<u32>().map_err(|_| bad());
+            let (lo, hi) = match v.split_once("..") {
+                Some((a, b)) => (Some(num(a)?), num(b)?),
+                None => (None, num(v)?),
+            };
+            Ok((Some(k.trim().to_string()), lo, hi))
         })
         .collect()
 }
@@ -300,13 +312,14 @@ pub fn run(
     let mut scenes_json = Vec::new();
     let mut summary = Vec::new();
     for (scene, range) in ranges {
-        let lo = range[0].as_u64().unwrap() as u32;
+        let mut lo = range[0].as_u64().unwrap() as u32;
         let mut hi = range[1].as_u64().unwrap() as u32;
         if let Some(m) = caps
             .iter()
             .find(|c| c.0.is_none() || c.0.as_deref() == Some(scene.as_str()))
         {
-            hi = hi.min(m.1);
+            lo = lo.max(m.1.unwrap_or(0));
+            hi = hi.min(m.2);
         }
         if quick {
             hi = hi.min(lo + 1);
