@@ -59,11 +59,6 @@ impl IoFile {
         }
     }
 
-    /// Bytes of the buffer (what this file holds in memory).
-    pub fn buffer_bytes(&self) -> usize {
-        self.buf.len()
-    }
-
     /// Offset of the next byte `read_exact` returns.
     pub fn position(&self) -> u64 {
         self.base + self.pos as u64
@@ -112,11 +107,6 @@ impl IoFile {
             out = &mut out[n..];
         }
         Ok(())
-    }
-
-    /// True when no byte is left to read.
-    pub fn at_end(&mut self) -> io::Result<bool> {
-        Ok(self.pos == self.len && self.fill()? == 0)
     }
 
     pub fn write_all(&mut self, mut data: &[u8]) -> io::Result<()> {
