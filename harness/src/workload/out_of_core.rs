@@ -7,8 +7,8 @@
 //! 1. The generation's rays (ray, corner, weight, depth, medium) are in a spill file, in the order
 //!    the in-memory tracer makes them.
 //! 2. The engine reads them sequentially and gives hit records (ray id, object, t, u, v) in the
-//!    order rays finish; they are filed by ray id (the thesis's sort by ray id) in an array of
-//!    16 bytes per ray of the generation.
+//!    order rays finish; they are spilled into one file per group of [`GROUP`] ray ids (a
+//!    one-pass bucket sort: the thesis's sort by ray id), each group's then filed by id.
 //! 3. Shading takes the rays in groups of [`GROUP`] ids, read sequentially; each group's hits
 //!    are sorted by object id and the bounding-box and geometry files read forward only,
 //!    loading just the objects hit (Algorithm 3.6, "join" of hit records and scene). What
@@ -18,8 +18,8 @@
 //! 4. Shadow rays go to their own spill file, are answered by the engine (one byte per ray), and
 //!    their gains added in order.
 //!
-//! What is held: the image (12 bytes per pixel corner), one hit record per ray of the current
-//! generation, one byte per shadow ray, a group of rays, and the engine within its budget.
+//! What is held: the image (12 bytes per pixel corner), one byte per shadow ray, a group of rays
+//! and their hit records, one small buffer per hit-record file, and the engine within its budget.
 
 use super::camera::Camera;
 use super::trace::{shade_hit, GenerationStats, Path, RayStats, Render, MAX_DEPTH};
@@ -38,6 +38,32 @@ pub const GROUP: usize = 1 << 14;
 /// Bytes of one ray record of a generation file, and of a shadow record.
 const RAY_RECORD: usize = 52;
 const SHADOW_RECORD: usize = 48;
+const HIT_RECORD: usize = 20;
+/// Buffer of each hit-record file (one per group of the generation).
+const HIT_BUFFER: usize = 16 << 10;
+
+fn encode_hit(id: u32, h: &Hit) -> [u8; HIT_RECORD] {
+    let mut b = [0u8; HIT_RECORD];
+    b[..4].copy_from_slice(&id.to_le_bytes());
+    b[4..8].copy_from_slice(&h.t.to_le_bytes());
+    b[8..12].copy_from_slice(&h.object.to_le_bytes());
+    b[12..16].copy_from_slice(&h.u.to_le_bytes());
+    b[16..].copy_from_slice(&h.v.to_le_bytes());
+    b
+}
+
+fn decode_hit(b: &[u8]) -> (u32, Hit) {
+    let u = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+    (
+        u(0),
+        Hit {
+            t: f32::from_bits(u(4)),
+            object: u(8),
+            u: f32::from_bits(u(12)),
+            v: f32::from_bits(u(16)),
+        },
+    )
+}
 
 pub struct OutOfCoreRender {
     pub render: Render,
@@ -213,7 +239,6 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     let mut counters = Counters::default();
     let (mut intersect_s, mut shade_s) = (0.0, 0.0);
     let mut generation = 0u32;
-    let mut hits: Vec<Hit> = Vec::new();
     let mut record = ObjectRecord::default();
     while rays.len > 0 {
         generation += 1;
@@ -223,19 +248,26 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
             rays: n,
             ..Default::default()
         };
-        // Intersection: hit records filed by ray id.
+        // Intersection: hit records spilled into one file per group of ray ids.
         let t0 = Instant::now();
-        hits.clear();
-        hits.resize(n as usize, Hit::MISS);
+        let groups = n.div_ceil(GROUP as u64) as usize;
+        let mut buckets = (0..groups)
+            .map(|b| Records::create(spill.path(), &format!("hits-{generation}-{b}"), HIT_BUFFER))
+            .collect::<io::Result<Vec<_>>>()?;
         let mut file = rays.reader()?;
-        let mut error = None;
+        let (mut error, mut write_error) = (None, None);
         engine.trace_stream(
             &mut ray_stream(&mut file, n, RAY_RECORD, &mut error),
             false,
-            &mut |id, hit| hits[id as usize] = hit,
+            &mut |id, hit| {
+                if write_error.is_none() {
+                    let r = buckets[id as usize / GROUP].push(&encode_hit(id, &hit));
+                    write_error = r.err();
+                }
+            },
             &mut counters,
         )?;
-        if let Some(e) = error {
+        if let Some(e) = error.or(write_error) {
             return Err(e);
         }
         io_total.add(&file.io);
@@ -252,31 +284,43 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
         let mut out_next: Vec<(u32, Ray, Path)> = Vec::new();
         let mut out_shadow: Vec<(u32, Ray, u32, Vec3)> = Vec::new();
         let mut buf = [0u8; RAY_RECORD];
+        let mut hb = [0u8; HIT_RECORD];
+        let mut hits = vec![Hit::MISS; GROUP];
         let mut first = 0u64;
-        while first < n {
+        for mut bucket in buckets {
             let count = (n - first).min(GROUP as u64) as usize;
             group.clear();
             for _ in 0..count {
                 file.read_exact(&mut buf)?;
                 group.push(decode_path(&buf));
             }
+            // This group's hit records, filed by ray id.
+            let mut hfile = bucket.reader()?;
+            for _ in 0..bucket.len {
+                hfile.read_exact(&mut hb)?;
+                let (id, hit) = decode_hit(&hb);
+                hits[(id as u64 - first) as usize] = hit;
+            }
+            io_total.add(&hfile.io);
+            drop(hfile);
+            io_total.add(&bucket.remove()?);
             order.clear();
             for k in 0..count {
-                let hit = &hits[first as usize + k];
+                let hit = &hits[k];
                 if hit.is_hit() {
                     order.push(k as u32);
                 } else {
                     term[k] = group[k].1.weight * background;
                 }
             }
-            order.sort_by_key(|&k| (hits[first as usize + k as usize].object, k));
+            order.sort_by_key(|&k| (hits[k as usize].object, k));
             bbox.rewind()?;
             geometry.rewind()?;
             let mut loaded = u32::MAX;
             out_next.clear();
             out_shadow.clear();
             for &k in &order {
-                let hit = hits[first as usize + k as usize];
+                let hit = hits[k as usize];
                 if hit.object != loaded {
                     // Forward through the bounding-box file to the object's geometry offset.
                     let offset = loop {
