@@ -62,6 +62,10 @@ impl Counters {
     }
 }
 
+/// Rays per engine call by default: large enough to amortise the call, small enough to split
+/// across threads.
+pub const DEFAULT_BATCH: usize = 4096;
+
 /// A built acceleration structure. `Send + Sync`: batches may be answered from several threads
 /// at once, each with its own `Counters`.
 pub trait Engine: Send + Sync {
@@ -76,6 +80,20 @@ pub trait Engine: Send + Sync {
     /// Bytes of the acceleration structure itself (nodes, cells, index lists; not the geometry
     /// shared by all engines unless the engine copies it).
     fn structure_bytes(&self) -> u64;
+
+    /// Rays per call the engine wants: `Some(n)` lets the caller split a generation into calls
+    /// of n rays over its threads (in-memory engines); `None` asks for the whole generation in
+    /// one call (the breadth-first engine sweeps the scene once per pass for all its rays).
+    fn batch_hint(&self) -> Option<usize> {
+        Some(DEFAULT_BATCH)
+    }
+
+    /// Why the last calls failed, if they did: an engine that reads files (breadth-first) cannot
+    /// report an I/O error through `intersect`, so it answers MISS and says so here. The caller
+    /// turns it into an error instead of results.
+    fn failure(&self) -> Option<String> {
+        None
+    }
 
     /// Build statistics (node counts, depths, resolution, build seconds …), by name.
     fn build_stats(&self) -> BTreeMap<String, f64> {

@@ -14,6 +14,7 @@
 //! assert!(hits[0].is_hit());
 //! ```
 
+pub mod breadth_first;
 pub mod bvh;
 pub mod embree;
 pub mod engine;
@@ -23,6 +24,7 @@ pub mod object_space;
 pub mod obvhs_engine;
 pub mod ray;
 pub mod reference;
+pub mod store;
 pub mod testing;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest};
@@ -32,6 +34,7 @@ pub use ray::{Hit, Ray};
 pub fn registry() -> Vec<EngineInfo> {
     let mut v = vec![
         reference::info(),
+        breadth_first::info(),
         embree::info(),
         grid::info(),
         bvh::info2(),

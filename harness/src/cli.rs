@@ -158,6 +158,14 @@ pub struct ReproduceArgs {
     /// Engines, comma-separated (default: every available engine but `reference`).
     #[arg(long)]
     pub engines: Option<String>,
+    /// nakamaru-3.2: the largest size factor to run, `N` for every scene, `balls=6,tree=14`, or
+    /// a range `tree=17..18` (the full ranges take long).
+    #[arg(long)]
+    pub max_sf: Option<String>,
+    /// nakamaru-3.2: cost of a page fault and of a seek in ms for an extra modelled disk
+    /// (beside the HDD-like 8 ms and the SSD-like 0.1 ms).
+    #[arg(long)]
+    pub fault_ms: Option<f64>,
     #[arg(long)]
     pub threads: Option<usize>,
     /// yamauchi-* only: image size of 003's pass (default 512, 128 with --quick).
@@ -187,6 +195,18 @@ pub enum SceneCommand {
         /// Output file (written atomically); stdout when absent.
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
+    },
+    /// Write a scene store for the breadth-first engine (bounding-box and geometry files,
+    /// header.json), streaming from the generator without holding the scene.
+    Store {
+        #[command(flatten)]
+        scene: SceneArg,
+        /// Directory to create (must not exist, or be empty); written under a temporary name and
+        /// renamed when complete.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        #[arg(long)]
+        json: bool,
     },
     /// Count a scene's primitives by streaming it.
     Stats {

@@ -24,6 +24,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene(SceneCommand::Gen { scene, output }) => {
             commands::scene::gen(&scene_source(&scene.scene, &scene.opts)?, output.as_deref())
         }
+        Command::Scene(SceneCommand::Store {
+            scene,
+            output,
+            json,
+        }) => commands::scene::store(&scene_source(&scene.scene, &scene.opts)?, &output, json),
         Command::Scene(SceneCommand::Stats { scene, json }) => {
             commands::scene::stats(&scene_source(&scene.scene, &scene.opts)?, json)
         }
@@ -42,6 +47,16 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            if a.id == "nakamaru-3.2" {
+                return commands::reproduce_thrashing::run(
+                    &a.id,
+                    a.quick,
+                    out,
+                    a.max_sf.as_deref(),
+                    a.fault_ms,
+                    a.json,
+                );
+            }
             let limits = commands::yamauchi::Limits {
                 size: a.size,
                 max_pes: a.max_pes,

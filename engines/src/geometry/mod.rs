@@ -14,7 +14,7 @@ use crate::engine::TriangleTest;
 use crate::ray::Ray;
 use glam::Vec3;
 use kernels::f32 as k;
-use rtbench_scenes::{triangulate, Scene, Shape};
+use rtbench_scenes::{triangulate, Scene, ShapeRef};
 
 /// One prepared primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -120,53 +120,13 @@ pub struct Geometry {
 impl Geometry {
     pub fn from_scene(scene: &Scene) -> Geometry {
         let mut g = Geometry::default();
+        let mut prims = Vec::new();
         let mut tris = Vec::new();
         for (i, o) in scene.objects.iter().enumerate() {
-            let id = i as u32;
-            match &o.shape {
-                Shape::Sphere { center, radius } => g.push(
-                    Prim::Sphere {
-                        center: center.as_vec3(),
-                        radius: *radius as f32,
-                    },
-                    id,
-                ),
-                Shape::Cone {
-                    base,
-                    base_radius,
-                    apex,
-                    apex_radius,
-                } => g.push(
-                    Prim::Cone {
-                        base: base.as_vec3(),
-                        base_radius: *base_radius as f32,
-                        apex: apex.as_vec3(),
-                        apex_radius: *apex_radius as f32,
-                    },
-                    id,
-                ),
-                Shape::Patch { vertices, .. } if vertices.len() == 3 => g.push(
-                    Prim::Triangle([
-                        vertices[0].as_vec3(),
-                        vertices[1].as_vec3(),
-                        vertices[2].as_vec3(),
-                    ]),
-                    id,
-                ),
-                Shape::Polygon(v) | Shape::Patch { vertices: v, .. } => {
-                    tris.clear();
-                    triangulate::triangulate(v, &mut tris);
-                    for t in &tris {
-                        g.push(
-                            Prim::Triangle([
-                                v[t[0]].as_vec3(),
-                                v[t[1]].as_vec3(),
-                                v[t[2]].as_vec3(),
-                            ]),
-                            id,
-                        );
-                    }
-                }
+            prims.clear();
+            prims_of(o.shape.as_ref(), &mut prims, &mut tris);
+            for p in &prims {
+                g.push(*p, i as u32);
             }
         }
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
@@ -188,5 +148,45 @@ impl Geometry {
     /// Bytes the prepared primitives take (shared by all engines).
     pub fn bytes(&self) -> u64 {
         (self.prims.len() * (std::mem::size_of::<Prim>() + 4)) as u64
+    }
+}
+
+/// The prepared primitives of one scene object, appended to `out`: spheres and cones as they
+/// are, a three-vertex patch as one triangle, other polygons and patches cut into triangles by
+/// ear clipping. `tris` is scratch space. One function, so that every engine (and the on-disk
+/// store of [`crate::store`]) prepares an object the same way.
+pub fn prims_of(shape: ShapeRef<'_>, out: &mut Vec<Prim>, tris: &mut Vec<[usize; 3]>) {
+    match shape {
+        ShapeRef::Sphere { center, radius } => out.push(Prim::Sphere {
+            center: center.as_vec3(),
+            radius: radius as f32,
+        }),
+        ShapeRef::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+        } => out.push(Prim::Cone {
+            base: base.as_vec3(),
+            base_radius: base_radius as f32,
+            apex: apex.as_vec3(),
+            apex_radius: apex_radius as f32,
+        }),
+        ShapeRef::Patch { vertices, .. } if vertices.len() == 3 => out.push(Prim::Triangle([
+            vertices[0].as_vec3(),
+            vertices[1].as_vec3(),
+            vertices[2].as_vec3(),
+        ])),
+        ShapeRef::Polygon(v) | ShapeRef::Patch { vertices: v, .. } => {
+            tris.clear();
+            triangulate::triangulate(v, tris);
+            for t in tris.iter() {
+                out.push(Prim::Triangle([
+                    v[t[0]].as_vec3(),
+                    v[t[1]].as_vec3(),
+                    v[t[2]].as_vec3(),
+                ]));
+            }
+        }
     }
 }

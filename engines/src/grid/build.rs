@@ -28,9 +28,9 @@ pub const FLOOR_SPAN: f64 = 0.9;
 pub const FLOOR_FLAT: f64 = 0.01;
 
 /// Relative padding of cells against `f32` rounding, per unit of the largest coordinate.
-const PAD_COORD: f32 = 4e-6;
+pub(crate) const PAD_COORD: f32 = 4e-6;
 /// Padding as a fraction of a cell's side.
-const PAD_CELL: f32 = 1e-5;
+pub(crate) const PAD_CELL: f32 = 1e-5;
 
 /// The uniform grid itself: its box, its resolution and its compact cell lists.
 #[derive(Clone, Debug, Default)]

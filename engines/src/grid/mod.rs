@@ -33,6 +33,7 @@ pub mod build;
 pub mod config;
 pub mod mailbox;
 pub mod overlap;
+pub mod paging;
 pub mod resolution;
 pub mod shadow_cache;
 pub mod traverse;

@@ -35,7 +35,7 @@ use glam::Vec3;
 const MIN_MOVE: f32 = 1e-18;
 
 /// Per-ray set-up shared by every primitive test and by the walk.
-struct RaySetup {
+pub(super) struct RaySetup {
     /// 1/d per axis, or 0 along an axis the ray does not move on.
     inv: [f32; 3],
     /// Whether the ray moves along each axis: |d| at least [`MIN_MOVE`], so that 1/d and the
@@ -46,7 +46,7 @@ struct RaySetup {
 
 impl RaySetup {
     #[inline]
-    fn new(ray: &Ray) -> RaySetup {
+    pub(super) fn new(ray: &Ray) -> RaySetup {
         let d = ray.dir.to_array();
         let mut inv = [0.0; 3];
         let mut moves = [false; 3];
@@ -90,7 +90,12 @@ impl Grid {
     /// t of plane 0) rather than accumulated, so rounding does not drift along long rays. The
     /// three axes are spelled out (no indexing by axis) so that the state stays in registers.
     #[inline(always)]
-    fn walk(&self, ray: &Ray, s: &RaySetup, mut visit: impl FnMut(usize, f32, f32) -> bool) {
+    pub(super) fn walk(
+        &self,
+        ray: &Ray,
+        s: &RaySetup,
+        mut visit: impl FnMut(usize, f32, f32) -> bool,
+    ) {
         let g = &self.cells;
         // Clip the segment to the grid's box (the slab test of the DDA's set-up, which also
         // needs the exit distance and the axes the ray does not move along).

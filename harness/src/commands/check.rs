@@ -53,6 +53,9 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             size,
         )
     });
+    if let Some(f) = tested.failure() {
+        return Err(input(f));
+    }
     let agreement = c.agreement();
     let v = json!({
         "engine": engine,

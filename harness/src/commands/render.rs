@@ -1,7 +1,7 @@
 //! `rtbench render`: the SPD workload for one scene and one engine.
 
 use crate::cli::RenderArgs;
-use crate::error::Result;
+use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
 use crate::workload::{self, trace};
@@ -11,6 +11,10 @@ use sha2::{Digest, Sha256};
 pub fn run(a: &RenderArgs) -> Result<()> {
     workload::check_size(a.size)?;
     let settings = workload::parse_settings(&a.set)?;
+    let store = std::path::Path::new(&a.scene.scene);
+    if store.join(rtbench_engines::store::HEADER_FILE).is_file() {
+        return run_store(a, store, settings);
+    }
     let src = Source::resolve(
         &a.scene.scene,
         a.scene.opts.sf,
@@ -21,6 +25,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let prepared = workload::prepare(&src)?;
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
     let r = pool.install(|| trace::render(&prepared.input.scene, engine.as_ref(), a.size, None));
+    if let Some(f) = engine.failure() {
+        return Err(input(f));
+    }
     let pixels = r.pixels();
     let sha = hex(&Sha256::digest(&pixels));
     if let Some(png) = &a.png {
@@ -86,4 +93,90 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 
 pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// `rtbench render --scene STORE_DIR --engine breadth-first`: the out-of-core workload
+/// ([`workload::out_of_core`]); the scene is never loaded.
+fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, String)>) -> Result<()> {
+    use rtbench_engines::breadth_first::{config::BreadthFirstConfig, BreadthFirst};
+    let o = &a.scene.opts;
+    if o.sf.is_some() || o.tessellate.is_some() || o.hash.is_some() {
+        return Err(input(format!(
+            "{}: a scene store is fixed; --sf, --tessellate and --hash apply to programs",
+            dir.display()
+        )));
+    }
+    if a.engine != "breadth-first" {
+        return Err(input(format!(
+            "{}: a scene store is traced by the breadth-first engine only, not '{}'",
+            dir.display(),
+            a.engine
+        )));
+    }
+    let t = std::time::Instant::now();
+    let config = BreadthFirstConfig::from_settings(rtbench_engines::Settings::new(
+        "breadth-first",
+        settings,
+    ))?;
+    let engine = BreadthFirst::open(dir, config)?;
+    let build_s = t.elapsed().as_secs_f64();
+    let ooc = workload::out_of_core::render(&engine, a.size)
+        .map_err(|e| input(format!("{}: out-of-core render: {e}", dir.display())))?;
+    let r = &ooc.render;
+    let pixels = r.pixels();
+    let sha = hex(&Sha256::digest(&pixels));
+    if let Some(png) = &a.png {
+        write_atomic(png, |w| {
+            image::write_buffer_with_format(
+                w,
+                &pixels,
+                a.size,
+                a.size,
+                image::ExtendedColorType::Rgb8,
+                image::ImageFormat::Png,
+            )
+            .map_err(std::io::Error::other)
+        })?;
+    }
+    let h = engine.header();
+    let v = json!({
+        "engine": a.engine,
+        "scene": {
+            "name": h.name,
+            "store": dir.display().to_string(),
+            "objects": h.objects,
+            "primitives": h.primitives,
+            "lights": h.lights.len(),
+        },
+        "threads": 1,
+        "rays": r.stats,
+        "time_s": {
+            "preprocess": build_s,
+            "build": build_s,
+            "trace": r.trace_s,
+            "intersect": r.intersect_s,
+            "shade": r.shade_s,
+        },
+        "memory": {"structure_bytes": rtbench_engines::Engine::structure_bytes(&engine),
+                   "peak_rss_bytes": workload::peak_rss_bytes()},
+        "counters": r.counters,
+        "io": {"workload": ooc.io},
+        "build_stats": rtbench_engines::Engine::build_stats(&engine),
+        "image": {"width": a.size, "height": a.size, "sha256": sha},
+    });
+    if a.json {
+        print_json(&v);
+    } else {
+        let s = &r.stats;
+        println!(
+            "{} on store {}: {} rays in {:.3} s, preprocess {:.3} s, peak RSS {:.1} MiB",
+            a.engine,
+            dir.display(),
+            s.total,
+            r.trace_s,
+            build_s,
+            workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+        );
+    }
+    Ok(())
 }

@@ -31,6 +31,14 @@ const TABLES: &[(&str, &str)] = &[
         "001 (Kimura 2007) §3.3-3.5: node statistics of 2/4/8-ary BVHs (orderings and ratios)",
     ),
     (
+        "nakamaru-3.1",
+        "000 (Nakamaru 2002) Table 3.1: breadth-first vs Rayshade (rss, rss-r) times on small data",
+    ),
+    (
+        "nakamaru-3.2",
+        "000 (Nakamaru 2002) Table 3.2, Figs. 3.5-3.7: grid thrashing onset (Mattson page model) vs breadth-first, 32 MB",
+    ),
+    (
         "kimura-simd",
         "001 (Kimura 2007) §4.3: SIMD 4-ary single-ray traversal speed-up (2.32-4.45x)",
     ),
@@ -105,6 +113,7 @@ pub fn run(
         "spd-stats" => {}
         "kimura-3.3" => return kimura_trees(id, quick, out, as_json),
         "kimura-simd" => return kimura_simd(id, quick, out, as_json),
+        "nakamaru-3.1" => return super::reproduce_nakamaru::run(id, quick, out, as_json),
         _ => {
             let ids: Vec<_> = TABLES.iter().map(|t| t.0).collect();
             return Err(input(format!(
@@ -215,7 +224,13 @@ pub fn run(
 }
 
 /// Writes DIR/<id>.json and DIR/<id>.md, and prints one of them.
-fn write_report(id: &str, out: &Path, doc: &Value, md: &str, as_json: bool) -> Result<()> {
+pub(super) fn write_report(
+    id: &str,
+    out: &Path,
+    doc: &Value,
+    md: &str,
+    as_json: bool,
+) -> Result<()> {
     std::fs::create_dir_all(out)
         .map_err(|e| input(format!("{}: cannot create: {e}", out.display())))?;
     write_atomic(&out.join(format!("{id}.json")), |w| {

@@ -3,6 +3,7 @@
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
+use rtbench_engines::store::{StoreHeader, StoreWriter};
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
@@ -73,6 +74,79 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
                 crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
             );
         }
+    }
+    Ok(())
+}
+
+/// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
+/// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
+/// so a failure (bad input, full disk) leaves nothing behind.
+pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
+    let start = std::time::Instant::now();
+    if out.exists()
+        && std::fs::read_dir(out)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
+        return Err(input(format!(
+            "{}: exists and is not an empty directory",
+            out.display()
+        )));
+    }
+    let name = out
+        .file_name()
+        .ok_or_else(|| input(format!("{}: not a directory name", out.display())))?;
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = parent.join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let cleanup = |e: String| {
+        let _ = std::fs::remove_dir_all(&tmp);
+        input(e)
+    };
+    let mut w = StoreWriter::create(&tmp, &src.label())
+        .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
+    if let Err(e) = src.stream(&mut w) {
+        let _ = std::fs::remove_dir_all(&tmp);
+        return Err(e);
+    }
+    let io = w
+        .finish()
+        .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
+    if out.exists() {
+        let _ = std::fs::remove_dir(out);
+    }
+    std::fs::rename(&tmp, out)
+        .map_err(|e| cleanup(format!("{}: cannot rename into place: {e}", out.display())))?;
+    let header = StoreHeader::read(out).map_err(|e| input(e.to_string()))?;
+    let secs = start.elapsed().as_secs_f64();
+    let v = json!({
+        "store": out.display().to_string(),
+        "scene": src.label(),
+        "objects": header.objects,
+        "primitives": header.primitives,
+        "bytes_written": io.bytes_written,
+        "write_calls": io.write_calls,
+        "time_s": secs,
+        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+    });
+    if as_json {
+        print_json(&v);
+    } else {
+        eprintln!(
+            "wrote {} ({} objects, {} primitives, {:.1} MB) in {:.2} s, peak RSS {:.1} MiB",
+            out.display(),
+            header.objects,
+            header.primitives,
+            io.bytes_written as f64 / 1e6,
+            secs,
+            crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+        );
     }
     Ok(())
 }

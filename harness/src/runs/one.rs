@@ -63,6 +63,9 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         let (engine, build_s) =
             workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
         let r = pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
+        if let Some(f) = engine.failure() {
+            return Err(crate::error::input(f));
+        }
         build.push(prepared.prepare_s + build_s);
         tr.push(r.trace_s);
         cpu.push(r.trace_cpu_s);

@@ -72,9 +72,14 @@ pub fn measure(scene: &Scene, engine: &dyn Engine, primary: &[Ray]) -> Acne {
     let mut displaced = 0u64;
     let mut counters = Counters::default();
     let mut hits = Vec::new();
-    trace::query_all(primary, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
-        engine.intersect(r, h, c)
-    });
+    trace::query_all(
+        engine.batch_hint(),
+        primary,
+        &mut hits,
+        Hit::MISS,
+        &mut counters,
+        |r, h, c| engine.intersect(r, h, c),
+    );
     let lights: Vec<Vec3> = scene.lights.iter().map(|l| l.position.as_vec3()).collect();
     let (mut rays, mut from) = (Vec::new(), Vec::new());
     for (ray, hit) in primary.iter().zip(&hits) {
@@ -113,9 +118,14 @@ pub fn measure(scene: &Scene, engine: &dyn Engine, primary: &[Ray]) -> Acne {
         }
     }
     let mut second = Vec::new();
-    trace::query_all(&rays, &mut second, Hit::MISS, &mut counters, |r, h, c| {
-        engine.intersect(r, h, c)
-    });
+    trace::query_all(
+        engine.batch_hint(),
+        &rays,
+        &mut second,
+        Hit::MISS,
+        &mut counters,
+        |r, h, c| engine.intersect(r, h, c),
+    );
     let acne = second
         .iter()
         .zip(&from)

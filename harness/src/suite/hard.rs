@@ -103,6 +103,7 @@ fn run_variant(
         };
         let mut hits = Vec::new();
         trace::query_all(
+            engine.batch_hint(),
             &set.rays,
             &mut hits,
             Hit::MISS,

@@ -105,13 +105,23 @@ pub fn cross_check(
     let rays: Vec<_> = rec.closest.iter().map(|(r, _)| *r).collect();
     let (mut hits, mut occ) = (Vec::new(), Vec::new());
     let mut counters = Counters::default();
-    trace::query_all(&rays, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
-        tested.intersect(r, h, c)
-    });
+    trace::query_all(
+        tested.batch_hint(),
+        &rays,
+        &mut hits,
+        Hit::MISS,
+        &mut counters,
+        |r, h, c| tested.intersect(r, h, c),
+    );
     let srays: Vec<_> = rec.any.iter().map(|(r, _)| *r).collect();
-    trace::query_all(&srays, &mut occ, false, &mut counters, |r, o, c| {
-        tested.occluded(r, o, c)
-    });
+    trace::query_all(
+        tested.batch_hint(),
+        &srays,
+        &mut occ,
+        false,
+        &mut counters,
+        |r, o, c| tested.occluded(r, o, c),
+    );
 
     let mut agree = 0u64;
     let (mut t_err, mut t_err_raw) = (Vec::new(), Vec::new());

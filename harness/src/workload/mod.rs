@@ -2,6 +2,8 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod out_of_core;
+pub mod paging;
 pub mod surface;
 pub mod trace;
 pub mod yamauchi;

@@ -23,7 +23,7 @@ use super::surface::Surfaces;
 use glam::Vec3;
 use rayon::prelude::*;
 use rtbench_engines::{Counters, Engine, Hit, Ray};
-use rtbench_scenes::Scene;
+use rtbench_scenes::{Material, Scene};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -34,16 +34,14 @@ pub const MAX_DEPTH: u8 = 5;
 pub const OFFSET_REL: f32 = 1.0 / 32768.0;
 /// Floor of the offset, for hit points at the origin.
 const OFFSET_MIN: f32 = 1e-7;
-/// Rays per engine call: large enough to amortise the call, small enough to split across threads.
-const BATCH: usize = 4096;
 
 /// What one ray of a generation carries besides the ray.
 #[derive(Clone, Copy)]
-struct Path {
-    corner: u32,
-    weight: Vec3,
-    depth: u8,
-    inside: bool,
+pub(crate) struct Path {
+    pub corner: u32,
+    pub weight: Vec3,
+    pub depth: u8,
+    pub inside: bool,
 }
 
 /// Ray counts of one generation.
@@ -130,11 +128,13 @@ fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
     }
 }
 
-/// Answers a batch of queries (`engine.intersect` or `engine.occluded`) split into chunks over
-/// the pool's threads, each chunk with its own counters, summed into `counters`. `out` is resized
-/// to the batch and filled with `fill` first. Returns the CPU seconds used on threads other than
-/// the caller's.
+/// Answers a batch of queries (`engine.intersect` or `engine.occluded`) split into chunks of
+/// `batch` rays (the engine's [`Engine::batch_hint`]; `None`: all in one call, for engines that
+/// answer a whole generation at once) over the pool's threads, each chunk with its own
+/// counters, summed into `counters`. `out` is resized to the batch and filled with `fill` first.
+/// Returns the CPU seconds used on threads other than the caller's.
 pub(crate) fn query_all<T: Clone + Send>(
+    batch: Option<usize>,
     rays: &[Ray],
     out: &mut Vec<T>,
     fill: T,
@@ -144,9 +144,10 @@ pub(crate) fn query_all<T: Clone + Send>(
     out.clear();
     out.resize(rays.len(), fill);
     let me = rayon::current_thread_index();
+    let chunk = batch.unwrap_or(rays.len()).max(1);
     let sums: Vec<(Counters, f64)> = rays
-        .par_chunks(BATCH)
-        .zip(out.par_chunks_mut(BATCH))
+        .par_chunks(chunk)
+        .zip(out.par_chunks_mut(chunk))
         .map(|(r, o)| {
             let mut c = Counters::default();
             let cpu = other_thread_cpu(me, || query(r, o, &mut c));
@@ -167,6 +168,102 @@ pub(crate) fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
     p + n * scale
 }
 
+/// Shades one hit (NFF Phong, SPD spawning rules; see the module's policies): returns the
+/// ambient term for the ray's corner, emits a shadow ray with its gain per light the shading
+/// normal faces, and the reflection and refraction rays of the next generation. Shared by the
+/// in-memory tracer and the out-of-core one (`super::out_of_core`), so images agree.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shade_hit(
+    ray: &Ray,
+    hit: &Hit,
+    path: &Path,
+    m: &Material,
+    normals: (Vec3, Vec3),
+    lights: &[(Vec3, Vec3)],
+    g: &mut GenerationStats,
+    shadow: &mut dyn FnMut(Ray, u32, Vec3),
+    next: &mut dyn FnMut(Ray, Path),
+) -> Vec3 {
+    let color = m.color.as_vec3();
+    let d = ray.dir;
+    let p = ray.at(hit.t);
+    let (mut ns, mut ng) = normals;
+    if ng.dot(d) > 0.0 {
+        ng = -ng;
+        ns = -ns;
+    }
+    if ns.dot(d) > 0.0 {
+        // A smooth normal turned away from the viewer: fall back to the facing flat one.
+        ns = ng;
+    }
+    let above = offset_origin(p, ng);
+    for (lp, lc) in lights {
+        let to_light = *lp - p;
+        if ns.dot(to_light) <= 0.0 {
+            continue;
+        }
+        let dist = to_light.length();
+        let l = to_light / dist;
+        let diffuse = color * (m.kd as f32 * ns.dot(l));
+        let h = (l - d).normalize_or_zero();
+        let spec = if m.ks > 0.0 {
+            m.ks as f32 * ns.dot(h).max(0.0).powf(m.shine as f32)
+        } else {
+            0.0
+        };
+        let gain = path.weight * *lc * (diffuse + Vec3::splat(spec));
+        let o = above;
+        shadow(
+            Ray::new(o, l, 0.0, (*lp - o).length() * (1.0 - 1e-6)),
+            path.corner,
+            gain,
+        );
+    }
+    // Ambient term for every object.
+    let ambient = path.weight * color * 0.1;
+    if path.depth >= MAX_DEPTH {
+        return ambient;
+    }
+    let (ks, kt) = (m.ks as f32, m.t as f32);
+    if ks > 0.0 || kt > 0.0 {
+        let r = (d - ns * (2.0 * d.dot(ns))).normalize();
+        let wr = if ks > 0.0 { ks } else { kt };
+        next(
+            Ray::new(above, r, 0.0, f32::INFINITY),
+            Path {
+                corner: path.corner,
+                weight: path.weight * wr,
+                depth: path.depth + 1,
+                inside: path.inside,
+            },
+        );
+        g.reflect += 1;
+    }
+    if kt > 0.0 {
+        let ior = m.ior as f32;
+        let inside = path.inside;
+        let eta = if inside { ior } else { 1.0 / ior };
+        let cos_i = -d.dot(ns);
+        let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        if k >= 0.0 {
+            let t = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
+            next(
+                Ray::new(offset_origin(p, -ng), t, 0.0, f32::INFINITY),
+                Path {
+                    corner: path.corner,
+                    weight: path.weight * kt * color,
+                    depth: path.depth + 1,
+                    inside: !inside,
+                },
+            );
+            g.refract += 1;
+        } else {
+            g.total_internal_reflections += 1;
+        }
+    }
+    ambient
+}
+
 /// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels. With `record`,
 /// every query and its answer is kept.
 pub fn render(
@@ -178,6 +275,7 @@ pub fn render(
     let start = Instant::now();
     let cpu_start = super::thread_cpu_seconds();
     let mut other_cpu = 0.0;
+    let batch = engine.batch_hint();
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
     let w = size + 1;
@@ -230,9 +328,14 @@ pub fn render(
             ..Default::default()
         };
         let t0 = Instant::now();
-        other_cpu += query_all(&rays, &mut hits, Hit::MISS, &mut counters, |r, h, c| {
-            engine.intersect(r, h, c)
-        });
+        other_cpu += query_all(
+            batch,
+            &rays,
+            &mut hits,
+            Hit::MISS,
+            &mut counters,
+            |r, h, c| engine.intersect(r, h, c),
+        );
         intersect_s += t0.elapsed().as_secs_f64();
         if let Some(rec) = record.as_deref_mut() {
             rec.closest
@@ -252,81 +355,31 @@ pub fn render(
             }
             g.hits += 1;
             let m = &scene.materials[surfaces.material[hit.object as usize] as usize];
-            let color = m.color.as_vec3();
-            let d = ray.dir;
             let p = ray.at(hit.t);
-            let (mut ns, mut ng) = surfaces.normals(hit, p);
-            if ng.dot(d) > 0.0 {
-                ng = -ng;
-                ns = -ns;
-            }
-            if ns.dot(d) > 0.0 {
-                // A smooth normal turned away from the viewer: fall back to the facing flat one.
-                ns = ng;
-            }
-            // Ambient term for every object.
-            corners[path.corner as usize] += path.weight * color * 0.1;
-            let above = offset_origin(p, ng);
-            for (lp, lc) in &lights {
-                let to_light = *lp - p;
-                if ns.dot(to_light) <= 0.0 {
-                    continue;
-                }
-                let dist = to_light.length();
-                let l = to_light / dist;
-                let diffuse = color * (m.kd as f32 * ns.dot(l));
-                let h = (l - d).normalize_or_zero();
-                let spec = if m.ks > 0.0 {
-                    m.ks as f32 * ns.dot(h).max(0.0).powf(m.shine as f32)
-                } else {
-                    0.0
-                };
-                let gain = path.weight * *lc * (diffuse + Vec3::splat(spec));
-                let o = above;
-                shadow_rays.push(Ray::new(o, l, 0.0, (*lp - o).length() * (1.0 - 1e-6)));
-                shadow_gain.push((path.corner, gain));
-            }
-            if path.depth >= MAX_DEPTH {
-                continue;
-            }
-            let (ks, kt) = (m.ks as f32, m.t as f32);
-            if ks > 0.0 || kt > 0.0 {
-                let r = (d - ns * (2.0 * d.dot(ns))).normalize();
-                next_rays.push(Ray::new(above, r, 0.0, f32::INFINITY));
-                let wr = if ks > 0.0 { ks } else { kt };
-                next_paths.push(Path {
-                    corner: path.corner,
-                    weight: path.weight * wr,
-                    depth: path.depth + 1,
-                    inside: path.inside,
-                });
-                g.reflect += 1;
-            }
-            if kt > 0.0 {
-                let ior = m.ior as f32;
-                let inside = path.inside;
-                let eta = if inside { ior } else { 1.0 / ior };
-                let cos_i = -d.dot(ns);
-                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                if k >= 0.0 {
-                    let t = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
-                    next_rays.push(Ray::new(offset_origin(p, -ng), t, 0.0, f32::INFINITY));
-                    next_paths.push(Path {
-                        corner: path.corner,
-                        weight: path.weight * kt * color,
-                        depth: path.depth + 1,
-                        inside: !inside,
-                    });
-                    g.refract += 1;
-                } else {
-                    g.total_internal_reflections += 1;
-                }
-            }
+            let normals = surfaces.normals(hit, p);
+            corners[path.corner as usize] += shade_hit(
+                ray,
+                hit,
+                path,
+                m,
+                normals,
+                &lights,
+                &mut g,
+                &mut |r, corner, gain| {
+                    shadow_rays.push(r);
+                    shadow_gain.push((corner, gain));
+                },
+                &mut |r, p| {
+                    next_rays.push(r);
+                    next_paths.push(p);
+                },
+            );
         }
         shade_s += t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
         other_cpu += query_all(
+            batch,
             &shadow_rays,
             &mut blocked,
             false,

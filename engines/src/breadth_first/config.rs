@@ -1,0 +1,133 @@
+//! Settings of the `breadth-first` engine, parsed from `key=value` strings.
+
+use crate::engine::{EngineError, Settings, TriangleTest};
+use std::path::PathBuf;
+use std::str::FromStr;
+
+/// How many candidate voxels each ray is registered in per pass (seed 000 §3.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Registration {
+    /// The same count every pass (`fixed:N`; Table 3.1 used 1, so that the engine makes the
+    /// intersection tests Rayshade makes).
+    Fixed(u32),
+    /// ⌈r/10 + 0.5⌉ every pass, r the grid's resolution per axis (`thesis`; the Ch.3 scaling runs).
+    Thesis,
+    /// ⌈r/10 + 0.5⌉ to start, then inversely proportional to the rays in memory, so the memory
+    /// freed by finished rays goes to those still running (`inverse`; §3.2, dynamic count).
+    Inverse,
+}
+
+impl FromStr for Registration {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "thesis" => Ok(Registration::Thesis),
+            "inverse" => Ok(Registration::Inverse),
+            _ => match s.strip_prefix("fixed:").map(str::parse::<u32>) {
+                Some(Ok(n)) if n >= 1 => Ok(Registration::Fixed(n)),
+                _ => Err("expected fixed:N (N ≥ 1), thesis or inverse".into()),
+            },
+        }
+    }
+}
+
+impl Registration {
+    /// ⌈r/10 + 0.5⌉ as seed 000 prints it.
+    pub fn thesis_count(res: u32) -> u32 {
+        (res as f64 / 10.0 + 0.5).ceil() as u32
+    }
+
+    /// The count of the first pass, which sizes the registration memory.
+    pub fn initial(&self, res: u32) -> u32 {
+        match *self {
+            Registration::Fixed(n) => n,
+            Registration::Thesis | Registration::Inverse => Self::thesis_count(res),
+        }
+    }
+}
+
+/// A byte size: `33554432`, `32MiB`, `64KiB`, `1GiB` (also `MB`, `KB`, `GB` as powers of 10).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bytes(pub u64);
+
+impl FromStr for Bytes {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let split = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+        let (num, unit) = s.split_at(split);
+        let n: u64 = num
+            .parse()
+            .map_err(|_| "expected a size such as 32MiB".to_string())?;
+        let k: u64 = match unit {
+            "" | "B" => 1,
+            "KiB" => 1 << 10,
+            "MiB" => 1 << 20,
+            "GiB" => 1 << 30,
+            "KB" => 1000,
+            "MB" => 1_000_000,
+            "GB" => 1_000_000_000,
+            _ => {
+                return Err(format!(
+                    "unknown unit '{unit}' (B, KiB, MiB, GiB, KB, MB, GB)"
+                ))
+            }
+        };
+        match n.checked_mul(k) {
+            Some(0) => Err("must be above 0".into()),
+            Some(v) => Ok(Bytes(v)),
+            None => Err("too large".into()),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct BreadthFirstConfig {
+    /// Everything the engine holds: grid, ray slots, registrations, I/O buffers.
+    pub memory: u64,
+    /// Where the store of an in-memory scene is written (a fresh subdirectory, removed on drop).
+    pub spill: Option<PathBuf>,
+    pub registration: Registration,
+    /// Bytes of each file buffer (bbox and geometry file).
+    pub buffer: u64,
+    pub triangle: TriangleTest,
+    /// Floor and backdrop polygons in their own group, out of the grid (seed 000 §1.2: "for
+    /// balls and tree the base plate was excluded"), or in it.
+    pub floor: Floor,
+}
+
+pub use crate::grid::config::Floor;
+
+pub const DEFAULT_MEMORY: u64 = 1 << 30;
+pub const DEFAULT_BUFFER: u64 = 1 << 16;
+
+fn bad(key: &str, value: &str, reason: &str) -> EngineError {
+    EngineError::BadValue {
+        engine: "breadth-first".into(),
+        key: key.into(),
+        value: value.into(),
+        reason: reason.into(),
+    }
+}
+
+impl BreadthFirstConfig {
+    pub fn from_settings(mut s: Settings) -> Result<BreadthFirstConfig, EngineError> {
+        let memory = s.get("memory", Bytes(DEFAULT_MEMORY))?.0;
+        let spill: String = s.get("spill", String::new())?;
+        let registration = s.get("registration", Registration::Inverse)?;
+        let buffer = s.get("buffer", Bytes(DEFAULT_BUFFER))?.0;
+        let triangle = s.get("triangle", TriangleTest::Watertight)?;
+        let floor = s.get("floor", Floor::Out)?;
+        s.finish()?;
+        if buffer < 64 {
+            return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
+        }
+        Ok(BreadthFirstConfig {
+            memory,
+            spill: (!spill.is_empty()).then(|| PathBuf::from(spill)),
+            registration,
+            buffer,
+            triangle,
+            floor,
+        })
+    }
+}

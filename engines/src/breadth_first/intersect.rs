@@ -1,0 +1,342 @@
+//! Intersection, seed 000's Algorithm 3.5: rays are registered in their next candidate voxels,
+//! the scene is swept once per pass, and passes repeat until every ray's hit is complete.
+//!
+//! - A voxel is a *candidate* for a ray when it is marked and either it is the ray's first voxel
+//!   in the grid, or the ray entered it through a face flagged as lying on a voxel boundary
+//!   (§3.2, "registration at voxel boundaries"). The thesis's second case (a ray starting inside
+//!   a voxel boundary is registered just before it first crosses a boundary face) is taken here
+//!   as the first voxel itself: both make the ray meet every box it starts in, and the first
+//!   voxel is known without walking. Every box of voxels the walk reaches is then reached at a
+//!   candidate: the walk is face-connected and the box convex.
+//! - A ray's hit is *complete* once it lies in voxels already walked and swept, or the ray left
+//!   the grid (§3.1). After registering k candidates the walk is covered up to the exit of the
+//!   last one; between passes the walk continues through non-candidate voxels (all their boxes
+//!   were met before) until the next candidate, stopping early if the hit lies there.
+//! - In the sweep each object's box of voxels is visited; for each ray registered there the
+//!   per-ray mailbox (last object tested) and the previous-voxel test (the ray's last voxel of
+//!   the previous pass lies in this box: tested then) skip repeated tests (§3.3), then the
+//!   ray–box test, and only then is the geometry read, forward only (§4.2.2, "G").
+//! - Memory is refilled with new rays at the start of every pass, and the registration count is
+//!   set from the rays in memory (§3.3).
+//! - Hit records leave in completion order through `out(ray id, hit)`; the caller files them by
+//!   ray id (the thesis's sort by ray id).
+
+use super::dda::{Dda, START};
+use super::voxels::{face_bit, Voxels, MARKED};
+
+#[inline]
+fn face_bit_of(entered: u8) -> u8 {
+    face_bit((entered / 2) as usize, entered % 2 == 1)
+}
+use super::Work;
+use crate::engine::{Counters, TriangleTest};
+use crate::geometry::aabb::{Aabb, SlabRay};
+use crate::geometry::kernels::f32::WatertightRay;
+use crate::ray::{Hit, Ray};
+use std::io;
+
+/// No registration: the end of a voxel's list.
+const NONE: u32 = u32::MAX;
+
+/// One ray in memory (seed 000 §1.3's per-ray data).
+#[derive(Clone, Copy)]
+pub struct Slot {
+    id: u32,
+    ray: Ray,
+    slab: SlabRay,
+    wt: WatertightRay,
+    dda: Dda,
+    /// Nearest hit so far; `t` also ends the segment still searched.
+    best: Hit,
+    best_t: f32,
+    /// Last object tested (the mailbox, on the ray's side).
+    mailbox: u32,
+    /// The last voxel registered in the previous pass, and in this one (`[u32::MAX; 3]`: none).
+    prev: [u32; 3],
+    last: [u32; 3],
+    /// The walk is swept up to here once this pass's sweep is done.
+    covered: f32,
+    /// The walk ended (left the grid or the segment) during registration.
+    exhausted: bool,
+}
+
+/// One registration of a ray in a voxel: a link of that voxel's list.
+#[derive(Clone, Copy)]
+pub struct Reg {
+    voxel: u32,
+    slot: u32,
+    next: u32,
+}
+
+/// Bytes one ray in memory takes (slot and its registrations), for the memory budget.
+pub fn slot_bytes() -> u64 {
+    std::mem::size_of::<Slot>() as u64
+}
+
+pub fn reg_bytes() -> u64 {
+    std::mem::size_of::<Reg>() as u64
+}
+
+#[inline]
+fn is_candidate(g: &Voxels, d: &Dda) -> bool {
+    let f = g.flags[g.index(d.voxel())];
+    // `entered` is 2·axis + side, the numbering of `face_bit(axis, side)`.
+    f & MARKED != 0 && (d.entered == START || f & face_bit_of(d.entered) != 0)
+}
+
+/// Walks to the ray's first candidate voxel; false when it has none.
+fn first_candidate(g: &Voxels, d: &mut Dda, c: &mut Counters) -> bool {
+    loop {
+        c.cells_visited += 1;
+        if is_candidate(g, d) {
+            return true;
+        }
+        if !d.advance(g) {
+            return false;
+        }
+    }
+}
+
+impl Work {
+    /// Answers all of `rays` (closest hit, or any hit with `any`), calling `out` once per ray.
+    pub fn trace(
+        &mut self,
+        rays: &mut dyn Iterator<Item = (u32, Ray)>,
+        any: bool,
+        test: TriangleTest,
+        out: &mut dyn FnMut(u32, Hit),
+        c: &mut Counters,
+    ) -> io::Result<()> {
+        let mut input_left = true;
+        let mut pass = 0usize;
+        loop {
+            // Refill the free slots (Algorithm 3.5, "while memory not full of rays").
+            while input_left && self.slots.len() < self.capacity {
+                let Some((id, ray)) = rays.next() else {
+                    input_left = false;
+                    break;
+                };
+                c.rays += 1;
+                let wt = WatertightRay::new(ray.dir);
+                // The floor group first: a near floor hit shortens the walk.
+                let mut best = Hit::MISS;
+                let mut seg = ray;
+                'floor: for (fid, rec) in &self.floor {
+                    for prim in &rec.prims {
+                        c.primitive_tests += 1;
+                        if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
+                            c.primitive_hits += 1;
+                            seg.tmax = t;
+                            best = Hit {
+                                t,
+                                object: *fid,
+                                u,
+                                v,
+                            };
+                            if any {
+                                break 'floor;
+                            }
+                        }
+                    }
+                }
+                let g = &self.voxels;
+                let found = if any && best.is_hit() {
+                    None
+                } else {
+                    Dda::start(&seg, g).and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
+                };
+                match found {
+                    None => out(id, best),
+                    Some(dda) => self.slots.push(Slot {
+                        id,
+                        ray,
+                        slab: SlabRay::new(&ray, self.extent),
+                        wt,
+                        dda,
+                        best,
+                        best_t: seg.tmax,
+                        mailbox: u32::MAX,
+                        prev: [u32::MAX; 3],
+                        last: [u32::MAX; 3],
+                        covered: f32::NEG_INFINITY,
+                        exhausted: false,
+                    }),
+                }
+            }
+            if self.slots.is_empty() {
+                return Ok(());
+            }
+            pass += 1;
+            *c.extra
+                .entry(format!("bf_pass_{pass:03}_rays"))
+                .or_insert(0) += self.slots.len() as u64;
+            let count = self.registration_count(self.slots.len());
+            self.register(count, c);
+            self.sweep(any, test, c)?;
+            *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
+            self.finish_pass(any, out, c);
+        }
+    }
+
+    /// Registrations per ray this pass.
+    fn registration_count(&self, in_memory: usize) -> usize {
+        let fixed = self.initial_count as usize;
+        if self.inverse {
+            (self.regs_capacity / in_memory.max(1)).max(fixed)
+        } else {
+            fixed
+        }
+    }
+
+    /// Registers every ray in memory in up to `count` candidate voxels, from the one its walk
+    /// stands on.
+    fn register(&mut self, count: usize, c: &mut Counters) {
+        let g = &self.voxels;
+        for (si, s) in self.slots.iter_mut().enumerate() {
+            let mut k = 0;
+            'walk: loop {
+                let v = s.dda.voxel();
+                let vi = g.index(v) as u32;
+                self.regs.push(Reg {
+                    voxel: vi,
+                    slot: si as u32,
+                    next: self.head[vi as usize],
+                });
+                self.head[vi as usize] = (self.regs.len() - 1) as u32;
+                k += 1;
+                s.last = v;
+                s.covered = s.dda.t_exit();
+                if k == count || s.best_t <= s.covered {
+                    break;
+                }
+                // On to the next candidate.
+                loop {
+                    if !s.dda.advance(g) {
+                        s.exhausted = true;
+                        break 'walk;
+                    }
+                    c.cells_visited += 1;
+                    if is_candidate(g, &s.dda) {
+                        break;
+                    }
+                    if s.best_t <= s.dda.t_exit() {
+                        s.covered = s.dda.t_exit();
+                        break 'walk;
+                    }
+                }
+            }
+        }
+        *c.extra.entry("bf_registrations".into()).or_insert(0) += self.regs.len() as u64;
+    }
+
+    /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects").
+    fn sweep(&mut self, any: bool, test: TriangleTest, c: &mut Counters) -> io::Result<()> {
+        let g = &self.voxels;
+        self.bbox.rewind()?;
+        self.geometry.rewind()?;
+        let (mut prev_skips, mut loads) = (0u64, 0u64);
+        let mut next_floor = self.floor.iter().map(|f| f.0).peekable();
+        while let Some((id, b)) = self.bbox.next_record()? {
+            if next_floor.next_if_eq(&id).is_some() || !(b.lo.is_finite() && b.hi.is_finite()) {
+                continue;
+            }
+            let (a, z) = g.range(b.lo, b.hi);
+            let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
+            let mut loaded = false;
+            for cz in a[2]..=z[2] {
+                for cy in a[1]..=z[1] {
+                    let row = g.index([0, cy, cz]);
+                    for cx in a[0]..=z[0] {
+                        let mut r = self.head[row + cx as usize];
+                        while r != NONE {
+                            let reg = self.regs[r as usize];
+                            r = reg.next;
+                            let s = &mut self.slots[reg.slot as usize];
+                            if any && s.best.is_hit() {
+                                continue;
+                            }
+                            if s.mailbox == id {
+                                c.mailbox_skips += 1;
+                                continue;
+                            }
+                            s.mailbox = id;
+                            let p = s.prev;
+                            if (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
+                                prev_skips += 1;
+                                continue;
+                            }
+                            c.box_tests += 1;
+                            if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
+                                continue;
+                            }
+                            if !loaded {
+                                self.geometry.read_at(b.offset, &mut self.record)?;
+                                loaded = true;
+                                loads += 1;
+                            }
+                            let mut seg = s.ray;
+                            for prim in &self.record.prims {
+                                seg.tmax = s.best_t;
+                                c.primitive_tests += 1;
+                                if let Some((t, u, v)) = prim.intersect(&seg, test, &s.wt) {
+                                    c.primitive_hits += 1;
+                                    s.best_t = t;
+                                    s.best = Hit {
+                                        t,
+                                        object: id,
+                                        u,
+                                        v,
+                                    };
+                                    if any {
+                                        break;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for reg in &self.regs {
+            self.head[reg.voxel as usize] = NONE;
+        }
+        self.regs.clear();
+        *c.extra.entry("bf_prev_voxel_skips".into()).or_insert(0) += prev_skips;
+        *c.extra.entry("bf_geometry_loads".into()).or_insert(0) += loads;
+        Ok(())
+    }
+
+    /// Algorithm 3.5's last loop: rays whose hit is complete leave; the others walk to the first
+    /// candidate of the next pass.
+    fn finish_pass(&mut self, any: bool, out: &mut dyn FnMut(u32, Hit), c: &mut Counters) {
+        let g = &self.voxels;
+        let mut i = 0;
+        while i < self.slots.len() {
+            let s = &mut self.slots[i];
+            s.prev = s.last;
+            let mut done = (any && s.best.is_hit()) || s.exhausted || s.best_t <= s.covered;
+            if !done {
+                loop {
+                    if !s.dda.advance(g) {
+                        done = true;
+                        break;
+                    }
+                    c.cells_visited += 1;
+                    if is_candidate(g, &s.dda) {
+                        break;
+                    }
+                    if s.best_t <= s.dda.t_exit() {
+                        done = true;
+                        break;
+                    }
+                }
+            }
+            if done {
+                out(s.id, s.best);
+                self.slots.swap_remove(i);
+            } else {
+                i += 1;
+            }
+        }
+    }
+}

@@ -1,0 +1,339 @@
+//! `breadth-first`: Nakamaru's out-of-core breadth-first ray tracer, the basic method of seed
+//! 000 chapter 3 (Nakamaru and Ohno 1997) with the improved method's separate bounding-box and
+//! geometry files and lazy geometry loading (§4.2.1–4.2.2, "S" and "G").
+//!
+//! Rays, not objects, are registered in a uniform grid; the scene is streamed from disk once per
+//! pass, sequentially, so its size never makes the engine thrash. Files, one concept each:
+//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4), [`dda`]
+//! (the resumable walk), [`intersect`] (passes, registration, the sweep: Algorithm 3.5),
+//! [`spill`] (the temporary store of an in-memory scene).
+//!
+//! Built from a `BuildInput` (an in-memory scene) it first writes the scene as a store
+//! ([`crate::store`]) in its spill directory; [`BreadthFirst::open`] builds it from a store on
+//! disk. It answers a whole generation per call ([`Engine::batch_hint`] is `None`).
+//!
+//! Settings (`key=value`):
+//!
+//! | key | values | default | what |
+//! |---|---|---|---|
+//! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers |
+//! | `registration` | `fixed:N`, `thesis`, `inverse` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
+//! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
+//! | `buffer` | bytes | `64KiB` | each file buffer |
+//! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
+//! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
+//!
+//! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
+//! of the sweep), `mailbox_skips`, `cells_visited` (voxels walked); in `extra`: `bf_passes`
+//! (scene sweeps), `bf_pass_NNN_rays` (rays in memory at pass NNN, summed over calls: the
+//! surviving rays per pass), `bf_registrations`, `bf_prev_voxel_skips`, `bf_geometry_loads`,
+//! and the exact I/O of the calls: `io_bytes_read`, `io_read_calls`, `io_seeks`.
+
+pub mod config;
+pub mod dda;
+pub mod intersect;
+pub mod spill;
+pub mod voxels;
+
+#[cfg(test)]
+mod tests;
+
+use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::grid::build::{FLOOR_FLAT, FLOOR_SPAN};
+use crate::ray::{Hit, Ray};
+use crate::store::{
+    BboxReader, GeometryReader, IoCounters, ObjectRecord, StoreHeader, StoreWriter, Surface,
+};
+use config::{BreadthFirstConfig, Floor, Registration};
+use glam::Vec3;
+use intersect::{Reg, Slot};
+use spill::SpillDir;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::Instant;
+use voxels::Voxels;
+
+pub fn info() -> EngineInfo {
+    EngineInfo {
+        name: "breadth-first",
+        description: "Nakamaru's out-of-core breadth-first ray tracer: rays registered in a \
+                      uniform grid, the scene streamed from disk once per pass (seed 000)",
+        available: || Ok(()),
+        build: build_engine,
+    }
+}
+
+fn err(reason: String) -> EngineError {
+    EngineError::Build {
+        engine: "breadth-first".into(),
+        reason,
+    }
+}
+
+fn build_engine(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
+    let config = BreadthFirstConfig::from_settings(settings)?;
+    Ok(Box::new(BreadthFirst::from_scene(input, config)?))
+}
+
+/// What the engine works with during a call: the grid, the rays in memory and their
+/// registrations, and the two files.
+pub struct Work {
+    voxels: Voxels,
+    /// Per voxel, the first registration of its list.
+    head: Vec<u32>,
+    regs: Vec<Reg>,
+    regs_capacity: usize,
+    slots: Vec<Slot>,
+    /// Rays in memory at most.
+    capacity: usize,
+    initial_count: u32,
+    inverse: bool,
+    bbox: BboxReader,
+    geometry: GeometryReader,
+    record: ObjectRecord,
+    /// The floor group: (object id, its record), held in memory.
+    floor: Vec<(u32, ObjectRecord)>,
+    /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
+    extent: f32,
+}
+
+impl Work {
+    fn io(&self) -> IoCounters {
+        let mut io = self.bbox.file.io;
+        io.add(&self.geometry.file.io);
+        io
+    }
+}
+
+/// The `grid` engine's floor test ([`crate::grid::build::floor_objects`]) on a bounding box:
+/// spanning [`FLOOR_SPAN`] of the scene along two axes, and flat across the third.
+fn is_floor_box(lo: Vec3, hi: Vec3, scene_extent: Vec3) -> bool {
+    let e = hi - lo;
+    let spans = (0..3)
+        .filter(|&i| scene_extent[i] > 0.0 && e[i] as f64 >= FLOOR_SPAN * scene_extent[i] as f64)
+        .count();
+    spans >= 2 && e.min_element() as f64 <= FLOOR_FLAT * e.max_element() as f64
+}
+
+pub struct BreadthFirst {
+    config: BreadthFirstConfig,
+    header: StoreHeader,
+    work: Mutex<Work>,
+    failure: Mutex<Option<String>>,
+    stats: BTreeMap<String, f64>,
+    structure_bytes: u64,
+    /// The temporary store of an in-memory scene; dropped (removed) with the engine.
+    _spill: Option<SpillDir>,
+}
+
+impl BreadthFirst {
+    /// Writes the scene as a store in the spill directory, then opens it.
+    pub fn from_scene(
+        input: &BuildInput,
+        config: BreadthFirstConfig,
+    ) -> Result<BreadthFirst, EngineError> {
+        let t = Instant::now();
+        let spill = SpillDir::create(config.spill.as_deref()).map_err(err)?;
+        let io = StoreWriter::create(spill.path(), &input.scene.name)
+            .and_then(|w| w.write_scene(&input.scene))
+            .map_err(|e| {
+                err(format!(
+                    "{}: cannot write the scene store: {e}",
+                    spill.shown()
+                ))
+            })?;
+        let store_s = t.elapsed().as_secs_f64();
+        let mut e = Self::open(spill.path(), config)?;
+        e.stats.insert("store_write_s".into(), store_s);
+        e.stats
+            .insert("store_bytes_written".into(), io.bytes_written as f64);
+        e._spill = Some(spill);
+        Ok(e)
+    }
+
+    /// Opens a store and preprocesses it (Algorithm 3.4: one sweep of the bounding-box file
+    /// marking voxels and boundary faces).
+    pub fn open(dir: &Path, config: BreadthFirstConfig) -> Result<BreadthFirst, EngineError> {
+        let t = Instant::now();
+        let header = StoreHeader::read(dir).map_err(|e| err(e.to_string()))?;
+        let open_err = |e: std::io::Error| err(format!("{}: {e}", dir.display()));
+        let mut bbox =
+            BboxReader::open(dir, header.objects, config.buffer as usize).map_err(open_err)?;
+        let mut geometry = GeometryReader::open(dir, config.buffer as usize).map_err(open_err)?;
+        // The floor group, and the box and primitive count of the rest (one sweep).
+        let (mut floor, mut bounds, mut grid_prims) =
+            (Vec::new(), header.bounds, header.primitives);
+        if config.floor == Floor::Out {
+            let ext = header.bounds[1] - header.bounds[0];
+            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+                if is_floor_box(b.lo, b.hi, ext) {
+                    let mut rec = ObjectRecord::default();
+                    geometry.read_at(b.offset, &mut rec).map_err(open_err)?;
+                    if matches!(rec.surface, Some(Surface::Flat { .. })) {
+                        grid_prims -= rec.prims.len() as u64;
+                        floor.push((id, rec));
+                        continue;
+                    }
+                }
+                lo = lo.min(b.lo);
+                hi = hi.max(b.hi);
+            }
+            bounds = [lo, hi];
+            bbox.rewind().map_err(open_err)?;
+            geometry.rewind().map_err(open_err)?;
+        }
+        let mut voxels = Voxels::new(bounds, grid_prims);
+        let nvox = voxels.count() as u64;
+        let grid_bytes = nvox * 5;
+        let buffers = 2 * config.buffer;
+        let initial = config.registration.initial(voxels.max_res());
+        let per_ray = intersect::slot_bytes() + initial as u64 * intersect::reg_bytes();
+        let left = config.memory.saturating_sub(grid_bytes + buffers);
+        let capacity = (left / per_ray) as usize;
+        if capacity == 0 {
+            return Err(err(format!(
+                "memory={} B is too small: the grid ({} voxels) and buffers take {} B, and one \
+                 ray {} B more",
+                config.memory,
+                nvox,
+                grid_bytes + buffers,
+                per_ray
+            )));
+        }
+        let mut next_floor = floor.iter().map(|f| f.0).peekable();
+        while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+            if next_floor.next_if_eq(&id).is_none() {
+                voxels.mark(b.lo, b.hi);
+            }
+        }
+        let mut pre_io = bbox.file.io;
+        pre_io.add(&geometry.file.io);
+        bbox.file.io = IoCounters::default();
+        geometry.file.io = IoCounters::default();
+        let preprocess_s = t.elapsed().as_secs_f64();
+
+        let mut stats = BTreeMap::new();
+        stats.insert("preprocess_s".into(), preprocess_s);
+        stats.insert("res_x".into(), voxels.res[0] as f64);
+        stats.insert("res_y".into(), voxels.res[1] as f64);
+        stats.insert("res_z".into(), voxels.res[2] as f64);
+        stats.insert("voxels".into(), nvox as f64);
+        stats.insert("marked_voxels".into(), voxels.marked_count() as f64);
+        stats.insert("objects".into(), header.objects as f64);
+        stats.insert("primitives".into(), header.primitives as f64);
+        stats.insert("memory_budget_bytes".into(), config.memory as f64);
+        stats.insert("rays_in_memory".into(), capacity as f64);
+        stats.insert("registration_initial".into(), initial as f64);
+        stats.insert("bytes_per_ray".into(), per_ray as f64);
+        stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
+        stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
+        stats.insert("floor_objects".into(), floor.len() as f64);
+        let extent = header.bounds[0]
+            .abs()
+            .max(header.bounds[1].abs())
+            .max_element();
+        let work = Work {
+            extent: if extent.is_finite() { extent } else { 0.0 },
+            head: vec![u32::MAX; voxels.count()],
+            voxels,
+            regs: Vec::with_capacity(capacity * initial as usize),
+            regs_capacity: capacity * initial as usize,
+            slots: Vec::with_capacity(capacity),
+            capacity,
+            initial_count: initial,
+            inverse: config.registration == Registration::Inverse,
+            bbox,
+            geometry,
+            record: ObjectRecord::default(),
+            floor,
+        };
+        Ok(BreadthFirst {
+            config,
+            header,
+            work: Mutex::new(work),
+            failure: Mutex::new(None),
+            stats,
+            structure_bytes: grid_bytes,
+            _spill: None,
+        })
+    }
+
+    pub fn header(&self) -> &StoreHeader {
+        &self.header
+    }
+
+    pub fn config(&self) -> &BreadthFirstConfig {
+        &self.config
+    }
+
+    /// Answers `rays` (ids are their positions) through `out`; the shared body of `intersect`
+    /// and `occluded`, and the entry of the out-of-core workload.
+    pub fn trace_stream(
+        &self,
+        rays: &mut dyn Iterator<Item = (u32, Ray)>,
+        any: bool,
+        out: &mut dyn FnMut(u32, Hit),
+        c: &mut Counters,
+    ) -> std::io::Result<()> {
+        let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
+        let before = w.io();
+        let r = w.trace(rays, any, self.config.triangle, out, c);
+        // Rays left in memory by an error are dropped: their answers are MISS.
+        w.slots.clear();
+        let after = w.io();
+        let e = &mut c.extra;
+        *e.entry("io_bytes_read".into()).or_insert(0) += after.bytes_read - before.bytes_read;
+        *e.entry("io_read_calls".into()).or_insert(0) += after.read_calls - before.read_calls;
+        *e.entry("io_seeks".into()).or_insert(0) += after.seeks - before.seeks;
+        r
+    }
+
+    fn answer<T>(
+        &self,
+        rays: &[Ray],
+        out: &mut [T],
+        any: bool,
+        c: &mut Counters,
+        put: impl Fn(&mut T, Hit),
+    ) {
+        let mut it = rays.iter().enumerate().map(|(i, r)| (i as u32, *r));
+        let r = self.trace_stream(&mut it, any, &mut |id, h| put(&mut out[id as usize], h), c);
+        if let Err(e) = r {
+            let mut f = self.failure.lock().unwrap_or_else(|p| p.into_inner());
+            f.get_or_insert_with(|| format!("breadth-first: reading the scene store: {e}"));
+        }
+    }
+}
+
+impl Engine for BreadthFirst {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], c: &mut Counters) {
+        hits.fill(Hit::MISS);
+        self.answer(rays, hits, false, c, |h, hit| *h = hit);
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], c: &mut Counters) {
+        occluded.fill(false);
+        self.answer(rays, occluded, true, c, |o, hit| *o = hit.is_hit());
+    }
+
+    fn structure_bytes(&self) -> u64 {
+        self.structure_bytes
+    }
+
+    fn batch_hint(&self) -> Option<usize> {
+        None
+    }
+
+    fn failure(&self) -> Option<String> {
+        self.failure
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .clone()
+    }
+
+    fn build_stats(&self) -> BTreeMap<String, f64> {
+        self.stats.clone()
+    }
+}

@@ -1,0 +1,188 @@
+//! The breadth-first engine answers as the grid engine does (same cells, same kernels) under
+//! every registration policy and memory size, counts its passes and I/O, honours its budget,
+//! and fails cleanly on bad settings and an unwritable spill directory.
+
+use super::config::{Bytes, Registration};
+use super::*;
+use crate::geometry::Geometry;
+use crate::{build_engine, Counters, Engine, Hit, Ray};
+use rtbench_scenes::generate_scene;
+use rtbench_scenes::spd::{Options, Program};
+use std::sync::Arc;
+
+/// SplitMix64: the same rays every run.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
+        lo + (hi - lo) * Vec3::new(self.unit(), self.unit(), self.unit())
+    }
+}
+
+fn spd(program: Program, sf: u32) -> BuildInput {
+    let scene = generate_scene(
+        program,
+        &Options {
+            size_factor: sf,
+            ..Options::standard(program)
+        },
+    )
+    .unwrap();
+    BuildInput {
+        geometry: Arc::new(Geometry::from_scene(&scene)),
+        scene: Arc::new(scene),
+    }
+}
+
+fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+/// Closest-hit rays from around the scene towards points in it, and segments between points.
+fn rays_for(g: &Geometry, n: usize) -> (Vec<Ray>, Vec<Ray>) {
+    let mut rng = Rng(7);
+    let (lo, hi) = (g.bounds_min, g.bounds_max);
+    let c = (lo + hi) * 0.5;
+    let h = (hi - lo) * 0.5;
+    let (wlo, whi) = (c - h * 1.5, c + h * 1.5);
+    let mut closest = Vec::new();
+    let mut any = Vec::new();
+    for _ in 0..n {
+        let o = rng.in_box(wlo, whi);
+        let t = rng.in_box(lo, hi);
+        closest.push(Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY));
+        let a = rng.in_box(wlo, whi);
+        let d = rng.in_box(lo, hi) - a;
+        any.push(Ray::new(a, d / d.length(), 0.0, d.length()));
+    }
+    (closest, any)
+}
+
+/// Hits and occlusion answers of `engine` for `rays`.
+fn answers(e: &dyn Engine, rays: &(Vec<Ray>, Vec<Ray>), c: &mut Counters) -> (Vec<Hit>, Vec<bool>) {
+    let mut hits = vec![Hit::MISS; rays.0.len()];
+    let mut occ = vec![false; rays.1.len()];
+    e.intersect(&rays.0, &mut hits, c);
+    e.occluded(&rays.1, &mut occ, c);
+    (hits, occ)
+}
+
+#[test]
+fn agrees_with_the_grid_under_every_policy_and_budget() {
+    for (program, sf) in [
+        (Program::Tetra, 3),
+        (Program::Gears, 1),
+        (Program::Balls, 2),
+    ] {
+        let input = spd(program, sf);
+        let rays = rays_for(&input.geometry, 3000);
+        let grid = build_engine("grid", &input, kv(&[("preset", "rss-r")])).unwrap();
+        let (want_h, want_o) = answers(grid.as_ref(), &rays, &mut Counters::default());
+        for settings in [
+            vec![],
+            vec![("registration", "fixed:1")],
+            vec![("registration", "thesis"), ("floor", "in")],
+            // A few hundred rays in memory: many refills; a small buffer: many read calls.
+            vec![("memory", "200KiB"), ("buffer", "4KiB")],
+        ] {
+            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
+            let mut c = Counters::default();
+            let (h, o) = answers(e.as_ref(), &rays, &mut c);
+            let same_h = h
+                .iter()
+                .zip(&want_h)
+                .filter(|(a, b)| a.object == b.object && a.t == b.t)
+                .count();
+            let same_o = o.iter().zip(&want_o).filter(|(a, b)| a == b).count();
+            // The same cells and kernels: only ties of equal t may name another object.
+            assert!(
+                same_h >= h.len() - 2 && same_o == o.len(),
+                "{program:?} {settings:?}: {same_h}/{} hits, {same_o}/{} any",
+                h.len(),
+                o.len()
+            );
+            assert!(want_h.iter().filter(|h| h.is_hit()).count() > 500);
+            assert_eq!(c.rays, 6000);
+            assert!(c.extra["bf_passes"] >= 2);
+            assert!(e.failure().is_none());
+        }
+    }
+}
+
+#[test]
+fn small_memory_means_more_passes_and_reads() {
+    let input = spd(Program::Tetra, 4);
+    let rays = rays_for(&input.geometry, 2000);
+    let run = |settings: &[(&str, &str)]| {
+        let e = build_engine("breadth-first", &input, kv(settings)).unwrap();
+        let stats = e.build_stats();
+        let mut c = Counters::default();
+        answers(e.as_ref(), &rays, &mut c);
+        (c, stats)
+    };
+    let (big, big_stats) = run(&[("registration", "fixed:1")]);
+    let (small, small_stats) = run(&[
+        ("registration", "fixed:1"),
+        ("memory", "300KiB"),
+        ("buffer", "1KiB"),
+    ]);
+    assert!(big_stats["rays_in_memory"] > 4000.0);
+    let cap = small_stats["rays_in_memory"];
+    assert!(cap > 10.0 && cap < 2000.0, "{cap}");
+    // Everything the budget covers fits in it.
+    let held = small_stats["voxels"] * 5.0 + 2.0 * 1024.0 + cap * small_stats["bytes_per_ray"];
+    assert!(held <= 300.0 * 1024.0);
+    assert!(small.extra["bf_passes"] > big.extra["bf_passes"]);
+    // 1 KiB buffers over a store of many KiB: every sweep reads the files again.
+    assert!(small.extra["io_read_calls"] > small.extra["bf_passes"]);
+    assert!(small.extra["io_bytes_read"] > 0);
+}
+
+#[test]
+fn settings_and_spill_errors() {
+    let input = spd(Program::Tetra, 1);
+    let bad = |pairs: &[(&str, &str)]| build_engine("breadth-first", &input, kv(pairs)).err();
+    assert!(bad(&[("memory", "0")]).is_some());
+    assert!(bad(&[("memory", "12XB")]).is_some());
+    assert!(bad(&[("registration", "fixed:0")]).is_some());
+    assert!(bad(&[("colour", "red")]).is_some());
+    // Too small for the grid and one ray: refused, naming the budget.
+    let e = bad(&[("memory", "100")]).unwrap().to_string();
+    assert!(e.contains("too small"), "{e}");
+    // A spill directory that does not exist (or cannot be written) is a build error.
+    let e = bad(&[("spill", "/proc/no-such-dir")]).unwrap().to_string();
+    assert!(e.contains("spill directory /proc/no-such-dir"), "{e}");
+    assert_eq!("32MiB".parse::<Bytes>(), Ok(Bytes(32 << 20)));
+    assert_eq!(
+        "fixed:2".parse::<Registration>(),
+        Ok(Registration::Fixed(2))
+    );
+    assert_eq!(Registration::thesis_count(19), 3);
+}
+
+#[test]
+fn spill_directory_is_removed_on_drop() {
+    let parent = std::env::temp_dir().join(format!("rtbench-bf-spill-test-{}", std::process::id()));
+    std::fs::create_dir_all(&parent).unwrap();
+    let input = spd(Program::Tetra, 1);
+    let e = build_engine(
+        "breadth-first",
+        &input,
+        kv(&[("spill", parent.to_str().unwrap())]),
+    )
+    .unwrap();
+    assert_eq!(std::fs::read_dir(&parent).unwrap().count(), 1);
+    drop(e);
+    assert_eq!(std::fs::read_dir(&parent).unwrap().count(), 0);
+    std::fs::remove_dir(&parent).unwrap();
+}

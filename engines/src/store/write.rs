@@ -1,0 +1,250 @@
+//! Writing a store: a [`Sink`] that encodes each object as it streams by (seed 000 §3
+//! preprocessing, "convert all scene data to a binary format, each object with its AABB"). It
+//! holds one object at a time, the lights and the materials, never the scene.
+
+use super::io::{IoCounters, IoFile};
+use super::{Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE, VERSION};
+use crate::geometry::{prims_of, Prim};
+use glam::{DVec3, Vec3};
+use rtbench_scenes::{Light, Material, Scene, ShapeRef, Sink, View};
+use serde_json::json;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// Buffer of each file being written.
+const WRITE_BUFFER: usize = 1 << 16;
+
+/// Streams a scene into a store directory. Call [`StoreWriter::finish`] at the end; the first
+/// I/O error is kept and returned there (a `Sink` cannot fail mid-stream).
+pub struct StoreWriter {
+    dir: PathBuf,
+    name: String,
+    bbox: IoFile,
+    geometry: IoFile,
+    error: Option<io::Error>,
+    view: View,
+    background: DVec3,
+    lights: Vec<Light>,
+    materials: Vec<Material>,
+    objects: u64,
+    prims_total: u64,
+    lo: Vec3,
+    hi: Vec3,
+    // Scratch, reused per object.
+    prims: Vec<Prim>,
+    tris: Vec<[usize; 3]>,
+    record: Vec<u8>,
+}
+
+fn f32s(out: &mut Vec<u8>, v: &[f32]) {
+    for x in v {
+        out.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+fn v3(out: &mut Vec<u8>, v: Vec3) {
+    f32s(out, &v.to_array());
+}
+
+/// The 16-byte header of a binary file of the store.
+fn file_header(magic: &[u8; 8], extra: u32) -> [u8; 16] {
+    let mut h = [0u8; 16];
+    h[..8].copy_from_slice(magic);
+    h[8..12].copy_from_slice(&VERSION.to_le_bytes());
+    h[12..].copy_from_slice(&extra.to_le_bytes());
+    h
+}
+
+impl StoreWriter {
+    /// Creates `dir` (and parents) and the two binary files in it.
+    pub fn create(dir: &Path, name: &str) -> io::Result<StoreWriter> {
+        std::fs::create_dir_all(dir)?;
+        let mut bbox = IoFile::create(&dir.join(BBOX_FILE), WRITE_BUFFER)?;
+        let mut geometry = IoFile::create(&dir.join(GEOMETRY_FILE), WRITE_BUFFER)?;
+        bbox.write_all(&file_header(BBOX_MAGIC, super::BBOX_RECORD as u32))?;
+        geometry.write_all(&file_header(GEOMETRY_MAGIC, 0))?;
+        Ok(StoreWriter {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            bbox,
+            geometry,
+            error: None,
+            view: View::default(),
+            background: DVec3::ZERO,
+            lights: Vec::new(),
+            materials: Vec::new(),
+            objects: 0,
+            prims_total: 0,
+            lo: Vec3::INFINITY,
+            hi: Vec3::NEG_INFINITY,
+            prims: Vec::new(),
+            tris: Vec::new(),
+            record: Vec::new(),
+        })
+    }
+
+    /// Writes a scene already in memory (the breadth-first engine built from a `BuildInput`):
+    /// each object keeps its own material index.
+    pub fn write_scene(mut self, scene: &Scene) -> io::Result<IoCounters> {
+        self.background = scene.background;
+        self.view = scene.view.clone();
+        self.lights = scene.lights.clone();
+        self.materials = scene.materials.clone();
+        for o in &scene.objects {
+            self.write_object(o.material, o.shape.as_ref())?;
+        }
+        self.finish()
+    }
+
+    fn write_object(&mut self, material: u32, shape: ShapeRef<'_>) -> io::Result<()> {
+        self.prims.clear();
+        prims_of(shape, &mut self.prims, &mut self.tris);
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for p in &self.prims {
+            let (a, b) = p.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        let r = &mut self.record;
+        r.clear();
+        r.extend_from_slice(&[0; 4]);
+        r.extend_from_slice(&material.to_le_bytes());
+        encode_surface(r, &Surface::of(shape));
+        r.extend_from_slice(&(self.prims.len() as u32).to_le_bytes());
+        for p in &self.prims {
+            encode_prim(r, p);
+        }
+        let len = r.len() as u32;
+        r[..4].copy_from_slice(&len.to_le_bytes());
+        let offset = self.geometry.written();
+        self.geometry.write_all(r)?;
+        let mut b = Vec::with_capacity(super::BBOX_RECORD);
+        v3(&mut b, lo);
+        v3(&mut b, hi);
+        b.extend_from_slice(&offset.to_le_bytes());
+        self.bbox.write_all(&b)?;
+        if !self.prims.is_empty() {
+            self.lo = self.lo.min(lo);
+            self.hi = self.hi.max(hi);
+        }
+        self.objects += 1;
+        self.prims_total += self.prims.len() as u64;
+        Ok(())
+    }
+
+    /// Flushes the binary files and writes `header.json`. Returns the bytes and calls made.
+    pub fn finish(self) -> io::Result<IoCounters> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let mut io = self.bbox.finish()?;
+        io.add(&self.geometry.finish()?);
+        let v = &self.view;
+        let d3 = |v: DVec3| json!([v.x, v.y, v.z]);
+        let header = json!({
+            "format": "rtbench-store",
+            "version": VERSION,
+            "name": self.name,
+            "objects": self.objects,
+            "primitives": self.prims_total,
+            "bounds": [self.lo.to_array(), self.hi.to_array()],
+            "background": d3(self.background),
+            "view": {"from": d3(v.from), "at": d3(v.at), "up": d3(v.up), "angle": v.angle,
+                     "hither": v.hither, "resolution": v.resolution},
+            "lights": self.lights.iter().map(|l| json!({
+                "position": d3(l.position), "color": l.color.map(d3)})).collect::<Vec<_>>(),
+            "materials": self.materials.iter().map(|m| json!({
+                "color": d3(m.color), "kd": m.kd, "ks": m.ks, "shine": m.shine, "t": m.t,
+                "ior": m.ior})).collect::<Vec<_>>(),
+        });
+        let text = serde_json::to_string_pretty(&header).map_err(io::Error::other)?;
+        std::fs::write(self.dir.join(HEADER_FILE), &text)?;
+        io.bytes_written += text.len() as u64;
+        io.write_calls += 1;
+        Ok(io)
+    }
+}
+
+pub(super) fn encode_surface(r: &mut Vec<u8>, s: &Surface) {
+    match *s {
+        Surface::Sphere { center, radius } => {
+            r.push(0);
+            v3(r, center);
+            f32s(r, &[radius]);
+        }
+        Surface::Cone { base, rb, apex, ra } => {
+            r.push(1);
+            v3(r, base);
+            f32s(r, &[rb]);
+            v3(r, apex);
+            f32s(r, &[ra]);
+        }
+        Surface::Flat { normal } => {
+            r.push(2);
+            v3(r, normal);
+        }
+        Surface::Smooth { normals, flat } => {
+            r.push(3);
+            for n in normals {
+                v3(r, n);
+            }
+            v3(r, flat);
+        }
+    }
+}
+
+pub(super) fn encode_prim(r: &mut Vec<u8>, p: &Prim) {
+    match *p {
+        Prim::Sphere { center, radius } => {
+            r.push(0);
+            v3(r, center);
+            f32s(r, &[radius]);
+        }
+        Prim::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+        } => {
+            r.push(1);
+            v3(r, base);
+            f32s(r, &[base_radius]);
+            v3(r, apex);
+            f32s(r, &[apex_radius]);
+        }
+        Prim::Triangle(t) => {
+            r.push(2);
+            for v in t {
+                v3(r, v);
+            }
+        }
+    }
+}
+
+impl Sink for StoreWriter {
+    fn background(&mut self, color: DVec3) {
+        self.background = color;
+    }
+    fn view(&mut self, view: &View) {
+        self.view = view.clone();
+    }
+    fn light(&mut self, light: &Light) {
+        self.lights.push(light.clone());
+    }
+    fn material(&mut self, material: &Material) {
+        self.materials.push(material.clone());
+    }
+    fn shape(&mut self, shape: ShapeRef<'_>) {
+        if self.materials.is_empty() {
+            // NFF allows primitives before any `f`: they get the default material (as
+            // `SceneCollector` does).
+            self.materials.push(Material::default());
+        }
+        let material = (self.materials.len() - 1) as u32;
+        if self.error.is_none() {
+            if let Err(e) = self.write_object(material, shape) {
+                self.error = Some(e);
+            }
+        }
+    }
+}

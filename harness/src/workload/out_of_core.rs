@@ -1,0 +1,438 @@
+//! The SPD workload for a scene store, never holding the scene (seed 000 §3.4, Algorithm 3.6,
+//! with the improved method's lazy geometry loading, §4.2.2 "G"): the breadth-first engine
+//! answers each generation streamed from a spill file, and shading reads the geometry file
+//! forward only.
+//!
+//! Per generation:
+//! 1. The generation's rays (ray, corner, weight, depth, medium) are in a spill file, in the order
+//!    the in-memory tracer makes them.
+//! 2. The engine reads them sequentially and gives hit records (ray id, object, t, u, v) in the
+//!    order rays finish; they are spilled into one file per group of [`GROUP`] ray ids (a
+//!    one-pass bucket sort: the thesis's sort by ray id), each group's then filed by id.
+//! 3. Shading takes the rays in groups of [`GROUP`] ids, read sequentially; each group's hits
+//!    are sorted by object id and the bounding-box and geometry files read forward only,
+//!    loading just the objects hit (Algorithm 3.6, "join" of hit records and scene). What
+//!    shading emits is put back in ray order before it is written (the thesis's second sort),
+//!    so the next generation's file, the shadow rays and the image's sums come in the same order
+//!    as in memory, and the image is the in-memory tracer's to the bit.
+//! 4. Shadow rays go to their own spill file, are answered by the engine (one byte per ray), and
+//!    their gains added in order.
+//!
+//! What is held: the image (12 bytes per pixel corner), one byte per shadow ray, a group of rays
+//! and their hit records, one small buffer per hit-record file, and the engine within its budget.
+
+use super::camera::Camera;
+use super::trace::{shade_hit, GenerationStats, Path, RayStats, Render, MAX_DEPTH};
+use glam::Vec3;
+use rtbench_engines::breadth_first::spill::SpillDir;
+use rtbench_engines::breadth_first::BreadthFirst;
+use rtbench_engines::store::{BboxReader, GeometryReader, IoCounters, IoFile, ObjectRecord};
+use rtbench_engines::{Counters, Hit, Ray};
+use std::io;
+use std::path::{Path as FsPath, PathBuf};
+use std::time::Instant;
+
+/// Rays shaded per group (Algorithm 3.6's "while memory not full of rays").
+pub const GROUP: usize = 1 << 14;
+
+/// Bytes of one ray record of a generation file, and of a shadow record.
+const RAY_RECORD: usize = 52;
+const SHADOW_RECORD: usize = 48;
+const HIT_RECORD: usize = 20;
+/// Buffer of each hit-record file (one per group of the generation).
+const HIT_BUFFER: usize = 16 << 10;
+
+fn encode_hit(id: u32, h: &Hit) -> [u8; HIT_RECORD] {
+    let mut b = [0u8; HIT_RECORD];
+    b[..4].copy_from_slice(&id.to_le_bytes());
+    b[4..8].copy_from_slice(&h.t.to_le_bytes());
+    b[8..12].copy_from_slice(&h.object.to_le_bytes());
+    b[12..16].copy_from_slice(&h.u.to_le_bytes());
+    b[16..].copy_from_slice(&h.v.to_le_bytes());
+    b
+}
+
+fn decode_hit(b: &[u8]) -> (u32, Hit) {
+    let u = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+    (
+        u(0),
+        Hit {
+            t: f32::from_bits(u(4)),
+            object: u(8),
+            u: f32::from_bits(u(12)),
+            v: f32::from_bits(u(16)),
+        },
+    )
+}
+
+pub struct OutOfCoreRender {
+    pub render: Render,
+    /// The workload's own spill and shading I/O (the engine's is in `render.counters`).
+    pub io: IoCounters,
+}
+
+fn put_ray(b: &mut Vec<u8>, r: &Ray) {
+    for x in [
+        r.origin.x, r.origin.y, r.origin.z, r.tmin, r.dir.x, r.dir.y, r.dir.z, r.tmax,
+    ] {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+fn get_f32(b: &[u8], i: usize) -> f32 {
+    f32::from_le_bytes(b[4 * i..4 * i + 4].try_into().unwrap())
+}
+
+fn get_ray(b: &[u8]) -> Ray {
+    let f = |i| get_f32(b, i);
+    Ray::new(
+        Vec3::new(f(0), f(1), f(2)),
+        Vec3::new(f(4), f(5), f(6)),
+        f(3),
+        f(7),
+    )
+}
+
+fn encode_path(r: &Ray, p: &Path) -> [u8; RAY_RECORD] {
+    let mut b = Vec::with_capacity(RAY_RECORD);
+    put_ray(&mut b, r);
+    b.extend_from_slice(&p.corner.to_le_bytes());
+    for x in p.weight.to_array() {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+    b.extend_from_slice(&[p.depth, p.inside as u8, 0, 0]);
+    b.try_into().unwrap()
+}
+
+fn decode_path(b: &[u8]) -> (Ray, Path) {
+    let corner = u32::from_le_bytes(b[32..36].try_into().unwrap());
+    let f = |i| get_f32(b, i);
+    (
+        get_ray(b),
+        Path {
+            corner,
+            weight: Vec3::new(f(9), f(10), f(11)),
+            depth: b[48],
+            inside: b[49] != 0,
+        },
+    )
+}
+
+fn encode_shadow(r: &Ray, corner: u32, gain: Vec3) -> [u8; SHADOW_RECORD] {
+    let mut b = Vec::with_capacity(SHADOW_RECORD);
+    put_ray(&mut b, r);
+    b.extend_from_slice(&corner.to_le_bytes());
+    for x in gain.to_array() {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+    b.try_into().unwrap()
+}
+
+/// A spill file of fixed-size records: written once, then read forward (twice).
+struct Records {
+    path: PathBuf,
+    len: u64,
+    buffer: usize,
+    writer: Option<IoFile>,
+    io: IoCounters,
+}
+
+impl Records {
+    fn create(dir: &FsPath, name: &str, buffer: usize) -> io::Result<Records> {
+        let path = dir.join(name);
+        Ok(Records {
+            writer: Some(IoFile::create(&path, buffer)?),
+            path,
+            len: 0,
+            buffer,
+            io: IoCounters::default(),
+        })
+    }
+
+    fn push(&mut self, rec: &[u8]) -> io::Result<()> {
+        self.len += 1;
+        self.writer
+            .as_mut()
+            .expect("written before reading")
+            .write_all(rec)
+    }
+
+    fn close(&mut self) -> io::Result<()> {
+        if let Some(w) = self.writer.take() {
+            let io = w.finish()?;
+            self.io.add(&io);
+        }
+        Ok(())
+    }
+
+    fn reader(&mut self) -> io::Result<IoFile> {
+        self.close()?;
+        IoFile::open(&self.path, self.buffer)
+    }
+
+    fn remove(mut self) -> io::Result<IoCounters> {
+        self.close()?;
+        std::fs::remove_file(&self.path)?;
+        Ok(self.io)
+    }
+}
+
+/// Streams a record file's rays into the engine, keeping the first read error.
+fn ray_stream<'a>(
+    file: &'a mut IoFile,
+    n: u64,
+    record: usize,
+    error: &'a mut Option<io::Error>,
+) -> impl Iterator<Item = (u32, Ray)> + 'a {
+    let mut buf = vec![0u8; record];
+    (0..n).map_while(move |id| match file.read_exact(&mut buf) {
+        Ok(()) => Some((id as u32, get_ray(&buf))),
+        Err(e) => {
+            *error = Some(e);
+            None
+        }
+    })
+}
+
+/// Traces the SPD workload of the engine's store at `size`×`size` pixels.
+pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
+    let start = Instant::now();
+    let cpu_start = super::thread_cpu_seconds();
+    let h = engine.header();
+    let config = engine.config();
+    let buffer = config.buffer as usize;
+    let spill = SpillDir::create(config.spill.as_deref()).map_err(io::Error::other)?;
+    let camera = Camera::new(&h.view);
+    let w = size + 1;
+    let n_corners = (w as usize) * (w as usize);
+    let mut corners = vec![Vec3::ZERO; n_corners];
+    let background = h.background.as_vec3();
+    let lights: Vec<(Vec3, Vec3)> = h
+        .lights
+        .iter()
+        .map(|l| {
+            let i = 1.0 / (h.lights.len() as f32).sqrt();
+            (
+                l.position.as_vec3(),
+                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
+            )
+        })
+        .collect();
+    let mut io_total = IoCounters::default();
+    let mut bbox = BboxReader::open(&h.dir, h.objects, buffer)?;
+    let mut geometry = GeometryReader::open(&h.dir, buffer)?;
+
+    let mut rays = Records::create(spill.path(), "rays-1", buffer)?;
+    for j in 0..w {
+        for i in 0..w {
+            let path = Path {
+                corner: j * w + i,
+                weight: Vec3::ONE,
+                depth: 1,
+                inside: false,
+            };
+            rays.push(&encode_path(&camera.corner_ray(i, j, size), &path))?;
+        }
+    }
+
+    let mut stats = RayStats::default();
+    let mut counters = Counters::default();
+    let (mut intersect_s, mut shade_s) = (0.0, 0.0);
+    let mut generation = 0u32;
+    let mut record = ObjectRecord::default();
+    while rays.len > 0 {
+        generation += 1;
+        let n = rays.len;
+        let mut g = GenerationStats {
+            generation,
+            rays: n,
+            ..Default::default()
+        };
+        // Intersection: hit records spilled into one file per group of ray ids.
+        let t0 = Instant::now();
+        let groups = n.div_ceil(GROUP as u64) as usize;
+        let mut buckets = (0..groups)
+            .map(|b| Records::create(spill.path(), &format!("hits-{generation}-{b}"), HIT_BUFFER))
+            .collect::<io::Result<Vec<_>>>()?;
+        let mut file = rays.reader()?;
+        let (mut error, mut write_error) = (None, None);
+        engine.trace_stream(
+            &mut ray_stream(&mut file, n, RAY_RECORD, &mut error),
+            false,
+            &mut |id, hit| {
+                if write_error.is_none() {
+                    let r = buckets[id as usize / GROUP].push(&encode_hit(id, &hit));
+                    write_error = r.err();
+                }
+            },
+            &mut counters,
+        )?;
+        if let Some(e) = error.or(write_error) {
+            return Err(e);
+        }
+        io_total.add(&file.io);
+        intersect_s += t0.elapsed().as_secs_f64();
+
+        // Shading, group by group, in object order; emitted records put back in ray order.
+        let t1 = Instant::now();
+        let mut next = Records::create(spill.path(), &format!("rays-{}", generation + 1), buffer)?;
+        let mut shadows = Records::create(spill.path(), &format!("shadows-{generation}"), buffer)?;
+        let mut file = rays.reader()?;
+        let mut group: Vec<(Ray, Path)> = Vec::with_capacity(GROUP);
+        let mut order: Vec<u32> = Vec::with_capacity(GROUP);
+        let mut term = vec![Vec3::ZERO; GROUP];
+        let mut out_next: Vec<(u32, Ray, Path)> = Vec::new();
+        let mut out_shadow: Vec<(u32, Ray, u32, Vec3)> = Vec::new();
+        let mut buf = [0u8; RAY_RECORD];
+        let mut hb = [0u8; HIT_RECORD];
+        let mut hits = vec![Hit::MISS; GROUP];
+        let mut first = 0u64;
+        for mut bucket in buckets {
+            let count = (n - first).min(GROUP as u64) as usize;
+            group.clear();
+            for _ in 0..count {
+                file.read_exact(&mut buf)?;
+                group.push(decode_path(&buf));
+            }
+            // This group's hit records, filed by ray id.
+            let mut hfile = bucket.reader()?;
+            for _ in 0..bucket.len {
+                hfile.read_exact(&mut hb)?;
+                let (id, hit) = decode_hit(&hb);
+                hits[(id as u64 - first) as usize] = hit;
+            }
+            io_total.add(&hfile.io);
+            drop(hfile);
+            io_total.add(&bucket.remove()?);
+            order.clear();
+            for k in 0..count {
+                let hit = &hits[k];
+                if hit.is_hit() {
+                    order.push(k as u32);
+                } else {
+                    term[k] = group[k].1.weight * background;
+                }
+            }
+            order.sort_by_key(|&k| (hits[k as usize].object, k));
+            bbox.rewind()?;
+            geometry.rewind()?;
+            let mut loaded = u32::MAX;
+            out_next.clear();
+            out_shadow.clear();
+            for &k in &order {
+                let hit = hits[k as usize];
+                if hit.object != loaded {
+                    // Forward through the bounding-box file to the object's geometry offset.
+                    let offset = loop {
+                        match bbox.next_record()? {
+                            Some((id, b)) if id == hit.object => break b.offset,
+                            Some(_) => continue,
+                            None => return Err(io::Error::other("hit names no object")),
+                        }
+                    };
+                    geometry.read_at(offset, &mut record)?;
+                    loaded = hit.object;
+                }
+                let (ray, path) = &group[k as usize];
+                let surface = record.surface.expect("decoded records have a surface");
+                let p = ray.at(hit.t);
+                let m = &h.materials[record.material as usize];
+                g.hits += 1;
+                term[k as usize] = shade_hit(
+                    ray,
+                    &hit,
+                    path,
+                    m,
+                    surface.normals(&hit, p),
+                    &lights,
+                    &mut g,
+                    &mut |r, corner, gain| out_shadow.push((k, r, corner, gain)),
+                    &mut |r, p| out_next.push((k, r, p)),
+                );
+            }
+            // Back to ray order (stable: a ray's own emissions keep their order).
+            out_next.sort_by_key(|e| e.0);
+            out_shadow.sort_by_key(|e| e.0);
+            for (k, (_, path)) in group.iter().enumerate() {
+                corners[path.corner as usize] += term[k];
+            }
+            for (_, r, p) in &out_next {
+                next.push(&encode_path(r, p))?;
+            }
+            for (_, r, corner, gain) in &out_shadow {
+                shadows.push(&encode_shadow(r, *corner, *gain))?;
+            }
+            first += count as u64;
+        }
+        io_total.add(&file.io);
+        drop(file);
+        io_total.add(&rays.remove()?);
+        shade_s += t1.elapsed().as_secs_f64();
+
+        // Shadow rays: any hit, one byte per ray, then the gains in order.
+        let t2 = Instant::now();
+        let ns = shadows.len;
+        let mut blocked = vec![false; ns as usize];
+        let mut file = shadows.reader()?;
+        let mut error = None;
+        engine.trace_stream(
+            &mut ray_stream(&mut file, ns, SHADOW_RECORD, &mut error),
+            true,
+            &mut |id, hit| blocked[id as usize] = hit.is_hit(),
+            &mut counters,
+        )?;
+        if let Some(e) = error {
+            return Err(e);
+        }
+        io_total.add(&file.io);
+        intersect_s += t2.elapsed().as_secs_f64();
+        let t3 = Instant::now();
+        let mut file = shadows.reader()?;
+        let mut sb = [0u8; SHADOW_RECORD];
+        for b in &blocked {
+            file.read_exact(&mut sb)?;
+            if *b {
+                g.shadow_blocked += 1;
+            } else {
+                let corner = u32::from_le_bytes(sb[32..36].try_into().unwrap());
+                corners[corner as usize] +=
+                    Vec3::new(get_f32(&sb, 9), get_f32(&sb, 10), get_f32(&sb, 11));
+            }
+        }
+        io_total.add(&file.io);
+        drop(file);
+        io_total.add(&shadows.remove()?);
+        g.shadow = ns;
+        shade_s += t3.elapsed().as_secs_f64();
+
+        if generation == 1 {
+            stats.eye = g.rays;
+            stats.eye_hit = g.hits;
+        }
+        stats.shadow += g.shadow;
+        stats.shadow_blocked += g.shadow_blocked;
+        stats.reflect += g.reflect;
+        stats.refract += g.refract;
+        stats.total += g.rays + g.shadow;
+        stats.generations.push(g);
+        debug_assert!(generation <= MAX_DEPTH as u32);
+        rays = next;
+    }
+    io_total.add(&rays.remove()?);
+    io_total.add(&bbox.file.io);
+    io_total.add(&geometry.file.io);
+    Ok(OutOfCoreRender {
+        render: Render {
+            size,
+            corners,
+            stats,
+            counters,
+            intersect_s,
+            shade_s,
+            trace_s: start.elapsed().as_secs_f64(),
+            // One thread does all the work here.
+            trace_cpu_s: super::thread_cpu_seconds() - cpu_start,
+        },
+        io: io_total,
+    })
+}

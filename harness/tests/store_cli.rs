@@ -1,0 +1,164 @@
+//! `rtbench scene store` and the out-of-core render (issue 7): a store traced by the
+//! breadth-first engine gives Embree's in-memory image; bad stores, engines and spill
+//! directories are input errors (exit 2, one line) that leave nothing behind.
+
+mod common;
+
+use common::{expect_input_error, rtbench};
+use serde_json::Value;
+use std::path::PathBuf;
+
+/// A fresh directory for one test, removed at the end.
+struct Dir(PathBuf);
+
+impl Dir {
+    fn new(tag: &str) -> Dir {
+        let d =
+            std::env::temp_dir().join(format!("rtbench-store-cli-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Dir(d)
+    }
+    fn join(&self, p: &str) -> String {
+        self.0.join(p).to_str().unwrap().to_string()
+    }
+}
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = rtbench(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn a_store_renders_out_of_core_as_embree_renders_in_memory() {
+    let d = Dir::new("render");
+    let store = d.join("rings2");
+    let s = json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &store, "--json",
+    ]);
+    let stats = json(&["scene", "stats", "rings", "--sf", "2", "--json"]);
+    assert_eq!(s["objects"], stats["objects"]);
+    // A small budget: a few hundred rays in memory, many passes and refills.
+    let ooc = json(&[
+        "render",
+        "--scene",
+        &store,
+        "--engine",
+        "breadth-first",
+        "--size",
+        "64",
+        "--set",
+        "memory=1MiB",
+        "--json",
+    ]);
+    let mem = json(&[
+        "render",
+        "--scene",
+        "rings",
+        "--sf",
+        "2",
+        "--engine",
+        "breadth-first",
+        "--size",
+        "64",
+        "--json",
+    ]);
+    assert_eq!(ooc["image"]["sha256"], mem["image"]["sha256"]);
+    assert_eq!(ooc["rays"], mem["rays"]);
+    assert!(ooc["counters"]["extra"]["bf_passes"].as_u64().unwrap() > 5);
+    assert!(ooc["io"]["workload"]["bytes_written"].as_u64().unwrap() > 0);
+    assert!(ooc["build_stats"]["rays_in_memory"].as_f64().unwrap() < 4000.0);
+    // The spill files are gone.
+    let left: Vec<_> = std::fs::read_dir(&d.0).unwrap().collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+}
+
+#[test]
+fn bad_stores_engines_and_spill_directories_exit_2() {
+    let d = Dir::new("errors");
+    let store = d.join("tetra1");
+    json(&[
+        "scene", "store", "tetra", "--sf", "1", "-o", &store, "--json",
+    ]);
+    expect_input_error(
+        &["scene", "store", "tetra", "--sf", "1", "-o", &store],
+        "exists and is not an empty directory",
+    );
+    expect_input_error(
+        &["render", "--scene", &store, "--engine", "grid"],
+        "breadth-first engine only",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            &store,
+            "--sf",
+            "2",
+            "--engine",
+            "breadth-first",
+        ],
+        "a scene store is fixed",
+    );
+    // A spill directory that cannot be created (its parent is a file): in-memory and store.
+    let file = d.join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let spill = format!("spill={file}/sub");
+    for scene in ["tetra", store.as_str()] {
+        expect_input_error(
+            &[
+                "render",
+                "--scene",
+                scene,
+                "--engine",
+                "breadth-first",
+                "--size",
+                "16",
+                "--set",
+                &spill,
+            ],
+            "spill directory",
+        );
+    }
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "tetra",
+            "--engine",
+            "breadth-first",
+            "--set",
+            "memory=0",
+        ],
+        "memory",
+    );
+    // A store written nowhere leaves nothing behind.
+    expect_input_error(
+        &[
+            "scene",
+            "store",
+            "tetra",
+            "--sf",
+            "1",
+            "-o",
+            &format!("{file}/x"),
+        ],
+        "cannot write",
+    );
+    let left: Vec<_> = std::fs::read_dir(&d.0)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "{left:?}");
+}
