@@ -170,7 +170,7 @@ impl Config {
 /// 001's branching factors (§1.4–§1.5): 2 to [`MAX_WIDTH`] in steps of two; 001's N-ary SAH
 /// (`wide=direct` with a SAH builder) splits in halves, so it needs a power of two.
 pub fn check_width(width: usize, builder: Builder, wide: WideMethod) -> Result<(), String> {
-    if !(2..=MAX_WIDTH).contains(&width) || width % 2 != 0 {
+    if !(2..=MAX_WIDTH).contains(&width) || width & 1 == 1 {
         return Err(format!("must be even, from 2 to {MAX_WIDTH}"));
     }
     if wide == WideMethod::Direct && builder != Builder::Median && !width.is_power_of_two() {
