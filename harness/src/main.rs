@@ -47,6 +47,12 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            if a.id != "nakamaru-3.2" && (a.max_sf.is_some() || a.fault_ms.is_some()) {
+                return Err(error::input(format!(
+                    "{}: --max-sf and --fault-ms are for nakamaru-3.2 only",
+                    a.id
+                )));
+            }
             if a.id == "nakamaru-3.2" {
                 return commands::reproduce_thrashing::run(
                     &a.id,

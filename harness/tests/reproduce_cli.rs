@@ -25,6 +25,22 @@ fn reproduce_list_has_the_kimura_tables() {
     let s = String::from_utf8_lossy(&out.stdout);
     assert!(s.contains("kimura-3.3"), "{s}");
     assert!(s.contains("kimura-simd"), "{s}");
+    // Options of one table are refused by the others, with one line and exit 2.
+    for (extra, needle) in [
+        (["--max-sf", "tree=3"], "for nakamaru-3.2 only"),
+        (["--size", "64"], "for the yamauchi-* tables only"),
+    ] {
+        let out = rtbench(
+            &[
+                &["reproduce", "kimura-3.3", "--out", "/nonexistent/x"][..],
+                &extra[..],
+            ]
+            .concat(),
+        );
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle) && err.lines().count() == 1, "{err}");
+    }
 }
 
 #[test]

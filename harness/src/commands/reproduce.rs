@@ -28,7 +28,7 @@ const TABLES: &[(&str, &str)] = &[
     ),
     (
         "kimura-3.3",
-        "001 (Kimura 2007) §3.3-3.5: node statistics of 2/4/8-ary BVHs (orderings and ratios)",
+        "001 (Kimura 2007) §3.3-3.5: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
     ),
     (
         "nakamaru-3.1",
