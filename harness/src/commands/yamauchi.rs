@@ -5,7 +5,7 @@
 //! (prose only: 003's plots are lost) are in `data/published/yamauchi-*.json`.
 
 use crate::error::{input, Result};
-use crate::output::{print_json, write_atomic};
+use crate::output::write_atomic;
 use crate::source::Source;
 use crate::workload::{self, yamauchi};
 use rayon::prelude::*;
@@ -193,21 +193,6 @@ fn series(name: &str, color: usize, pts: &[(f64, f64)]) -> Series {
             })
             .collect(),
     }
-}
-
-fn report(id: &str, out: &Path, doc: &Value, md: &str, as_json: bool) -> Result<()> {
-    write_atomic(&out.join(format!("{id}.json")), |w| {
-        serde_json::to_writer_pretty(w, doc).map_err(std::io::Error::other)
-    })?;
-    write_atomic(&out.join(format!("{id}.md")), |w| {
-        std::io::Write::write_all(w, md.as_bytes())
-    })?;
-    if as_json {
-        print_json(doc);
-    } else {
-        print!("{md}");
-    }
-    Ok(())
 }
 
 fn pass_json(t: &Traced) -> Value {
@@ -470,7 +455,7 @@ pub fn static_lb(
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size, "max_pes": max_pes,
         "measured": rows, "findings": findings,
         "environment": {"os": std::env::consts::OS, "arch": std::env::consts::ARCH, "threads": pool.current_num_threads()}});
-    report(id, out, &doc, &md, as_json)
+    super::reproduce::write_report(id, out, &doc, &md, as_json)
 }
 
 /// `yamauchi-dynamic-lb`: efficiency vs RP blocks per PE on the 2D torus with skewed allocation.
@@ -663,7 +648,7 @@ pub fn dynamic_lb(
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size, "pe_counts": pe_counts, "rp_blocks": blocks,
         "measured": rows, "findings": findings,
         "environment": {"os": std::env::consts::OS, "arch": std::env::consts::ARCH, "threads": pool.current_num_threads()}});
-    report(id, out, &doc, &md, as_json)
+    super::reproduce::write_report(id, out, &doc, &md, as_json)
 }
 
 /// `yamauchi-cfbs`: the cached frame buffer system — 003's queueing model beside the
@@ -912,7 +897,7 @@ pub fn cfbs(
     let doc = json!({"id": id, "published": published, "quick": quick, "size": size,
         "model": model_rows, "model_vs_simulation": curve, "execution_driven": exec, "pmcr": pmcr_rows,
         "environment": {"os": std::env::consts::OS, "arch": std::env::consts::ARCH, "threads": pool.current_num_threads()}});
-    report(id, out, &doc, &md, as_json)
+    super::reproduce::write_report(id, out, &doc, &md, as_json)
 }
 
 /// Table 4's costs with every PE unit `pmcr` times faster (at least 1 clock); the link's hop and
