@@ -184,7 +184,11 @@ impl BreadthFirst {
             bbox.rewind().map_err(open_err)?;
             geometry.rewind().map_err(open_err)?;
         }
-        let mut voxels = Voxels::new(bounds, grid_prims);
+        // The grid takes about one voxel per primitive (5 bytes each: flags and a list head).
+        // Where that would pass half the memory budget, it is made coarser to fit in half, so
+        // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
+        let voxel_target = grid_prims.min(config.memory / 2 / 5).max(1);
+        let mut voxels = Voxels::new(bounds, voxel_target);
         let nvox = voxels.count() as u64;
         let grid_bytes = nvox * 5;
         let buffers = 2 * config.buffer;
