@@ -4,7 +4,9 @@
 //! bounding box reaches). Rays are registered in voxels, not objects; see [`super::intersect`].
 //!
 //! The grid's box and resolution are the `grid` engine's (⌊n^(1/3) + 0.5⌋ cells per axis with
-//! n the primitives, the box padded against `f32` rounding), so both engines walk the same cells.
+//! n the primitives, the box padded against `f32` rounding), so both engines walk the same cells;
+//! except where that grid would take more than half the memory budget: then n is lowered until
+//! it fits (`BreadthFirst::open`), so a budget-bound run keeps room for rays.
 
 use crate::grid::build::{PAD_CELL, PAD_COORD};
 use crate::grid::config::Resolution;
