@@ -14,23 +14,24 @@ use cli::{Cli, Command, SceneCommand};
 use error::Result;
 use source::Source;
 
-fn scene_source(s: &str, o: &cli::SceneOpts) -> Result<Source> {
-    Source::resolve(s, o.sf, o.tessellate, o.hash)
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
-        Command::Scene(SceneCommand::Gen { scene, output }) => {
-            commands::scene::gen(&scene_source(&scene.scene, &scene.opts)?, output.as_deref())
-        }
+        Command::Scene(SceneCommand::Gen { scene, output }) => commands::scene::gen(
+            &Source::from_args(&scene.scene, &scene.opts)?,
+            output.as_deref(),
+        ),
         Command::Scene(SceneCommand::Store {
             scene,
             output,
             json,
-        }) => commands::scene::store(&scene_source(&scene.scene, &scene.opts)?, &output, json),
+        }) => commands::scene::store(
+            &Source::from_args(&scene.scene, &scene.opts)?,
+            &output,
+            json,
+        ),
         Command::Scene(SceneCommand::Stats { scene, json }) => {
-            commands::scene::stats(&scene_source(&scene.scene, &scene.opts)?, json)
+            commands::scene::stats(&Source::from_args(&scene.scene, &scene.opts)?, json)
         }
         Command::Engines { json } => commands::engines::list(json),
         Command::Render(a) => commands::render::run(&a),

@@ -40,7 +40,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         )));
     }
     let settings = workload::parse_settings(&a.set)?;
-    let src = Source::resolve(scene, a.opts.sf, a.opts.tessellate, a.opts.hash)?;
+    let src = Source::from_args(scene, &a.opts)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (tested, _) = workload::build(engine, &prepared.input, settings)?;

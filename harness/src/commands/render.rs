@@ -15,12 +15,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if store.join(rtbench_engines::store::HEADER_FILE).is_file() {
         return run_store(a, store, settings);
     }
-    let src = Source::resolve(
-        &a.scene.scene,
-        a.scene.opts.sf,
-        a.scene.opts.tessellate,
-        a.scene.opts.hash,
-    )?;
+    let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;

@@ -23,12 +23,7 @@ pub fn run(a: &TreeStatsArgs) -> Result<()> {
     pairs.extend(settings);
     let config = Config::parse(a.width, Settings::new(&format!("bvh{}", a.width), pairs))
         .map_err(|e| input(e.to_string()))?;
-    let src = Source::resolve(
-        &a.scene.scene,
-        a.scene.opts.sf,
-        a.scene.opts.tessellate,
-        a.scene.opts.hash,
-    )?;
+    let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     let prepared = workload::prepare(&src)?;
     let g = &prepared.input.geometry;
     if g.prims.is_empty() {
