@@ -39,6 +39,21 @@ where
     Ok(())
 }
 
+/// Writes a square RGB8 image (`size`² pixels, rows top down) as a PNG, atomically.
+pub fn write_png(path: &Path, pixels: &[u8], size: u32) -> Result<()> {
+    write_atomic(path, |w| {
+        image::write_buffer_with_format(
+            w,
+            pixels,
+            size,
+            size,
+            image::ExtendedColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(std::io::Error::other)
+    })
+}
+
 /// Prints one JSON document on stdout (the `--json` contract).
 pub fn print_json(v: &serde_json::Value) {
     println!(

@@ -2,7 +2,7 @@
 
 use crate::cli::RenderArgs;
 use crate::error::{input, Result};
-use crate::output::{print_json, write_atomic};
+use crate::output::{print_json, write_png};
 use crate::source::Source;
 use crate::workload::{self, trace};
 use serde_json::json;
@@ -26,17 +26,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let pixels = r.pixels();
     let sha = hex(&Sha256::digest(&pixels));
     if let Some(png) = &a.png {
-        write_atomic(png, |w| {
-            image::write_buffer_with_format(
-                w,
-                &pixels,
-                a.size,
-                a.size,
-                image::ExtendedColorType::Rgb8,
-                image::ImageFormat::Png,
-            )
-            .map_err(std::io::Error::other)
-        })?;
+        write_png(png, &pixels, a.size)?;
     }
     let scene = &prepared.input.scene;
     let g = &prepared.input.geometry;
@@ -121,17 +111,7 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
     let pixels = r.pixels();
     let sha = hex(&Sha256::digest(&pixels));
     if let Some(png) = &a.png {
-        write_atomic(png, |w| {
-            image::write_buffer_with_format(
-                w,
-                &pixels,
-                a.size,
-                a.size,
-                image::ExtendedColorType::Rgb8,
-                image::ImageFormat::Png,
-            )
-            .map_err(std::io::Error::other)
-        })?;
+        write_png(png, &pixels, a.size)?;
     }
     let h = engine.header();
     let v = json!({

@@ -6,7 +6,7 @@
 
 use super::yamauchi;
 use crate::error::{input, Result};
-use crate::output::{print_json, write_atomic};
+use crate::output::{print_json, write_atomic, write_png};
 use crate::source::Source;
 use crate::workload::camera::Camera;
 use crate::workload::{self, trace};
@@ -174,17 +174,7 @@ pub fn run(
             let r = pool.install(|| trace::render(&prepared.input.scene, e.as_ref(), size, None));
             let pixels = r.pixels();
             let png = out.join("images").join(format!("{scene}{sf}-{engine}.png"));
-            write_atomic(&png, |w| {
-                image::write_buffer_with_format(
-                    w,
-                    &pixels,
-                    size,
-                    size,
-                    image::ExtendedColorType::Rgb8,
-                    image::ImageFormat::Png,
-                )
-                .map_err(std::io::Error::other)
-            })?;
+            write_png(&png, &pixels, size)?;
             let measured = serde_json::to_value(&r.stats).unwrap();
             let mut cells = Vec::new();
             let mut within = true;

@@ -5,7 +5,7 @@
 //! (prose only: 003's plots are lost) are in `data/published/yamauchi-*.json`.
 
 use crate::error::{input, Result};
-use crate::output::write_atomic;
+use crate::output::{write_atomic, write_png};
 use crate::source::Source;
 use crate::workload::{self, yamauchi};
 use rayon::prelude::*;
@@ -69,17 +69,7 @@ fn trace_scenes_with(
         let trace_s = t.elapsed().as_secs_f64();
         let png = out.join("images").join(format!("{label}-yamauchi.png"));
         let pixels = pass.pixels();
-        write_atomic(&png, |w| {
-            image::write_buffer_with_format(
-                w,
-                &pixels,
-                size,
-                size,
-                image::ExtendedColorType::Rgb8,
-                image::ImageFormat::Png,
-            )
-            .map_err(std::io::Error::other)
-        })?;
+        write_png(&png, &pixels, size)?;
         v.push(Traced {
             label,
             os,

@@ -207,17 +207,7 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     let n_corners = (w as usize) * (w as usize);
     let mut corners = vec![Vec3::ZERO; n_corners];
     let background = h.background.as_vec3();
-    let lights: Vec<(Vec3, Vec3)> = h
-        .lights
-        .iter()
-        .map(|l| {
-            let i = 1.0 / (h.lights.len() as f32).sqrt();
-            (
-                l.position.as_vec3(),
-                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
-            )
-        })
-        .collect();
+    let lights = super::trace::scaled_lights(&h.lights);
     let mut io_total = IoCounters::default();
     let mut bbox = BboxReader::open(&h.dir, h.objects, buffer)?;
     let mut geometry = GeometryReader::open(&h.dir, buffer)?;

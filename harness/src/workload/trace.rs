@@ -163,6 +163,21 @@ pub(crate) fn query_all<T: Clone + Send>(
 }
 
 /// A secondary ray's origin: `p` moved off the surface along `n` (the self-intersection policy).
+/// Each light's position and colour, scaled by SPD's light scale for renderers that do not scale:
+/// 1/sqrt(number of lights).
+pub(crate) fn scaled_lights(lights: &[rtbench_scenes::Light]) -> Vec<(Vec3, Vec3)> {
+    let i = 1.0 / (lights.len() as f32).sqrt();
+    lights
+        .iter()
+        .map(|l| {
+            (
+                l.position.as_vec3(),
+                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
+            )
+        })
+        .collect()
+}
+
 pub(crate) fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
     let scale = p.abs().max_element().max(OFFSET_MIN / OFFSET_REL) * OFFSET_REL;
     p + n * scale
@@ -282,18 +297,7 @@ pub fn render(
     let n_corners = (w as usize) * (w as usize);
     let mut corners = vec![Vec3::ZERO; n_corners];
     let background = scene.background.as_vec3();
-    let lights: Vec<(Vec3, Vec3)> = scene
-        .lights
-        .iter()
-        .map(|l| {
-            // SPD's light scale for renderers that do not scale: 1/sqrt(#lights).
-            let i = 1.0 / (scene.lights.len() as f32).sqrt();
-            (
-                l.position.as_vec3(),
-                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
-            )
-        })
-        .collect();
+    let lights = scaled_lights(&scene.lights);
 
     let mut rays: Vec<Ray> = Vec::with_capacity(n_corners);
     let mut paths: Vec<Path> = Vec::with_capacity(n_corners);

@@ -64,17 +64,7 @@ struct Path {
 pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32) -> Pass {
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
-    let lights: Vec<(Vec3, Vec3)> = scene
-        .lights
-        .iter()
-        .map(|l| {
-            let i = 1.0 / (scene.lights.len() as f32).sqrt();
-            (
-                l.position.as_vec3(),
-                l.color.map(|c| c.as_vec3()).unwrap_or(Vec3::ONE) * i,
-            )
-        })
-        .collect();
+    let lights = super::trace::scaled_lights(&scene.lights);
     let mut rays = camera.pixel_centre_rays(size, size);
     let mut paths: Vec<Path> = (0..rays.len() as u32)
         .map(|pixel| Path {
