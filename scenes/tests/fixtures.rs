@@ -1,4 +1,4 @@
-//! Every fixture in ../shared/fixtures/spd/ (output of the SPD 3.14 C programs) against our
+//! Every fixture in tests/fixtures/spd/ (output of the SPD 3.14 C programs; provenance in its README) against our
 //! generators, record by record and number by number: numbers equal within 1e-5 relative or
 //! 1e-6 absolute (../shared/CLI.md, `scene gen`).
 //!
@@ -11,10 +11,7 @@ use std::io::Read;
 use std::path::PathBuf;
 
 fn fixtures_dir() -> PathBuf {
-    if let Ok(d) = std::env::var("RTBENCH_SHARED") {
-        return PathBuf::from(d).join("fixtures/spd");
-    }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/fixtures/spd")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/spd")
 }
 
 /// `<program>[-jenkins]-sf<N>[-tess].nff.gz` → what to generate.
