@@ -177,6 +177,10 @@ pub struct ReproduceArgs {
     /// yamauchi-* only: SPD scenes, comma-separated (standard SFs).
     #[arg(long)]
     pub scenes: Option<String>,
+    /// A table's option `key=value` (repeatable; `reproduce list --json` lists each table's keys).
+    /// The flags above are the same keys by their own names.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     #[arg(long)]
     pub json: bool,
 }

@@ -4,6 +4,7 @@ mod cli;
 mod commands;
 mod error;
 mod output;
+mod reproduce;
 mod runs;
 mod source;
 mod suite;
@@ -42,12 +43,15 @@ fn run(cli: Cli) -> Result<()> {
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),
         Command::Report(a) => commands::runs::report(&a),
         Command::Compare(a) => commands::runs::compare(&a),
-        Command::Reproduce(a) if a.id == "list" => commands::reproduce::list(a.json),
+        Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),
         Command::Reproduce(a) => {
             let out = a
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
+            if reproduce::find(&a.id).is_ok() {
+                return reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json);
+            }
             if a.id != "nakamaru-3.2" && (a.max_sf.is_some() || a.fault_ms.is_some()) {
                 return Err(error::input(format!(
                     "{}: --max-sf and --fault-ms are for nakamaru-3.2 only",
@@ -80,6 +84,25 @@ fn run(cli: Cli) -> Result<()> {
             )
         }
     }
+}
+
+/// The reproduce flags as a table's option pairs: each flag is the key of its own name, then `--set`.
+fn reproduce_pairs(a: &cli::ReproduceArgs) -> Result<Vec<(String, String)>> {
+    let mut pairs = Vec::new();
+    let mut flag = |key: &str, value: Option<String>| {
+        if let Some(v) = value {
+            pairs.push((key.to_string(), v));
+        }
+    };
+    flag("engines", a.engines.clone());
+    flag("threads", a.threads.map(|t| t.to_string()));
+    flag("max-sf", a.max_sf.clone());
+    flag("fault-ms", a.fault_ms.map(|t| t.to_string()));
+    flag("size", a.size.map(|t| t.to_string()));
+    flag("max-pes", a.max_pes.map(|t| t.to_string()));
+    flag("scenes", a.scenes.clone());
+    pairs.extend(reproduce::parse_set(&a.id, &a.set)?);
+    Ok(pairs)
 }
 
 fn main() {

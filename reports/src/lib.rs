@@ -22,6 +22,7 @@ mod anchor;
 mod atomic;
 mod compare;
 mod csv;
+mod document;
 mod error;
 mod html;
 mod markdown;
@@ -34,6 +35,7 @@ mod table;
 
 pub use anchor::EMBREE;
 pub use compare::{compare, Comparison, Finding, FindingKind};
+pub use document::{Block, Document, Table};
 pub use error::ReportError;
 pub use report::{write_report, Format};
 pub use results::{

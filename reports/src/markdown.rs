@@ -1,7 +1,8 @@
 //! `report.md`: environment, one table per thread count, failed runs, plots.
 
+use crate::document::{md_cell, Table};
 use crate::summary::Summary;
-use crate::table::{self, Table};
+use crate::table;
 use std::fmt::Write;
 
 /// The Markdown report. `plots` are the plot images (relative to the results directory) to show.
@@ -11,7 +12,7 @@ pub fn report(summary: &Summary, plots: &[String]) -> String {
     match &summary.environment {
         Some(env) => {
             for (what, value) in table::environment_lines(env) {
-                let _ = writeln!(s, "- **{what}**: {}", escape(&value));
+                let _ = writeln!(s, "- **{what}**: {}", md_cell(&value));
             }
         }
         None => s.push_str("- environment not recorded (no `env.json`)\n"),
@@ -35,7 +36,7 @@ pub fn report(summary: &Summary, plots: &[String]) -> String {
     if !failures.is_empty() {
         let _ = writeln!(s, "## Failed runs\n");
         for (key, why) in failures {
-            let _ = writeln!(s, "- `{key}`: {}", escape(&why));
+            let _ = writeln!(s, "- `{key}`: {}", md_cell(&why));
         }
         s.push('\n');
     }
@@ -50,22 +51,5 @@ pub fn report(summary: &Summary, plots: &[String]) -> String {
 }
 
 fn write_table(s: &mut String, t: &Table) {
-    let _ = writeln!(s, "## {}\n", t.caption);
-    let _ = writeln!(s, "| {} |", t.header.join(" | "));
-    let rule: Vec<&str> = t
-        .numeric
-        .iter()
-        .map(|&n| if n { "---:" } else { "---" })
-        .collect();
-    let _ = writeln!(s, "|{}|", rule.join("|"));
-    for row in &t.rows {
-        let cells: Vec<String> = row.iter().map(|c| escape(c)).collect();
-        let _ = writeln!(s, "| {} |", cells.join(" | "));
-    }
-    s.push('\n');
-}
-
-/// Keeps a cell a cell: a `|` inside would split it.
-fn escape(text: &str) -> String {
-    text.replace('|', "\\|").replace('\n', " ")
+    s.push_str(&t.to_markdown());
 }

@@ -1,17 +1,9 @@
 //! The report's tables as cells, shared by the Markdown and HTML writers.
 
+use crate::document::Table;
 use crate::number;
 use crate::results::Environment;
 use crate::summary::{Row, Summary};
-
-/// A table with a caption, ready to be written as Markdown or HTML.
-pub struct Table {
-    pub caption: String,
-    pub header: Vec<&'static str>,
-    /// Which columns hold numbers (right-aligned).
-    pub numeric: Vec<bool>,
-    pub rows: Vec<Vec<String>>,
-}
 
 const HEADER: [(&str, bool); 11] = [
     ("scene", false),
@@ -34,7 +26,7 @@ pub fn run_tables(summary: &Summary) -> Vec<Table> {
         .into_iter()
         .map(|threads| Table {
             caption: format!("{threads} thread{}", if threads == 1 { "" } else { "s" }),
-            header: HEADER.iter().map(|h| h.0).collect(),
+            header: HEADER.iter().map(|h| h.0.to_string()).collect(),
             numeric: HEADER.iter().map(|h| h.1).collect(),
             rows: summary
                 .rows
