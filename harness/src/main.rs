@@ -6,6 +6,7 @@ mod error;
 mod output;
 mod reproduce;
 mod runs;
+mod select;
 mod source;
 mod suite;
 mod workload;
@@ -73,15 +74,7 @@ fn run(cli: Cli) -> Result<()> {
                 max_pes: a.max_pes,
                 scenes: a.scenes.clone(),
             };
-            commands::reproduce::run(
-                &a.id,
-                a.quick,
-                out,
-                a.engines.as_deref(),
-                a.threads,
-                &limits,
-                a.json,
-            )
+            commands::reproduce::run(&a.id, a.quick, out, a.threads, &limits, a.json)
         }
     }
 }

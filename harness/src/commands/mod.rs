@@ -4,7 +4,6 @@ pub mod check;
 pub mod engines;
 pub mod render;
 pub mod reproduce;
-pub mod reproduce_nakamaru;
 pub mod reproduce_thrashing;
 pub mod runs;
 pub mod scene;

@@ -66,43 +66,10 @@ type EngineSettings = (String, Vec<(String, String)>);
 /// may carry its own settings after colons, `bvh4:simd=off:leaf=1`, so variants of one engine run
 /// side by side; `--set engine.key=value` applies to every entry of that engine.
 fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
-    let registry = rtbench_engines::registry();
-    let entries: Vec<String> = if p.engines.trim() == "all" {
-        registry
-            .iter()
-            .filter(|e| e.name != "reference" && (e.available)().is_ok())
-            .map(|e| e.name.to_string())
-            .collect()
-    } else {
-        p.engines
-            .split(',')
-            .map(|s| s.trim().to_string())
-            .filter(|s| !s.is_empty())
-            .collect()
-    };
-    if entries.is_empty() {
-        return Err(input("--engines: no engine given"));
-    }
     let mut out: Vec<EngineSettings> = Vec::new();
-    for entry in &entries {
-        let mut parts = entry.split(':');
-        let n = parts.next().unwrap_or_default().trim();
-        let info = registry
-            .iter()
-            .find(|e| e.name == n)
-            .ok_or_else(|| input(format!("unknown engine '{n}' (see `rtbench engines`)")))?;
-        (info.available)().map_err(|r| input(format!("engine '{n}' is not available: {r}")))?;
-        let mut settings = Vec::new();
-        for kv in parts {
-            let (k, v) = kv
-                .split_once('=')
-                .filter(|(k, _)| !k.trim().is_empty())
-                .ok_or_else(|| input(format!("--engines '{entry}': expected engine:key=value")))?;
-            settings.push((k.trim().to_string(), v.trim().to_string()));
-        }
-        let planned = (n.to_string(), settings);
+    for planned in crate::select::engines(Some(&p.engines), "--engines")? {
         if out.contains(&planned) {
-            return Err(input(format!("--engines: '{entry}' given twice")));
+            return Err(input(format!("--engines: '{}' given twice", planned.0)));
         }
         out.push(planned);
     }

@@ -15,7 +15,7 @@ mod params;
 mod published;
 mod writer;
 
-mod spd_stats;
+mod engine_timing;
 
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
@@ -91,8 +91,17 @@ impl Output {
     }
 }
 
-/// Every table, in the order `reproduce list` shows them.
-pub const TABLES: &[Table] = &[spd_stats::TABLE];
+/// Declares each table's module (named for its id) and lists its `TABLE`, in the order
+/// `reproduce list` shows them: adding a table is one line here.
+macro_rules! registry {
+    ($($table:ident),* $(,)?) => {
+        $(mod $table;)*
+        /// Every table, in the order `reproduce list` shows them.
+        pub const TABLES: &[Table] = &[$($table::TABLE),*];
+    };
+}
+
+registry!(spd_stats, kimura_3_3, kimura_simd, nakamaru_3_1,);
 
 pub fn find(id: &str) -> Result<&'static Table> {
     TABLES.iter().find(|t| t.id == id).ok_or_else(|| {

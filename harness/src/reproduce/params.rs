@@ -115,33 +115,7 @@ impl Params {
     /// `engines`: each a registered engine that can run here; default every available engine but
     /// `reference` (brute force: hours on the standard scenes).
     pub fn engines(&self) -> Result<Vec<String>> {
-        let registry = rtbench_engines::registry();
-        match self.list(ENGINES.key)? {
-            Some(names) => {
-                for n in &names {
-                    let base = n.split(':').next().unwrap_or(n);
-                    match registry.iter().find(|e| e.name == base) {
-                        None => {
-                            let known: Vec<&str> = registry.iter().map(|e| e.name).collect();
-                            return Err(input(format!(
-                                "{}: unknown engine '{n}' (known: {})",
-                                self.id,
-                                known.join(", ")
-                            )));
-                        }
-                        Some(e) => (e.available)().map_err(|why| {
-                            input(format!("{}: engine '{n}' is not available: {why}", self.id))
-                        })?,
-                    }
-                }
-                Ok(names)
-            }
-            None => Ok(registry
-                .into_iter()
-                .filter(|e| e.name != "reference" && (e.available)().is_ok())
-                .map(|e| e.name.to_string())
-                .collect()),
-        }
+        crate::select::engine_names(self.raw(ENGINES.key), &format!("{}: engines", self.id))
     }
 
     /// `scenes`: each an SPD program name; `None` when absent.

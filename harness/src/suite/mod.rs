@@ -75,34 +75,14 @@ const ALTERNATIVES: &[(&str, &str)] = &[("triangle", "moller"), ("robust", "on")
 /// The engines to run: `--engine a,b` (each must exist and be available) or every available
 /// engine of the registry but the test-only ones.
 pub fn engines(arg: Option<&str>) -> Result<Vec<String>> {
-    match arg {
-        Some(list) => {
-            let names: Vec<String> = list
-                .split(',')
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect();
-            if names.is_empty() {
-                return Err(input(format!("--engine '{list}': no engine named")));
-            }
-            for n in &names {
-                let info = registry()
-                    .into_iter()
-                    .find(|e| e.name == n)
-                    .ok_or_else(|| EngineError::Unknown(n.clone()))?;
-                (info.available)().map_err(|reason| EngineError::Unavailable {
-                    engine: n.clone(),
-                    reason,
-                })?;
-            }
-            Ok(names)
-        }
-        None => Ok(registry()
-            .into_iter()
-            .filter(|e| !e.name.starts_with("test-") && (e.available)().is_ok())
-            .map(|e| e.name.to_string())
-            .collect()),
+    if arg.is_some() {
+        return crate::select::engine_names(arg, "--engine");
     }
+    Ok(registry()
+        .into_iter()
+        .filter(|e| !e.name.starts_with("test-") && (e.available)().is_ok())
+        .map(|e| e.name.to_string())
+        .collect())
 }
 
 /// Each engine as it comes, and with each alternative kernel setting it accepts (tried by

@@ -1,0 +1,171 @@
+//! Timing engines side by side on one ray set (closest hit, the calling thread): one warm-up, then the
+//! median of several CPU and wall times; builds timed as the median wall time of several builds.
+//! Shared by the tables that compare engines on the same rays (001's rendering experiments).
+
+use crate::error::Result;
+use crate::select::median;
+use crate::workload;
+use rtbench_engines::{BuildInput, Counters, Hit, Ray};
+use serde::Serialize;
+use std::time::Instant;
+
+/// One engine to time: label, engine name, settings.
+pub type Timee = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+/// The counters a timed row keeps.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct TimedCounters {
+    pub nodes_visited: u64,
+    pub box_tests: u64,
+    pub primitive_tests: u64,
+}
+
+/// One engine's timing on one scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timed {
+    pub scene: &'static str,
+    pub sf: u32,
+    pub engine: &'static str,
+    pub engine_name: &'static str,
+    pub settings: Vec<(String, String)>,
+    pub build_s: f64,
+    pub cpu_s: f64,
+    pub wall_s: f64,
+    pub repeats: usize,
+    pub rays: usize,
+    pub hits: usize,
+    pub structure_bytes: u64,
+    pub primitives: usize,
+    pub counters: TimedCounters,
+}
+
+impl Timed {
+    pub fn bytes_per_primitive(&self) -> f64 {
+        self.structure_bytes as f64 / self.primitives.max(1) as f64
+    }
+}
+
+pub fn settings(kv: &[(&str, &str)]) -> Vec<(String, String)> {
+    kv.iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+fn available(engine: &str) -> bool {
+    rtbench_engines::registry()
+        .into_iter()
+        .find(|e| e.name == engine)
+        .is_some_and(|e| (e.available)().is_ok())
+}
+
+/// Times every available engine of `engines` on `rays`; an engine not available here is skipped
+/// (said on stderr).
+pub fn time_engines(
+    engines: &[Timee],
+    input: &BuildInput,
+    rays: &[Ray],
+    repeats: usize,
+    builds: usize,
+    (scene, sf): (&'static str, u32),
+    what: &str,
+) -> Result<Vec<Timed>> {
+    let mut out = Vec::new();
+    for &(label, engine, kv) in engines {
+        if !available(engine) {
+            eprintln!("{what}: {engine} is not available here; skipped");
+            continue;
+        }
+        eprintln!("{what}: {scene}{sf} {label} …");
+        let (mut e, build_s) = workload::build(engine, input, settings(kv))?;
+        let mut build_times = vec![build_s];
+        for _ in 1..builds {
+            drop(e);
+            let (again, s) = workload::build(engine, input, settings(kv))?;
+            e = again;
+            build_times.push(s);
+        }
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let mut counters = Counters::default();
+        e.intersect(rays, &mut hits, &mut counters);
+        let n_hits = hits.iter().filter(|x| x.t.is_finite()).count();
+        let (mut cpu, mut wall) = (Vec::new(), Vec::new());
+        for _ in 0..repeats {
+            let mut c = Counters::default();
+            let t = Instant::now();
+            let c0 = workload::thread_cpu_seconds();
+            e.intersect(rays, &mut hits, &mut c);
+            cpu.push(workload::thread_cpu_seconds() - c0);
+            wall.push(t.elapsed().as_secs_f64());
+        }
+        out.push(Timed {
+            scene,
+            sf,
+            engine: label,
+            engine_name: engine,
+            settings: settings(kv),
+            build_s: median(&mut build_times),
+            cpu_s: median(&mut cpu),
+            wall_s: median(&mut wall),
+            repeats,
+            rays: rays.len(),
+            hits: n_hits,
+            structure_bytes: e.structure_bytes(),
+            primitives: input.geometry.prims.len(),
+            counters: TimedCounters {
+                nodes_visited: counters.nodes_visited,
+                box_tests: counters.box_tests,
+                primitive_tests: counters.primitive_tests,
+            },
+        });
+    }
+    Ok(out)
+}
+
+/// A counter per ray, or "-" when the engine counts nothing (Embree).
+fn per_ray(count: u64, rays: f64) -> String {
+    if count == 0 {
+        "-".into()
+    } else {
+        format!("{:.2}", count as f64 / rays)
+    }
+}
+
+pub const HEADER: [&str; 10] = [
+    "scene",
+    "engine",
+    "CPU ms (wall)",
+    "nodes/ray",
+    "box tests/ray",
+    "tri tests/ray",
+    "hits",
+    "x Embree",
+    "build ms",
+    "B/prim",
+];
+
+/// Table rows of timed engines, with the time ratio to Embree's.
+pub fn rows(times: &[Timed]) -> Vec<Vec<String>> {
+    let embree = times.iter().find(|t| t.engine == "embree").map(|t| t.cpu_s);
+    times
+        .iter()
+        .map(|t| {
+            let n = t.rays as f64;
+            vec![
+                format!("{}{}", t.scene, t.sf),
+                t.engine.to_string(),
+                format!("{:.1} ({:.1})", t.cpu_s * 1e3, t.wall_s * 1e3),
+                per_ray(t.counters.nodes_visited, n),
+                per_ray(t.counters.box_tests, n),
+                per_ray(t.counters.primitive_tests, n),
+                t.hits.to_string(),
+                embree.map_or("-".into(), |e| format!("{:.2}", t.cpu_s / e)),
+                format!("{:.0}", t.build_s * 1e3),
+                format!("{:.1}", t.bytes_per_primitive()),
+            ]
+        })
+        .collect()
+}

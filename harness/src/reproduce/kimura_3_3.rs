@@ -1,0 +1,348 @@
+//! `kimura-3.3`: 001 (Kimura 2007) §3.3–3.5, node statistics of N-ary BVHs. 001's own N-ary builders
+//! (object median, N = 2, 4, …, 16; full-sweep SAH, N = 2, 4, 8, 16, one triangle per leaf) on 001's SPD
+//! scenes tessellated as 001 did, built with the library call behind `rtbench tree-stats` (no
+//! traversal). 001's plotted values (Figs. 3.12–3.19) are lost: its orderings and ratios compare.
+
+use super::published::{self, Source};
+use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use crate::error::Result;
+use crate::source::Source as SceneSource;
+use crate::workload;
+use rtbench_engines::bvh::{config::Config, stats::TreeStats, tree_statistics};
+use rtbench_reports::{Document, Table as DocTable};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+pub const TABLE: Table = Table {
+    id: "kimura-3.3",
+    seed: "001",
+    source: "§3.3–3.5, Table 3.1, 3.3, Figs. 3.12–3.19",
+    about: "001 (Kimura 2007) §3.3-3.5: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
+    runtime: Runtime {
+        quick: "seconds",
+        full: "minutes",
+    },
+    params: &[],
+    claims: &[
+        Claim { key: "table-3.3-bytes", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "table-3.1-triangles", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "depth-halves-2-4", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "depth-4-8-not-halved", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "binary-leaves", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "memory-less-than-binary", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "sah-memory-min-4-8", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "sah-deeper", fidelity: Fidelity::Faithful, why: "" },
+        Claim {
+            key: "cloister",
+            fidelity: Fidelity::NotReproducible,
+            why: "001's cloister scene (81,410 triangles) has no published source",
+        },
+    ],
+    run,
+};
+
+const PUBLISHED: &str = include_str!("../../../data/published/kimura-3.3.json");
+
+/// 001's three SPD scenes (Table 3.1), tessellated as 001 did (patch resolution 3).
+pub const SCENES: &[(&str, u32)] = &[("gears", 4), ("tree", 10), ("balls", 4)];
+
+/// 001's scenes, or gears4 alone with `--quick`.
+pub fn scenes(quick: bool) -> &'static [(&'static str, u32)] {
+    if quick {
+        &SCENES[..1]
+    } else {
+        SCENES
+    }
+}
+
+/// 001's branching factors: object median 2–16 in steps of 2, SAH (halving) 2, 4, 8, 16.
+const MEDIAN_WIDTHS: &[usize] = &[2, 4, 6, 8, 10, 12, 14, 16];
+const SAH_WIDTHS: &[usize] = &[2, 4, 8, 16];
+const BUILDERS: [(&str, &str, &[usize]); 2] = [
+    ("median", "object median", MEDIAN_WIDTHS),
+    ("sah-sweep", "SAH (full sweep)", SAH_WIDTHS),
+];
+
+#[derive(Deserialize)]
+struct Published {
+    source: Source,
+    scenes: PublishedScenes,
+    internal_node_bytes: NodeBytes,
+}
+#[derive(Deserialize)]
+struct PublishedScenes {
+    rows: Vec<PublishedScene>,
+}
+#[derive(Deserialize)]
+struct PublishedScene {
+    scene: String,
+    sf: Option<u32>,
+    triangles: u64,
+}
+#[derive(Deserialize)]
+struct NodeBytes {
+    width: Vec<u64>,
+    bytes: Vec<u64>,
+}
+
+#[derive(Serialize)]
+struct Tree {
+    scene: &'static str,
+    sf: u32,
+    builder: &'static str,
+    width: usize,
+    triangles: u64,
+    triangles_published: Option<u64>,
+    build_s: f64,
+    stats: BTreeMap<String, f64>,
+}
+
+/// The old comparison rows (kept in the JSON as `compare`).
+#[derive(Serialize)]
+struct Check {
+    scene: String,
+    claim: String,
+    published: String,
+    measured: String,
+    compares: String,
+}
+
+#[derive(Serialize)]
+struct Result_ {
+    id: &'static str,
+    published: serde_json::Value,
+    measured: Vec<Tree>,
+    compare: Vec<Check>,
+    quick: bool,
+    not_built: &'static str,
+    environment: serde_json::Value,
+}
+
+/// Per scene: (scene, sf, triangles, published triangles, builder → width → stats).
+type SceneTrees = (&'static str, u32, u64, Option<u64>, BTreeMap<&'static str, BTreeMap<usize, TreeStats>>);
+
+fn measure(p: &Published, quick: bool, trees: &mut Vec<Tree>) -> Result<Vec<SceneTrees>> {
+    let mut out = Vec::new();
+    for &(scene, sf) in scenes(quick) {
+        let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
+        let prepared = workload::prepare(&src)?;
+        let geometry = &prepared.input.geometry;
+        let tris = geometry.prims.len() as u64;
+        let published_tris = p
+            .scenes
+            .rows
+            .iter()
+            .find(|r| r.scene == scene && r.sf == Some(sf))
+            .map(|r| r.triangles);
+        let mut stats_of = BTreeMap::new();
+        for (builder, _, widths) in BUILDERS {
+            let mut by_width = BTreeMap::new();
+            for &width in widths {
+                eprintln!("kimura-3.3: {scene}{sf} {builder} N={width} …");
+                let config = Config::parse(width, rtbench_engines::Settings::new("bvh", kimura_tree(builder)))?;
+                let (t, build_s) = tree_statistics(geometry, &config);
+                let mut stats = BTreeMap::new();
+                t.insert_into(&mut stats);
+                trees.push(Tree {
+                    scene,
+                    sf,
+                    builder,
+                    width,
+                    triangles: tris,
+                    triangles_published: published_tris,
+                    build_s,
+                    stats,
+                });
+                by_width.insert(width, t);
+            }
+            stats_of.insert(builder, by_width);
+        }
+        out.push((scene, sf, tris, published_tris, stats_of));
+    }
+    Ok(out)
+}
+
+/// 001's tree: its own N-ary builder, one triangle per leaf, scalar.
+pub fn kimura_tree(builder: &str) -> Vec<(String, String)> {
+    [
+        ("builder", builder),
+        ("wide", "direct"),
+        ("leaf", "1"),
+        ("packets", "off"),
+        ("simd", "off"),
+    ]
+    .iter()
+    .map(|(k, v)| (k.to_string(), v.to_string()))
+    .collect()
+}
+
+fn run(ctx: &Ctx) -> Result<Output> {
+    let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
+    let mut trees = Vec::new();
+    let scenes = measure(&p, ctx.quick, &mut trees)?;
+    let rows = analyse(&p, &scenes);
+    let doc = document(&p, &trees, &rows, ctx.quick);
+    let compare = rows
+        .iter()
+        .filter(|r| r.claim != "cloister")
+        .map(|r| Check {
+            scene: r.subject.clone(),
+            claim: r.note.clone(),
+            published: r.published.clone(),
+            measured: r.measured.clone(),
+            compares: legacy_verdict(r),
+        })
+        .collect();
+    let result = Result_ {
+        id: ctx.id,
+        published: raw,
+        measured: trees,
+        compare,
+        quick: ctx.quick,
+        not_built: "cloister (no source)",
+        environment: environment(1),
+    };
+    let rows = rows.into_iter().map(|r| r.with_note("")).collect();
+    Ok(Output::new(result, rows, doc))
+}
+
+/// The wording of the first layout's `compares` field.
+fn legacy_verdict(r: &Row) -> String {
+    let ok = r.verdict == Verdict::Holds;
+    match r.kind {
+        Kind::Count => if ok { "count matches" } else { "count differs" }.into(),
+        Kind::Ordering => if ok { "ordering matches" } else { "ordering differs" }.into(),
+        _ => if ok { "matches" } else { "differs" }.into(),
+    }
+}
+
+/// `measured / published - 1` within `tol`.
+fn near(measured: f64, published: f64, tol: f64) -> bool {
+    (measured / published - 1.0).abs() <= tol
+}
+
+/// The claims, from the measured trees (pure). A row's note holds the first layout's claim wording.
+fn analyse(p: &Published, scenes: &[SceneTrees]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let ours: Vec<u64> = p
+        .internal_node_bytes
+        .width
+        .iter()
+        .map(|&w| TreeStats::internal_node_model_bytes(w as usize))
+        .collect();
+    let t33 = &p.internal_node_bytes.bytes;
+    rows.push(
+        Row::new("table-3.3-bytes", "-", format!("{t33:?}"), format!("{ours:?}"), Kind::Count, Verdict::of(&ours == t33))
+            .with_note("Table 3.3 internal-node bytes, N = 2…16"),
+    );
+    for (scene, sf, tris, published_tris, stats_of) in scenes {
+        let on = format!("{scene}{sf}");
+        if let Some(pt) = published_tris {
+            rows.push(
+                Row::new("table-3.1-triangles", &on, pt.to_string(), tris.to_string(), Kind::Count, Verdict::of(pt == tris))
+                    .with_note("Table 3.1 triangle count"),
+            );
+        }
+        for (builder, _, widths) in BUILDERS {
+            scene_builder_rows(&mut rows, &on, builder, widths, &stats_of[builder]);
+        }
+        let sah = &stats_of["sah-sweep"];
+        let mem = |n: usize| sah[&n].model_bytes();
+        let lowest = [2, 4, 8, 16].into_iter().min_by_key(|&n| mem(n)).unwrap_or(2);
+        rows.push(
+            Row::new(
+                "sah-memory-min-4-8",
+                &on,
+                "lowest at 4 and 8; 16 slightly higher (Fig. 3.19 prose)",
+                format!("lowest at N={lowest}; N=16 / min(4, 8) = {:.3}", mem(16) as f64 / mem(4).min(mem(8)) as f64),
+                Kind::Ordering,
+                Verdict::of((lowest == 4 || lowest == 8) && mem(16) > mem(4).min(mem(8))),
+            )
+            .with_note("sah-sweep: Eq. 3.3 memory lowest at N=4 and 8, slightly higher at 16"),
+        );
+        let r = sah[&2].avg_leaf_depth / stats_of["median"][&2].avg_leaf_depth;
+        rows.push(
+            Row::new("sah-deeper", &on, "about 1.1 (Fig. 3.16 prose)", format!("{r:.3}"), Kind::Ratio, Verdict::of(near(r, 1.1, 0.05)))
+                .with_note("N=2 avg leaf depth SAH / median"),
+        );
+    }
+    rows.push(Row::new("cloister", "cloister", "81,410 triangles (Table 3.1)", "-", Kind::Count, Verdict::NotMeasured));
+    rows
+}
+
+/// One builder's claims on one scene: depth ratios, binary leaves, memory against N = 2.
+fn scene_builder_rows(rows: &mut Vec<Row>, on: &str, builder: &str, widths: &[usize], w: &BTreeMap<usize, TreeStats>) {
+    let depth = |n: usize| w[&n].avg_leaf_depth;
+    let r42 = depth(4) / depth(2);
+    rows.push(
+        Row::new("depth-halves-2-4", on, "about 0.5 (Fig. 3.12/3.16 prose)", format!("{r42:.3}"), Kind::Ratio, Verdict::of(near(r42, 0.5, 0.1)))
+            .with_note(format!("{builder}: avg leaf depth N=4 / N=2")),
+    );
+    let r84 = depth(8) / depth(4);
+    rows.push(
+        Row::new("depth-4-8-not-halved", on, "between 0.5 and 1 (not halved)", format!("{r84:.3}"), Kind::Ordering, Verdict::of(r84 > 0.5 && r84 < 1.0))
+            .with_note(format!("{builder}: avg leaf depth N=8 / N=4")),
+    );
+    let t2 = &w[&2];
+    rows.push(
+        Row::new(
+            "binary-leaves",
+            on,
+            "exact (Fig. 3.13 prose)",
+            format!("leaves {}, internal {}, empty {}", t2.leaf_nodes, t2.internal_nodes, t2.empty_nodes),
+            Kind::Count,
+            Verdict::of(t2.leaf_nodes == t2.internal_nodes + 1 && t2.empty_nodes == 0),
+        )
+        .with_note(format!("{builder}: N=2 leaves = internal + 1, no empty nodes")),
+    );
+    let m2 = t2.model_bytes() as f64;
+    let ratios: Vec<String> = widths[1..].iter().map(|n| format!("{n}: {:.3}", w[n].model_bytes() as f64 / m2)).collect();
+    let below = widths[1..].iter().filter(|n| (w[*n].model_bytes() as f64) < m2).count();
+    rows.push(
+        Row::new(
+            "memory-less-than-binary",
+            on,
+            "below 1 for almost every N (Figs. 3.14, 3.19 prose)",
+            format!("{} ({below} of {} below 1)", ratios.join(", "), widths.len() - 1),
+            Kind::Ordering,
+            Verdict::of(below + 1 >= widths.len() - 1),
+        )
+        .with_note(format!("{builder}: Eq. 3.3 memory N / N=2, every N > 2")),
+    );
+}
+
+fn document(p: &Published, trees: &[Tree], rows: &[Row], quick: bool) -> Document {
+    let mut doc = Document::new("kimura-3.3: node statistics of N-ary BVHs (N = 2…16), 001 vs measured");
+    doc.paragraph(format!("Source: {}.", p.source.cite()));
+    doc.paragraph("001's plotted values (Figs. 3.12-3.19) are lost; what compares is its orderings and ratios, not absolute values. Cloister is not reproduced (no source).");
+    doc.paragraph(format!("Measured: `rtbench reproduce kimura-3.3` ({}): 001's own N-ary builders (`wide=direct leaf=1`), object median for N = 2, 4, …, 16 and full-sweep SAH for N = 2, 4, 8, 16 (001's SAH halves, so powers of two), built with the library call behind `rtbench tree-stats` (no traversal). Depth: root = 0. Memory: 001 Eq. 3.3 (empty nodes not counted | counted); actual bytes: our N-wide node array (boxes side by side, 64-byte aligned).", if quick { "--quick: gears4 only" } else { "full: gears4, tree10, balls4" }));
+    let mut t = DocTable::new("", &["scene", "builder", "N", "triangles (Table 3.1)", "internal", "leaves", "empty", "avg leaf depth", "with empty", "max depth", "Eq. 3.3 bytes", "with empty", "actual bytes", "build s"]);
+    let name = |b: &str| BUILDERS.iter().find(|x| x.0 == b).map_or("", |x| x.1);
+    for tr in trees {
+        let s = |k: &str| tr.stats.get(k).copied().unwrap_or(f64::NAN);
+        t.push(vec![
+            format!("{}{}", tr.scene, tr.sf),
+            name(tr.builder).into(),
+            tr.width.to_string(),
+            format!("{} ({})", tr.triangles, tr.triangles_published.map_or("-".into(), |p| p.to_string())),
+            s("internal_nodes").to_string(),
+            s("leaf_nodes").to_string(),
+            s("empty_nodes").to_string(),
+            format!("{:.3}", s("avg_leaf_depth")),
+            format!("{:.3}", s("avg_leaf_depth_with_empty")),
+            s("max_leaf_depth").to_string(),
+            s("model_bytes").to_string(),
+            s("model_bytes_with_empty").to_string(),
+            s("node_bytes").to_string(),
+            format!("{:.2}", tr.build_s),
+        ]);
+    }
+    doc.table(t);
+    doc.paragraph("001 §3.3's worked example (16 primitives): balanced depth 4 (N=2) vs 2 (N=4), 15 vs 5 internal nodes (a unit test builds it); Table 3.3's internal-node bytes 28 + 4N are what the Eq. 3.3 columns use.");
+    let mut c = DocTable::new("", &["scene", "claim", "published", "measured", "how it compares"]);
+    for r in rows.iter().filter(|r| r.claim != "cloister") {
+        c.push(vec![r.subject.clone(), r.note.clone(), r.published.clone(), r.measured.clone(), legacy_verdict(r)]);
+    }
+    doc.table(c);
+    doc
+}
