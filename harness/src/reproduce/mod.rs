@@ -101,7 +101,12 @@ macro_rules! registry {
     };
 }
 
-registry!(spd_stats, kimura_3_3, kimura_simd, nakamaru_3_1,);
+registry! {
+    spd_stats,
+    kimura_3_3,
+    kimura_simd,
+    nakamaru_3_1,
+}
 
 pub fn find(id: &str) -> Result<&'static Table> {
     TABLES.iter().find(|t| t.id == id).ok_or_else(|| {
