@@ -103,6 +103,7 @@ macro_rules! registry {
 
 registry! {
     spd_stats,
+    kimura_3_2,
     kimura_3_3,
     kimura_simd,
     nakamaru_3_1,
