@@ -134,27 +134,47 @@ fn run_suite(a: &CheckArgs, name: &str) -> Result<()> {
         "hard" => {
             let probe = suite::probe_input();
             let variants = suite::variants(&engines, &probe)?;
-            let h = pool.install(|| suite::hard::run(&variants, a.out.as_deref()))?;
-            if a.json {
-                print_json(&suite::report_json_hard(&h));
-            } else {
-                print!("{}", suite::report_markdown_hard(&h));
-            }
+            let h = pool.install(|| suite::hard::run(&variants))?;
+            let (doc, json) = (suite::hard_document(&h), suite::hard_json(&h));
+            suite_report(a, "hard", doc, &json, &suite::hard_charts(&h))?;
             suite::hard::verdict(&h)
         }
         "tessellation" => {
             let size = a.size.unwrap_or(128);
             workload::check_size(size)?;
-            let t = pool.install(|| suite::tessellation::run(&engines, size, a.out.as_deref()))?;
-            if a.json {
-                print_json(&suite::report_json_tess(&t));
-            } else {
-                print!("{}", suite::report_markdown_tess(&t));
-            }
-            Ok(())
+            let t = pool.install(|| suite::tessellation::run(&engines, size))?;
+            let (doc, json) = (suite::tess_document(&t), suite::tess_json(&t));
+            suite_report(a, "tessellation", doc, &json, &suite::tess_charts(&t))
         }
         other => Err(input(format!(
             "--suite {other}: unknown suite (known: hard, tessellation)"
         ))),
     }
+}
+
+/// A suite's report: with `--out DIR`, `DIR/<stem>.md`, `.json`, `.html` and `DIR/plots/` through the
+/// reproductions' writer; then the Markdown (or, with `--json`, the JSON) on stdout.
+fn suite_report(
+    a: &CheckArgs,
+    stem: &str,
+    mut doc: rtbench_reports::Document,
+    json: &serde_json::Value,
+    charts: &[rtbench_reports::plot::Chart],
+) -> Result<()> {
+    if let Some(dir) = &a.out {
+        let stems = crate::reproduce::write_charts(dir, charts)?;
+        if !stems.is_empty() {
+            doc.heading("Plots");
+            for s in stems {
+                doc.figure(format!("plots/{s}.png"), s);
+            }
+        }
+        crate::reproduce::write_document(dir, stem, &doc, json)?;
+    }
+    if a.json {
+        print_json(json);
+    } else {
+        print!("{}", doc.to_markdown());
+    }
+    Ok(())
 }

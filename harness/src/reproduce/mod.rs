@@ -19,6 +19,7 @@ mod engine_timing;
 
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
+pub use writer::{write_charts, write_document};
 
 use crate::error::{input, Result};
 use crate::output::print_json;

@@ -6,7 +6,7 @@ use super::cases::{self, CaseSet};
 use super::score::{self, Tally};
 use super::speed::{self, Speed};
 use super::truth::{self, Truth};
-use super::{report, Variant};
+use super::Variant;
 use crate::error::{Failure, Result};
 use crate::workload::camera::Camera;
 use crate::workload::trace;
@@ -14,7 +14,6 @@ use rtbench_engines::geometry::Geometry;
 use rtbench_engines::{build_engine, BuildInput, Counters, Hit, Ray};
 use rtbench_scenes::generate_scene;
 use rtbench_scenes::spd::{Options, Program};
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -140,7 +139,7 @@ fn run_variant(
 }
 
 /// Generates the cases and their answers, runs every variant, writes the report to `out`.
-pub fn run(variants: &[Variant], out: Option<&Path>) -> Result<HardResults> {
+pub fn run(variants: &[Variant]) -> Result<HardResults> {
     let t0 = Instant::now();
     let sets: Vec<(CaseSet, Vec<Truth>)> = cases::all()
         .into_iter()
@@ -214,9 +213,6 @@ pub fn run(variants: &[Variant], out: Option<&Path>) -> Result<HardResults> {
             .collect(),
         seconds: t0.elapsed().as_secs_f64(),
     };
-    if let Some(dir) = out {
-        report::write_hard(dir, &h)?;
-    }
     Ok(h)
 }
 

@@ -21,16 +21,13 @@ mod speed;
 pub mod tessellation;
 mod truth;
 
-use crate::error::{input, Result};
+use crate::error::Result;
 use rtbench_engines::geometry::Geometry;
 use rtbench_engines::{build_engine, registry, BuildInput, EngineError};
 use rtbench_scenes::{Material, Object, Scene, Shape};
 use std::sync::Arc;
 
-pub use report::{
-    hard_json as report_json_hard, hard_markdown as report_markdown_hard,
-    tess_json as report_json_tess, tess_markdown as report_markdown_tess,
-};
+pub use report::{hard_charts, hard_document, hard_json, tess_charts, tess_document, tess_json};
 
 /// A one-sphere scene to find out which settings an engine takes.
 pub fn probe_input() -> BuildInput {

@@ -1,16 +1,12 @@
-//! The suites' reports: Markdown tables, one JSON document, and plots (SVG and PNG, drawn by
-//! rtbench-reports), written atomically into the output folder.
+//! The suites' reports: a document (Markdown and HTML), one JSON document and plots, from the
+//! measured results alone; the reproductions' writer writes them (`check --suite … --out DIR`).
 
 use super::hard::HardResults;
 use super::tessellation::TessResults;
-use crate::error::{input, Result};
-use crate::output::write_atomic;
-use rtbench_reports::plot::{self, Bar, BarPanel, Chart, LegendAt, Panel, Point, Series, XyPanel};
+use rtbench_reports::plot::{Bar, BarPanel, Chart, LegendAt, Panel, Point, Series, XyPanel};
+use rtbench_reports::{Document, Table as DocTable};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
-use std::io::Write as _;
-use std::path::Path;
 
 fn e(x: f64) -> String {
     if x == 0.0 {
@@ -38,106 +34,129 @@ fn colors<'a>(engines: impl Iterator<Item = &'a str>) -> BTreeMap<String, usize>
     m
 }
 
-/// The hard suite as Markdown.
-pub fn hard_markdown(h: &HardResults) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Hard cases, acne and speed against error\n\n{} case rays in {} sets, answers in f64; {} engine variants; {:.0} s.\n",
+/// The hard suite as a document.
+pub fn hard_document(h: &HardResults) -> Document {
+    let mut doc = Document::new("Hard cases, acne and speed against error");
+    doc.paragraph(format!(
+        "{} case rays in {} sets, answers in f64; {} engine variants; {:.0} s.",
         h.case_rays.iter().map(|(_, n, _)| n).sum::<usize>(),
         h.case_rays.len(),
         h.results.len(),
         h.seconds
+    ));
+    let mut summary = DocTable::new(
+        "Summary (all cases)",
+        &[
+            "engine",
+            "leaks (of must-hit)",
+            "invalid",
+            "false hits",
+            "misses",
+            "wrong hits",
+            "coplanar: not lowest id",
+            "t err median",
+            "p99",
+            "max",
+            "acne, 7 standard scenes",
+            "Mrays/s",
+        ],
     );
-    s.push_str("## Summary (all cases)\n\n| engine | leaks (of must-hit) | invalid | false hits | misses | wrong hits | coplanar: not lowest id | t err median | p99 | max | acne, 7 standard scenes | Mrays/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in &h.results {
         let t = r.total("");
         let q = t.t_err();
         let a = r.acne_standard_total();
-        let _ = writeln!(
-            s,
-            "| {} | {} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} / {} ({}) | {} |",
+        summary.push(vec![
             r.variant.label(),
-            t.leaks,
-            t.must_hit,
-            t.invalid,
-            t.false_hits,
-            t.misses,
-            t.wrong_hits,
-            r.total("coplanar").ties_not_lowest,
+            format!("{} / {}", t.leaks, t.must_hit),
+            t.invalid.to_string(),
+            t.false_hits.to_string(),
+            t.misses.to_string(),
+            t.wrong_hits.to_string(),
+            r.total("coplanar").ties_not_lowest.to_string(),
             e(q.median),
             e(q.p99),
             e(q.max),
-            a.acne,
-            a.secondary,
-            e(a.rate()),
+            format!("{} / {} ({})", a.acne, a.secondary, e(a.rate())),
             r.speed
                 .map(|s| format!("{:.2}", s.mrays_per_s()))
-                .unwrap_or_else(|| "-".into())
-        );
+                .unwrap_or_else(|| "-".into()),
+        ]);
     }
-    s.push_str("\n## Leaks on the closed meshes (rays that must hit)\n\n| engine |");
+    doc.table(summary);
     let meshes: Vec<&str> = h
         .case_rays
         .iter()
         .map(|(c, _, _)| c.as_str())
         .filter(|c| c.starts_with("watertight"))
         .collect();
-    for m in &meshes {
-        let _ = write!(s, " {} |", m.trim_start_matches("watertight-"));
-    }
-    s.push_str("\n|---|");
-    s.push_str(&"---|".repeat(meshes.len()));
-    s.push('\n');
+    let mut header = vec!["engine"];
+    header.extend(meshes.iter().map(|m| m.trim_start_matches("watertight-")));
+    let mut leaks = DocTable::new("Leaks on the closed meshes (rays that must hit)", &header);
     for r in &h.results {
-        let _ = write!(s, "| {} |", r.variant.label());
-        for m in &meshes {
+        let mut row = vec![r.variant.label()];
+        row.extend(meshes.iter().map(|m| {
             let t = r.total(m);
-            let _ = write!(s, " {} / {} |", t.leaks, t.must_hit);
-        }
-        s.push('\n');
+            format!("{} / {}", t.leaks, t.must_hit)
+        }));
+        leaks.push(row);
     }
-    s.push_str("\n## By category: false hits / misses / wrong hits, t error p99 (ambiguous rays, whose answer hangs on rounding, are not scored)\n\n| category | rays (ambiguous) |");
-    for r in &h.results {
-        let _ = write!(s, " {} |", r.variant.label());
-    }
-    s.push_str("\n|---|---|");
-    s.push_str(&"---|".repeat(h.results.len()));
-    s.push('\n');
+    doc.table(leaks);
+    let labels: Vec<String> = h.results.iter().map(|r| r.variant.label()).collect();
+    let mut header = vec!["category", "rays (ambiguous)"];
+    header.extend(labels.iter().map(String::as_str));
+    let mut cats = DocTable::new(
+        "By category: false hits / misses / wrong hits, t error p99 (ambiguous rays, whose answer hangs on rounding, are not scored)",
+        &header,
+    );
     for (c, n, amb) in &h.case_rays {
-        let _ = write!(s, "| {c} | {n} ({amb}) |");
-        for r in &h.results {
+        let mut row = vec![c.clone(), format!("{n} ({amb})")];
+        row.extend(h.results.iter().map(|r| {
             let t = r.total(c);
-            let _ = write!(
-                s,
-                " {}/{}/{}, {} |",
+            format!(
+                "{}/{}/{}, {}",
                 t.false_hits,
                 t.misses,
                 t.wrong_hits,
                 e(t.t_err().p99)
-            );
-        }
-        s.push('\n');
+            )
+        }));
+        cats.push(row);
     }
-    s.push_str(
-        "\n## Acne: secondary rays that hit their own surface (acne / secondary rays)\n\n| scene |",
+    doc.table(cats);
+    doc.table(acne_table(h, &labels));
+    let errors: Vec<String> = h
+        .results
+        .iter()
+        .flat_map(|r| {
+            r.errors
+                .iter()
+                .map(move |e| format!("{}: {e}", r.variant.label()))
+        })
+        .collect();
+    if !errors.is_empty() {
+        doc.heading("Builds that failed");
+        doc.list(errors);
+    }
+    doc
+}
+
+/// Acne per scene and variant: secondary rays that hit their own surface.
+fn acne_table(h: &HardResults, labels: &[String]) -> DocTable {
+    let mut header = vec!["scene"];
+    header.extend(labels.iter().map(String::as_str));
+    let mut t = DocTable::new(
+        "Acne: secondary rays that hit their own surface (acne / secondary rays)",
+        &header,
     );
-    for r in &h.results {
-        let _ = write!(s, " {} |", r.variant.label());
-    }
-    s.push_str("\n|---|");
-    s.push_str(&"---|".repeat(h.results.len()));
-    s.push('\n');
     let mut rows: Vec<String> = Vec::new();
     if let Some(r0) = h.results.first() {
         rows.extend(r0.acne_standard.iter().map(|(n, _)| n.clone()));
         rows.extend(r0.acne_cases.iter().map(|(n, _)| n.clone()));
     }
     for row in &rows {
-        let _ = write!(s, "| {row} |");
-        for r in &h.results {
-            let a = r
-                .acne_standard
+        let mut cells = vec![row.clone()];
+        cells.extend(h.results.iter().map(|r| {
+            r.acne_standard
                 .iter()
                 .chain(&r.acne_cases)
                 .find(|(n, _)| n == row)
@@ -148,26 +167,11 @@ pub fn hard_markdown(h: &HardResults) -> String {
                         format!("{} / {}", a.acne, a.secondary)
                     }
                 })
-                .unwrap_or_else(|| "-".into());
-            let _ = write!(s, " {a} |");
-        }
-        s.push('\n');
+                .unwrap_or_else(|| "-".into())
+        }));
+        t.push(cells);
     }
-    let errors: Vec<String> = h
-        .results
-        .iter()
-        .flat_map(|r| {
-            r.errors
-                .iter()
-                .map(move |e| format!("- {}: {e}", r.variant.label()))
-        })
-        .collect();
-    if !errors.is_empty() {
-        s.push_str("\n## Builds that failed\n\n");
-        s.push_str(&errors.join("\n"));
-        s.push('\n');
-    }
-    s
+    t
 }
 
 pub fn hard_json(h: &HardResults) -> Value {
@@ -191,7 +195,7 @@ pub fn hard_json(h: &HardResults) -> Value {
     })
 }
 
-fn hard_charts(h: &HardResults) -> Vec<Chart> {
+pub fn hard_charts(h: &HardResults) -> Vec<Chart> {
     let engine_colors = colors(h.results.iter().map(|r| r.variant.engine.as_str()));
     let leaks = Chart {
         stem: "hard-leaks".into(),
@@ -295,64 +299,26 @@ fn hard_charts(h: &HardResults) -> Vec<Chart> {
     vec![leaks, speed]
 }
 
-fn write_charts(dir: &Path, charts: &[Chart]) -> Result<Vec<String>> {
-    let plots = dir.join("plots");
-    std::fs::create_dir_all(&plots)
-        .map_err(|e| input(format!("{}: cannot create: {e}", plots.display())))?;
-    let mut files = Vec::new();
-    for c in charts {
-        let svg = plot::svg(c).map_err(|e| input(format!("plot {}: {e}", c.stem)))?;
-        let png = plot::png(c).map_err(|e| input(format!("plot {}: {e}", c.stem)))?;
-        write_atomic(&plots.join(format!("{}.svg", c.stem)), |w| {
-            w.write_all(svg.as_bytes())
-        })?;
-        write_atomic(&plots.join(format!("{}.png", c.stem)), |w| {
-            w.write_all(&png)
-        })?;
-        files.push(format!("plots/{}.png", c.stem));
-    }
-    Ok(files)
-}
-
-fn write_doc(dir: &Path, stem: &str, md: &str, json: &Value, charts: &[Chart]) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| input(format!("{}: cannot create: {e}", dir.display())))?;
-    let files = write_charts(dir, charts)?;
-    let mut md = md.to_string();
-    md.push_str("\n## Plots\n\n");
-    for f in files {
-        let _ = writeln!(md, "![{f}]({f})");
-    }
-    write_atomic(&dir.join(format!("{stem}.md")), |w| {
-        w.write_all(md.as_bytes())
-    })?;
-    let text = serde_json::to_string_pretty(json).expect("JSON values serialise");
-    write_atomic(&dir.join(format!("{stem}.json")), |w| {
-        w.write_all(text.as_bytes())
-    })
-}
-
-/// DIR/hard.md, DIR/hard.json, DIR/plots/hard-*.svg and .png.
-pub fn write_hard(dir: &Path, h: &HardResults) -> Result<()> {
-    write_doc(
-        dir,
-        "hard",
-        &hard_markdown(h),
-        &hard_json(h),
-        &hard_charts(h),
-    )
-}
-
-/// The tessellation curves as Markdown.
-pub fn tess_markdown(t: &TessResults) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Tessellation: curved primitives against `--tessellate RES`\n\nImage RMSE (colour channels 0…1, all {}² pixel corners) of each tessellated render against the same engine's curved render, and trace time (queries) relative to the curved render's; {:.0} s.\n",
+/// The tessellation curves as a document.
+pub fn tess_document(t: &TessResults) -> Document {
+    let mut doc = Document::new("Tessellation: curved primitives against `--tessellate RES`");
+    doc.paragraph(format!(
+        "Image RMSE (colour channels 0…1, all {}² pixel corners) of each tessellated render against the same engine's curved render, and trace time (queries) relative to the curved render's; {:.0} s.",
         t.size + 1,
         t.seconds
+    ));
+    let mut table = DocTable::new(
+        "",
+        &[
+            "scene",
+            "engine",
+            "curved query s",
+            "RES: RMSE (query time ×)",
+            "first RES under 1e-3 RMSE",
+            "its time ×",
+            "RES for 1e-3 by a power-law fit",
+        ],
     );
-    s.push_str("| scene | engine | curved query s | RES: RMSE (query time ×) | first RES under 1e-3 RMSE | its time × | RES for 1e-3 by a power-law fit |\n|---|---|---|---|---|---|---|\n");
     for c in &t.curves {
         let pts: Vec<String> = c
             .points
@@ -367,17 +333,18 @@ pub fn tess_markdown(t: &TessResults) -> String {
             })
             .collect();
         let under = c.points.iter().find(|p| p.rmse < 1e-3);
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.3} | {}{} | {} | {} | {} |",
-            c.scene,
-            c.engine,
-            c.curved_s,
-            pts.join("; "),
-            c.stopped
-                .as_ref()
-                .map(|r| format!("; stopped: {r}"))
-                .unwrap_or_default(),
+        table.push(vec![
+            c.scene.clone(),
+            c.engine.clone(),
+            format!("{:.3}", c.curved_s),
+            format!(
+                "{}{}",
+                pts.join("; "),
+                c.stopped
+                    .as_ref()
+                    .map(|r| format!("; stopped: {r}"))
+                    .unwrap_or_default()
+            ),
             under
                 .map(|p| p.res.to_string())
                 .unwrap_or_else(|| "none ≤ 8".into()),
@@ -386,10 +353,11 @@ pub fn tess_markdown(t: &TessResults) -> String {
                 .unwrap_or_else(|| "-".into()),
             super::tessellation::extrapolate(&c.points, 1e-3)
                 .map(|r| format!("{r:.0}"))
-                .unwrap_or_else(|| "-".into())
-        );
+                .unwrap_or_else(|| "-".into()),
+        ]);
     }
-    s
+    doc.table(table);
+    doc
 }
 
 pub fn tess_json(t: &TessResults) -> Value {
@@ -406,7 +374,7 @@ pub fn tess_json(t: &TessResults) -> Value {
     })
 }
 
-fn tess_charts(t: &TessResults) -> Vec<Chart> {
+pub fn tess_charts(t: &TessResults) -> Vec<Chart> {
     let colors = colors(t.curves.iter().map(|c| c.engine.as_str()));
     let mut scenes: Vec<&str> = t.curves.iter().map(|c| c.scene.as_str()).collect();
     scenes.dedup();
@@ -459,15 +427,4 @@ fn tess_charts(t: &TessResults) -> Vec<Chart> {
                 .collect(),
         },
     ]
-}
-
-/// DIR/tessellation.md, .json and plots/tessellation-*.
-pub fn write_tessellation(dir: &Path, t: &TessResults) -> Result<()> {
-    write_doc(
-        dir,
-        "tessellation",
-        &tess_markdown(t),
-        &tess_json(t),
-        &tess_charts(t),
-    )
 }

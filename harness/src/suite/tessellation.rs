@@ -7,14 +7,12 @@
 //! An engine whose render takes longer than `BUDGET_S` stops its curve there (the brute-force
 //! reference would take minutes at RES 8); the report says where.
 
-use super::report;
 use crate::error::Result;
 use crate::workload::trace;
 use rtbench_engines::geometry::Geometry;
 use rtbench_engines::{build_engine, BuildInput};
 use rtbench_scenes::generate_scene;
 use rtbench_scenes::spd::{Options, Program};
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -107,7 +105,7 @@ fn rmse(a: &[glam::Vec3], b: &[glam::Vec3]) -> f64 {
     (sum / (3 * a.len().max(1)) as f64).sqrt()
 }
 
-pub fn run(engines: &[String], size: u32, out: Option<&Path>) -> Result<TessResults> {
+pub fn run(engines: &[String], size: u32) -> Result<TessResults> {
     let t0 = Instant::now();
     let mut curves = Vec::new();
     for (p, sf) in SCENES {
@@ -156,9 +154,6 @@ pub fn run(engines: &[String], size: u32, out: Option<&Path>) -> Result<TessResu
         curves,
         seconds: t0.elapsed().as_secs_f64(),
     };
-    if let Some(dir) = out {
-        report::write_tessellation(dir, &t)?;
-    }
     Ok(t)
 }
 
