@@ -13,84 +13,20 @@
 mod claims;
 mod params;
 mod published;
+mod table;
 mod writer;
 
 mod engine_timing;
 
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
+pub use table::{environment, Ctx, Image, Output, Runtime, Table};
 pub use writer::{write_charts, write_document};
 
 use crate::error::{input, Result};
 use crate::output::print_json;
-use rtbench_reports::plot::Chart;
-use rtbench_reports::Document;
 use serde_json::json;
 use std::path::Path;
-
-/// How long a table takes on this machine (2 cores): with `--quick`, and in full.
-#[derive(Clone, Copy, Debug)]
-pub struct Runtime {
-    pub quick: &'static str,
-    pub full: &'static str,
-}
-
-/// One reproducible table or claim set.
-pub struct Table {
-    pub id: &'static str,
-    /// "000" … "003", or "SPD".
-    pub seed: &'static str,
-    /// Where in the source: table, figure, section.
-    pub source: &'static str,
-    pub about: &'static str,
-    pub runtime: Runtime,
-    /// The options it takes (anything else is refused).
-    pub params: &'static [Param],
-    /// The claims its rows test, each with its fidelity label.
-    pub claims: &'static [Claim],
-    pub run: fn(&Ctx) -> Result<Output>,
-}
-
-/// What a table's run is given.
-pub struct Ctx<'a> {
-    pub id: &'static str,
-    pub quick: bool,
-    pub params: &'a Params,
-    /// The output folder (the writer fills it; a table only reads it, e.g. to resume).
-    pub out: &'a Path,
-}
-
-/// A PNG to write: path relative to the output folder, RGB8 pixels, square size.
-pub struct Image {
-    pub path: String,
-    pub pixels: Vec<u8>,
-    pub size: u32,
-}
-
-/// What a table's run returns: its typed result (serialised), its comparison rows, its document, and
-/// the plots and images the writer writes beside them.
-pub struct Output {
-    pub result: serde_json::Value,
-    pub rows: Vec<Row>,
-    pub doc: Document,
-    pub charts: Vec<Chart>,
-    /// Plots drawn by hand: (file stem, SVG text), written to `plots/<stem>.svg`.
-    pub svgs: Vec<(String, String)>,
-    pub images: Vec<Image>,
-}
-
-impl Output {
-    pub fn new(result: impl serde::Serialize, rows: Vec<Row>, doc: Document) -> Output {
-        Output {
-            result: serde_json::to_value(result).expect("results serialise"),
-            rows,
-            doc,
-            charts: Vec::new(),
-            svgs: Vec::new(),
-            images: Vec::new(),
-        }
-    }
-}
 
 /// Declares each table's module (named for its id) and lists its `TABLE`, in the order
 /// `reproduce list` shows them: adding a table is one line here.
@@ -185,11 +121,6 @@ pub fn run(
     };
     let output = (table.run)(&ctx)?;
     writer::write(table, out, output, as_json)
-}
-
-/// The environment line every reproduction records.
-pub fn environment(threads: usize) -> serde_json::Value {
-    json!({"os": std::env::consts::OS, "arch": std::env::consts::ARCH, "threads": threads})
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //! plots (SVG and PNG) and images, each written atomically into the output folder; then the Markdown
 //! (or, with `--json`, the JSON) on stdout. Also serves the `check --suite` reports.
 
-use super::{Fidelity, Output, Row, Table};
+use super::table::{Output, Table};
+use super::{Fidelity, Row};
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic, write_png};
 use rtbench_reports::plot::{self, Chart};
