@@ -27,8 +27,10 @@ fn reproduce_list_has_the_kimura_tables() {
     assert!(s.contains("kimura-simd"), "{s}");
     // Options of one table are refused by the others, with one line and exit 2.
     for (extra, needle) in [
-        (["--max-sf", "tree=3"], "for nakamaru-3.2 only"),
-        (["--size", "64"], "for the yamauchi-* tables only"),
+        (["--max-sf", "tree=3"], "option 'max-sf' does not apply"),
+        (["--size", "64"], "option 'size' does not apply"),
+        (["--set", "bogus=1"], "option 'bogus' does not apply"),
+        (["--set", "novalue"], "expected key=value"),
     ] {
         let out = rtbench(
             &[
@@ -82,4 +84,87 @@ fn kimura_trees_quick_four_ary_is_shallower() {
         );
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every table of the registry is listed with its seed, source, fidelity counts and runtime class; every
+/// declared claim carries a fidelity label.
+#[test]
+fn reproduce_list_json_labels_every_claim() {
+    let out = rtbench(&["reproduce", "list", "--json"]);
+    assert!(out.status.success());
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let tables = v.as_array().unwrap();
+    assert!(tables.len() >= 9, "{} tables", tables.len());
+    let labels = ["faithful", "substituted", "model", "not reproducible"];
+    for t in tables {
+        let id = t["id"].as_str().unwrap();
+        assert!(t["seed"].is_string() && t["table"].is_string(), "{id}");
+        assert!(t["runtime"]["quick"].is_string(), "{id}");
+        let claims = t["claims"].as_array().unwrap();
+        assert!(!claims.is_empty(), "{id} declares no claim");
+        let total: u64 = labels
+            .iter()
+            .map(|l| t["fidelity"][l].as_u64().unwrap())
+            .sum();
+        assert_eq!(total as usize, claims.len(), "{id}");
+        for c in claims {
+            assert!(
+                labels.contains(&c["fidelity"].as_str().unwrap()),
+                "{id}: {c}"
+            );
+        }
+    }
+}
+
+/// A table that has nothing to measure runs in well under a second: kimura-3.2's exact counts, with
+/// the printed 12^6 erratum caught, rows labelled, and the report in Markdown, JSON and HTML.
+#[test]
+fn kimura_3_2_counts_and_the_erratum() {
+    let dir = tmp("kimura-3.2");
+    let out = rtbench(&[
+        "reproduce",
+        "kimura-3.2",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    let failing: Vec<&str> = rows
+        .iter()
+        .filter(|r| r["verdict"] != "holds")
+        .map(|r| r["subject"].as_str().unwrap())
+        .collect();
+    assert_eq!(failing, ["B=12 D=6"]);
+    assert!(rows.iter().all(|r| r["fidelity"] == "faithful"));
+    for ext in ["md", "json", "html"] {
+        assert!(dir.join(format!("kimura-3.2.{ext}")).exists(), "{ext}");
+    }
+    let html = std::fs::read_to_string(dir.join("kimura-3.2.html")).unwrap();
+    assert!(html.contains("<td class=\"n\">2985984</td>"), "{html}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Engine names are checked against the registry before anything runs.
+#[test]
+fn unknown_engines_are_refused() {
+    let out = rtbench(&[
+        "reproduce",
+        "spd-stats",
+        "--engines",
+        "bogus",
+        "--out",
+        "/nonexistent/x",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown engine 'bogus'") && err.lines().count() == 1,
+        "{err}"
+    );
 }
