@@ -52,34 +52,23 @@ fn run(cli: Cli) -> Result<()> {
             if reproduce::find(&a.id).is_ok() {
                 return reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json);
             }
-            if a.id != "nakamaru-3.2" && (a.max_sf.is_some() || a.fault_ms.is_some()) {
+            if a.max_sf.is_some()
+                || a.fault_ms.is_some()
+                || a.size.is_some()
+                || a.max_pes.is_some()
+                || a.scenes.is_some()
+            {
                 return Err(error::input(format!(
-                    "{}: --max-sf and --fault-ms are for nakamaru-3.2 only",
+                    "{}: --max-sf, --fault-ms, --size, --max-pes and --scenes do not apply",
                     a.id
                 )));
             }
-            if a.id == "nakamaru-3.2" {
-                return commands::reproduce_thrashing::run(
-                    &a.id,
-                    a.quick,
-                    out,
-                    a.max_sf.as_deref(),
-                    a.fault_ms,
-                    a.json,
-                );
-            }
-            let limits = commands::yamauchi::Limits {
-                size: a.size,
-                max_pes: a.max_pes,
-                scenes: a.scenes.clone(),
-            };
             commands::reproduce::run(
                 &a.id,
                 a.quick,
                 out,
                 a.engines.as_deref(),
                 a.threads,
-                &limits,
                 a.json,
             )
         }

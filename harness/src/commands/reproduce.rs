@@ -4,7 +4,6 @@
 //! `spd-stats`: the SPD README's ray statistics of the seven standard scenes, against the ray
 //! counts of our workload with each engine.
 
-use super::yamauchi;
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic, write_png};
 use crate::source::Source;
@@ -93,23 +92,9 @@ pub fn run(
     out: &Path,
     asked: Option<&str>,
     threads: Option<usize>,
-    limits: &yamauchi::Limits,
     as_json: bool,
 ) -> Result<()> {
-    let limited = limits.size.is_some() || limits.max_pes.is_some() || limits.scenes.is_some();
-    if limited && !id.starts_with("yamauchi-") {
-        return Err(input(format!(
-            "{id}: --size, --max-pes and --scenes are for the yamauchi-* tables only"
-        )));
-    }
     match id {
-        "yamauchi-static-lb" => {
-            return yamauchi::static_lb(id, quick, limits, out, threads, as_json)
-        }
-        "yamauchi-dynamic-lb" => {
-            return yamauchi::dynamic_lb(id, quick, limits, out, threads, as_json)
-        }
-        "yamauchi-cfbs" => return yamauchi::cfbs(id, quick, limits, out, threads, as_json),
         "spd-stats" => {}
         "kimura-3.3" => return kimura_trees(id, quick, out, as_json),
         "kimura-simd" => return kimura_simd(id, quick, out, as_json),

@@ -15,7 +15,12 @@ mod params;
 mod published;
 mod writer;
 
+mod nakamaru_3_2;
+mod object_space_pass;
 mod spd_stats;
+mod yamauchi_cfbs;
+mod yamauchi_dynamic_lb;
+mod yamauchi_static_lb;
 
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
@@ -92,7 +97,13 @@ impl Output {
 }
 
 /// Every table, in the order `reproduce list` shows them.
-pub const TABLES: &[Table] = &[spd_stats::TABLE];
+pub const TABLES: &[Table] = &[
+    spd_stats::TABLE,
+    nakamaru_3_2::TABLE,
+    yamauchi_static_lb::TABLE,
+    yamauchi_dynamic_lb::TABLE,
+    yamauchi_cfbs::TABLE,
+];
 
 pub fn find(id: &str) -> Result<&'static Table> {
     TABLES.iter().find(|t| t.id == id).ok_or_else(|| {

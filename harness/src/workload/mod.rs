@@ -6,7 +6,7 @@ pub mod out_of_core;
 pub mod paging;
 pub mod surface;
 pub mod trace;
-pub mod yamauchi;
+pub mod pass_003;
 
 use crate::error::{input, Result};
 use crate::source::Source;
