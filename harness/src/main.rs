@@ -52,25 +52,20 @@ fn run(cli: Cli) -> Result<()> {
             if reproduce::find(&a.id).is_ok() {
                 return reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json);
             }
-            if a.max_sf.is_some()
-                || a.fault_ms.is_some()
-                || a.size.is_some()
-                || a.max_pes.is_some()
-                || a.scenes.is_some()
-            {
+            let given = [
+                ("max-sf", a.max_sf.is_some()),
+                ("fault-ms", a.fault_ms.is_some()),
+                ("size", a.size.is_some()),
+                ("max-pes", a.max_pes.is_some()),
+                ("scenes", a.scenes.is_some()),
+            ];
+            if let Some((key, _)) = given.iter().find(|g| g.1) {
                 return Err(error::input(format!(
-                    "{}: --max-sf, --fault-ms, --size, --max-pes and --scenes do not apply",
+                    "{}: option '{key}' does not apply",
                     a.id
                 )));
             }
-            commands::reproduce::run(
-                &a.id,
-                a.quick,
-                out,
-                a.engines.as_deref(),
-                a.threads,
-                a.json,
-            )
+            commands::reproduce::run(&a.id, a.quick, out, a.engines.as_deref(), a.threads, a.json)
         }
     }
 }

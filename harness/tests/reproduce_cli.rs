@@ -27,8 +27,8 @@ fn reproduce_list_has_the_kimura_tables() {
     assert!(s.contains("kimura-simd"), "{s}");
     // Options of one table are refused by the others, with one line and exit 2.
     for (extra, needle) in [
-        (["--max-sf", "tree=3"], "for nakamaru-3.2 only"),
-        (["--size", "64"], "for the yamauchi-* tables only"),
+        (["--max-sf", "tree=3"], "option 'max-sf' does not apply"),
+        (["--size", "64"], "option 'size' does not apply"),
     ] {
         let out = rtbench(
             &[

@@ -367,7 +367,14 @@ fn floor(scene: &str) -> &'static str {
 }
 
 /// The typed record of one scene: its rows, and onset and crossover per disk (pure).
-fn analyse(p: &Published, scene: &str, lo: u32, hi: u32, pts: &[Point], disks: &[Disk]) -> SceneResult {
+fn analyse(
+    p: &Published,
+    scene: &str,
+    lo: u32,
+    hi: u32,
+    pts: &[Point],
+    disks: &[Disk],
+) -> SceneResult {
     let rows = pts
         .iter()
         .map(|pt| SfRow {
@@ -498,7 +505,14 @@ fn rows(r: &Result_) -> Vec<Row> {
     rows
 }
 
-fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, svgs: &[(String, String)]) -> Document {
+fn document(
+    ctx: &Ctx,
+    p: &Published,
+    r: &Result_,
+    disks: &[Disk],
+    frames: u64,
+    svgs: &[(String, String)],
+) -> Document {
     let mut doc = Document::new("nakamaru-3.2: thrashing onset of the in-memory grid, 32 MiB");
     doc.paragraph(format!("Published: {}, {}. The figures' curves are lost; Table 3.2 (rayshade-ss memory per SF) survives and is shown beside ours.", p.source.document, p.source.sections.as_deref().unwrap_or("")));
     doc.paragraph(format!("Measured: `rtbench reproduce nakamaru-3.2{}{}{}`, one thread, 512×512. Grid: `grid` rss-r, its page stream (cell offsets, references, primitives, primitive→object, mailbox; 4 KiB pages) through Mattson's stack algorithm at {frames} pages; modelled = measured compute + pages touched × 4 KiB ÷ bandwidth (loading the data once) + faults beyond first touch × fault cost. Breadth-first: memory=32MiB, registration ⌈r/10+0.5⌉; modelled = measured + I/O bytes ÷ bandwidth + seeks × seek cost. Onset: smallest SF with modelled grid time per ray > 2 × its in-core time per ray. Crossover: smallest SF with modelled grid time > modelled breadth-first time.",
@@ -509,7 +523,14 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
         doc.list(
             s.result
                 .iter()
-                .map(|o| format!("{}: onset SF {}, crossover SF {}.", o.disk, show(o.onset_sf, s.sf[1]), show(o.crossover_sf, s.sf[1])))
+                .map(|o| {
+                    format!(
+                        "{}: onset SF {}, crossover SF {}.",
+                        o.disk,
+                        show(o.onset_sf, s.sf[1]),
+                        show(o.crossover_sf, s.sf[1])
+                    )
+                })
                 .collect(),
         );
         let stem = format!("{}-{}", ctx.id, s.scene);
@@ -521,7 +542,12 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
     let mut t = DocTable::new("", &["scene", "disk", "onset SF", "crossover SF"]);
     for s in &r.measured {
         for o in &s.result {
-            t.push(vec![s.scene.clone(), o.disk.clone(), show(o.onset_sf, s.sf[1]), show(o.crossover_sf, s.sf[1])]);
+            t.push(vec![
+                s.scene.clone(),
+                o.disk.clone(),
+                show(o.onset_sf, s.sf[1]),
+                show(o.crossover_sf, s.sf[1]),
+            ]);
         }
     }
     doc.table(t);
@@ -531,10 +557,23 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
 }
 
 fn scene_table(s: &SceneResult, disks: &[Disk]) -> DocTable {
-    let mut header: Vec<String> = ["SF", "objects", "Table 3.2 MB", "grid MB (model)", "page accesses", "pages touched", "faults @32 MiB beyond first touch", "grid compute s", "bf measured s", "bf I/O MB", "bf seeks", "bf passes"]
-        .iter()
-        .map(|h| h.to_string())
-        .collect();
+    let mut header: Vec<String> = [
+        "SF",
+        "objects",
+        "Table 3.2 MB",
+        "grid MB (model)",
+        "page accesses",
+        "pages touched",
+        "faults @32 MiB beyond first touch",
+        "grid compute s",
+        "bf measured s",
+        "bf I/O MB",
+        "bf seeks",
+        "bf passes",
+    ]
+    .iter()
+    .map(|h| h.to_string())
+    .collect();
     for d in disks {
         header.push(format!("grid model s ({})", d.name));
         header.push(format!("bf model s ({})", d.name));
@@ -640,4 +679,42 @@ fn plot(scene: &str, pts: &[Point], d: &Disk, onset: Option<u32>) -> String {
     let _ = writeln!(s, "<text x=\"{}\" y=\"40\" fill=\"#c0392b\">grid (rss-r)</text><text x=\"{}\" y=\"54\" fill=\"#2471a3\">breadth-first</text>", w - 150.0, w - 150.0);
     s.push_str("</svg>\n");
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn max_sf_caps_every_scene_or_named_ones() {
+        assert!(parse_caps("t", None).unwrap().is_empty());
+        let all = parse_caps("t", Some("6")).unwrap();
+        assert_eq!(sf_range("balls", [4, 7], &all, false), (4, 6));
+        let some = parse_caps("t", Some("tree=17..18,balls=5")).unwrap();
+        assert_eq!(sf_range("tree", [11, 18], &some, false), (17, 18));
+        assert_eq!(sf_range("balls", [4, 7], &some, false), (4, 5));
+        assert_eq!(sf_range("gears", [4, 12], &some, true), (4, 5));
+        for bad in ["x", "tree=", "tree=a..b", "tree=3..", "4,5"] {
+            let e = parse_caps("t", Some(bad)).err().map(|e| e.to_string());
+            assert!(e.is_some_and(|e| e.starts_with("t: max-sf")), "{bad}");
+        }
+    }
+
+    #[test]
+    fn fault_ms_must_be_a_positive_finite_number() {
+        assert_eq!(disks("t", None).unwrap().0.len(), 2);
+        let (d, ms) = disks("t", Some("2.5")).unwrap();
+        assert_eq!((d.len(), ms), (3, Some(2.5)));
+        for bad in ["0", "-1", "inf", "NaN", "x"] {
+            assert!(disks("t", Some(bad)).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_published_table_parses() {
+        let (p, _): (Published, _) = published::load("nakamaru-3.2", PUBLISHED);
+        assert_eq!(p.memory_mb, 32);
+        assert_eq!(p.sf_ranges.len(), 6);
+        assert!(p.table_3_2.iter().any(|r| r.scene == "tree" && r.sf == 15));
+    }
 }

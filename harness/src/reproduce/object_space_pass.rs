@@ -248,5 +248,64 @@ pub fn source_line(s: &super::published::Source) -> String {
 #[derive(serde::Deserialize)]
 pub struct Published {
     pub source: super::published::Source,
-    pub claims: Vec<super::published::PublishedClaim>,
+    pub claims: Vec<PublishedClaim>,
+}
+
+/// A claim of 003 as transcribed, with its figure where the prose gives one.
+#[derive(serde::Deserialize)]
+pub struct PublishedClaim {
+    pub id: String,
+    pub value: Option<f64>,
+}
+
+impl Published {
+    /// The figure of claim `id` (the files are compiled in: a missing one is a broken build,
+    /// caught by the tests).
+    pub fn value(&self, id: &str) -> f64 {
+        self.claims
+            .iter()
+            .find(|c| c.id == id)
+            .and_then(|c| c.value)
+            .unwrap_or_else(|| panic!("published claim '{id}' has no value"))
+    }
+}
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+
+    /// A pass record for tests of the pure analyses.
+    pub fn pass(scene: &str) -> PassRecord {
+        PassRecord {
+            scene: scene.into(),
+            size: 8,
+            primary: 64,
+            secondary: 0,
+            intensity_packets: 0,
+            subspace_visits: 0,
+            primitive_tests: 0,
+            trace_s: 0.0,
+            image: String::new(),
+        }
+    }
+
+    /// A simulated run of `clocks` against `t1` over `blocks` units.
+    pub fn sim(clocks: u64, t1: u64, blocks: u64) -> SimRecord {
+        let r = SimResult {
+            clocks,
+            ..SimResult::default()
+        };
+        SimRecord::new(&r, t1, blocks, 0.0)
+    }
+
+    #[test]
+    fn tori_are_as_even_as_possible_larger_axes_first() {
+        assert_eq!(shape(1, 1), [1, 1, 1]);
+        assert_eq!(shape(32, 1), [32, 1, 1]);
+        assert_eq!(shape(32, 2), [8, 4, 1]);
+        assert_eq!(shape(256, 2), [16, 16, 1]);
+        assert_eq!(shape(128, 3), [8, 4, 4]);
+        assert_eq!(powers(256), vec![1, 2, 4, 8, 16, 32, 64, 128, 256]);
+        assert_eq!(powers(100).last(), Some(&64));
+    }
 }

@@ -202,12 +202,20 @@ fn setup(ctx: &Ctx) -> Result<Setup> {
         size: osp::size(ctx)?,
         scenes: osp::scenes(ctx, if q { &["tetra"] } else { &["balls"] })?,
         packets: if q { 50_000 } else { 400_000 },
-        blocks: if q { vec![1, 4, 16] } else { vec![1, 2, 4, 8, 16, 32] },
+        blocks: if q {
+            vec![1, 4, 16]
+        } else {
+            vec![1, 2, 4, 8, 16, 32]
+        },
         configs: [(256u32, 16u32), (1024, 32)]
             .into_iter()
             .filter(|&(p, _)| p <= max_pes)
             .collect(),
-        pmcrs: if q { vec![1, 64] } else { vec![1, 4, 16, 64, 256] },
+        pmcrs: if q {
+            vec![1, 64]
+        } else {
+            vec![1, 4, 16, 64, 256]
+        },
         r_pmcr: if q { 4 } else { 16 },
     })
 }
@@ -392,7 +400,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
         published: raw,
         quick: ctx.quick,
         size: s.size,
-        load_ratio: Model::table3(2, 10, 0.5).saturation() / Model::table3(1024, 1, 0.5).saturation(),
+        load_ratio: Model::table3(2, 10, 0.5).saturation()
+            / Model::table3(1024, 1, 0.5).saturation(),
         model,
         packets_per_point: s.packets,
         model_vs_simulation: points,
@@ -420,7 +429,11 @@ fn span(v: impl Iterator<Item = f64>, show: impl Fn(f64) -> String) -> Option<St
 /// The comparison rows (pure).
 fn rows(p: &Published, r: &Result_) -> Vec<Row> {
     let mut rows = model_claim_rows(p, r);
-    let mut scenes: Vec<&str> = r.execution_driven.iter().map(|e| e.scene.as_str()).collect();
+    let mut scenes: Vec<&str> = r
+        .execution_driven
+        .iter()
+        .map(|e| e.scene.as_str())
+        .collect();
     scenes.dedup();
     for scene in scenes {
         rows.extend(exec_rows(p, scene, &r.execution_driven));
@@ -468,7 +481,8 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             format!(
                 "latency doubles at λ ≈ {} (model) and {} (simulation); model saturation {:.3e}",
                 k.model.map_or("-".into(), |v| format!("{v:.2e}")),
-                k.simulated.map_or("beyond the grid".into(), |v| format!("{v:.2e}")),
+                k.simulated
+                    .map_or("beyond the grid".into(), |v| format!("{v:.2e}")),
                 k.model_saturation
             ),
             Kind::Shape,
@@ -494,7 +508,10 @@ fn exec_rows(p: &Published, scene: &str, exec: &[ExecRun]) -> Vec<Row> {
         let best = runs().filter(|e| e.pes == pes).map(|e| e.rp_blocks).max()?;
         let at = |c: bool| runs().find(|e| e.pes == pes && e.rp_blocks == best && e.cfbs == c);
         let (d, c) = (at(false)?, at(true)?);
-        Some(format!("{pes} PEs × {best}: T direct / T cached = {:.3}", d.sim.clocks as f64 / c.sim.clocks as f64))
+        Some(format!(
+            "{pes} PEs × {best}: T direct / T cached = {:.3}",
+            d.sim.clocks as f64 / c.sim.clocks as f64
+        ))
     };
     let gains: Vec<String> = [256, 1024].into_iter().filter_map(gain).collect();
     vec![
@@ -522,8 +539,10 @@ fn exec_rows(p: &Published, scene: &str, exec: &[ExecRun]) -> Vec<Row> {
             "bursty",
             scene,
             format!("interval variance / mean from {} to {}", range[0], range[1]),
-            span(runs().map(|e| e.interval_var_over_mean), |v| format!("{v:.0}"))
-                .unwrap_or("not run".into()),
+            span(runs().map(|e| e.interval_var_over_mean), |v| {
+                format!("{v:.0}")
+            })
+            .unwrap_or("not run".into()),
             Kind::Range,
             if runs().next().is_some() {
                 Verdict::of(bursty)
@@ -535,7 +554,11 @@ fn exec_rows(p: &Published, scene: &str, exec: &[ExecRun]) -> Vec<Row> {
             "cfbs-at-1024",
             scene,
             "256 PEs: almost no effect; 1024 PEs: helps from about 16 RP blocks per PE",
-            if gains.is_empty() { "not run".into() } else { gains.join("; ") },
+            if gains.is_empty() {
+                "not run".into()
+            } else {
+                gains.join("; ")
+            },
             Kind::Shape,
             Verdict::Shown,
         ),
@@ -553,7 +576,9 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, s: &Setup) -> Document {
     model_section(&mut doc, r);
     exec_section(&mut doc, r, s);
     pmcr_section(&mut doc, r, s);
-    doc.paragraph("003 (4.3.2): FBC hit rate about 60%; λ about 5.9e-6 (1024 PEs × 1 RP block) and 8.3e-5 (× 32); interval variance 100-1000 times the mean; the caches help only at 1024 PEs with about 16 RP blocks or more. 'FB share' is how much of the image time the frame buffer adds after the last RP block finishes.");
+    let (hit, lam) = (p.claim("hit-rate-60"), p.claim("lambda-1024"));
+    let range = p.claim("bursty").range.unwrap_or([f64::NAN; 2]);
+    doc.paragraph(format!("003 (4.3.2): FBC hit rate about {:.0}%; λ about {:.1e} (1024 PEs × 1 RP block) and {:.1e} (× 32); interval variance {}-{} times the mean; the caches help only at 1024 PEs with about 16 RP blocks or more. 'FB share' is how much of the image time the frame buffer adds after the last RP block finishes.", hit.value.unwrap_or(f64::NAN) * 100.0, lam.value_1rpb.unwrap_or(f64::NAN), lam.value_32rpb.unwrap_or(f64::NAN), range[0], range[1]));
     doc
 }
 
@@ -561,7 +586,12 @@ fn model_section(doc: &mut Document, r: &Result_) {
     doc.heading("Queueing model (eqs. 11-21, Table 3)");
     let mut t = DocTable::new(
         "",
-        &["m-ary n-stage", "P_M", "saturation λ_PE (per PE per clock)", "digest's derived value"],
+        &[
+            "m-ary n-stage",
+            "P_M",
+            "saturation λ_PE (per PE per clock)",
+            "digest's derived value",
+        ],
     );
     for m in &r.model {
         t.push(vec![
@@ -582,7 +612,12 @@ fn model_section(doc: &mut Document, r: &Result_) {
     ));
     let mut t = DocTable::new(
         "",
-        &["λ_PE", "model L_mean as printed", "model L_mean normalised", "simulated L_mean"],
+        &[
+            "λ_PE",
+            "model L_mean as printed",
+            "model L_mean normalised",
+            "simulated L_mean",
+        ],
     );
     let show = |v: Option<f64>| v.map_or("saturated".into(), |v| format!("{v:.1}"));
     for c in &r.model_vs_simulation {
@@ -596,17 +631,38 @@ fn model_section(doc: &mut Document, r: &Result_) {
     doc.table(t);
     let k = &r.knees;
     doc.paragraph(format!("Latency doubles at λ ≈ {} (model, normalised) and {} (simulation), on this grid of λ; model saturation {:.3e}. 003: the simulation saturates about an order of magnitude later.", k.model.map_or("–".into(), |v| format!("{v:.2e}")), k.simulated.map_or("beyond the grid".into(), |v| format!("{v:.2e}")), k.model_saturation));
-    doc.figure("plots/yamauchi-cfbs-model-vs-simulation.svg", "model vs simulation");
+    doc.figure(
+        "plots/yamauchi-cfbs-model-vs-simulation.svg",
+        "model vs simulation",
+    );
 }
 
 fn exec_section(doc: &mut Document, r: &Result_, s: &Setup) {
-    let mut scenes: Vec<&str> = r.execution_driven.iter().map(|e| e.scene.as_str()).collect();
+    let mut scenes: Vec<&str> = r
+        .execution_driven
+        .iter()
+        .map(|e| e.scene.as_str())
+        .collect();
     scenes.dedup();
     for scene in scenes {
-        doc.heading(format!("{scene}: execution-driven, 2D skewed, {0}×{0}", s.size));
+        doc.heading(format!(
+            "{scene}: execution-driven, 2D skewed, {0}×{0}",
+            s.size
+        ));
         let mut t = DocTable::new(
             "",
-            &["PEs", "CFBS", "R", "speed-up vs R = 1", "FB share of image time", "hit rate", "λ_PE", "interval var/mean", "var/mean²", "mean latency"],
+            &[
+                "PEs",
+                "CFBS",
+                "R",
+                "speed-up vs R = 1",
+                "FB share of image time",
+                "hit rate",
+                "λ_PE",
+                "interval var/mean",
+                "var/mean²",
+                "mean latency",
+            ],
         );
         for e in r.execution_driven.iter().filter(|e| e.scene == scene) {
             t.push(vec![
@@ -615,7 +671,11 @@ fn exec_section(doc: &mut Document, r: &Result_, s: &Setup) {
                 e.rp_blocks.to_string(),
                 format!("{:.2}", e.sim.speedup),
                 format!("{:.3}", e.fb_share),
-                if e.cfbs { format!("{:.1}%", e.hit_rate * 100.0) } else { "–".into() },
+                if e.cfbs {
+                    format!("{:.1}%", e.hit_rate * 100.0)
+                } else {
+                    "–".into()
+                },
                 format!("{:.2e}", e.lambda_pe),
                 format!("{:.0}", e.interval_var_over_mean),
                 format!("{:.1}", e.interval_var_over_mean_squared),
@@ -628,12 +688,25 @@ fn exec_section(doc: &mut Document, r: &Result_, s: &Setup) {
 
 fn pmcr_section(doc: &mut Document, r: &Result_, s: &Setup) {
     let (pp, pm) = *s.configs.last().unwrap_or(&(256, 16));
-    doc.heading(format!("Processor-memory cycle ratio (003 Fig. 41): {pp} PEs × {} RP blocks, 2D skewed, {}", s.r_pmcr, s.scenes.first().map_or("", |s| s.as_str())));
+    doc.heading(format!(
+        "Processor-memory cycle ratio (003 Fig. 41): {pp} PEs × {} RP blocks, 2D skewed, {}",
+        s.r_pmcr,
+        s.scenes.first().map_or("", |s| s.as_str())
+    ));
     doc.paragraph("Every PE unit cost (Table 4 but the link's hop) divided by the PMCR; links and frame buffer unchanged.");
     let cfbs_col = format!("T direct / T with {pm}-ary CFBS");
     let mut t = DocTable::new(
         "",
-        &["PMCR", &cfbs_col, "FB share of image time (direct)", "FB share (CFBS)", "hit rate", "λ_PE", "mean latency direct", "mean latency CFBS"],
+        &[
+            "PMCR",
+            &cfbs_col,
+            "FB share of image time (direct)",
+            "FB share (CFBS)",
+            "hit rate",
+            "λ_PE",
+            "mean latency direct",
+            "mean latency CFBS",
+        ],
     );
     for x in &r.pmcr {
         t.push(vec![
@@ -673,5 +746,30 @@ fn chart(id: &str, curve: &[CurvePoint]) -> Chart {
                 osp::series("random simulation", 2, &spts),
             ],
         })],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_model_matches_the_digests_saturation_points() {
+        let (p, _): (Published, _) = published::load("yamauchi-cfbs", PUBLISHED);
+        let rows = model_rows(&p);
+        assert_eq!(rows.iter().filter(|r| r.derived.is_some()).count(), 4);
+        for r in rows.iter().filter(|r| r.derived.is_some()) {
+            let d = r.derived.unwrap();
+            assert!((r.saturation / d - 1.0).abs() < 1e-3, "{}-ary", r.m);
+        }
+        assert!(p.claim("lambda-1024").value_32rpb.is_some());
+        assert_eq!(p.claim("bursty").range, Some([100.0, 1000.0]));
+    }
+
+    #[test]
+    fn faster_units_keep_the_links_cost() {
+        let (c, f) = (Costs::default(), faster(64));
+        assert_eq!(f.triangle, (c.triangle / 64).max(1));
+        assert_eq!(f.hop, c.hop);
     }
 }
