@@ -135,14 +135,39 @@ fn yamauchi_static_lb_small_run_reports_every_machine() {
 #[test]
 fn yamauchi_options_are_checked() {
     for (id, flag, value, needle) in [
-        ("yamauchi-cfbs", "--max-sf", "3", "option 'max-sf' does not apply"),
+        (
+            "yamauchi-cfbs",
+            "--max-sf",
+            "3",
+            "option 'max-sf' does not apply",
+        ),
         ("yamauchi-static-lb", "--size", "0", "size '0'"),
         ("yamauchi-static-lb", "--max-pes", "0", "max-pes '0'"),
-        ("yamauchi-dynamic-lb", "--max-pes", "8", "max-pes must be at least 16"),
-        ("yamauchi-cfbs", "--scenes", "bogus", "unknown scene 'bogus'"),
-        ("yamauchi-cfbs", "--engines", "grid", "option 'engines' does not apply"),
+        (
+            "yamauchi-dynamic-lb",
+            "--max-pes",
+            "8",
+            "max-pes must be at least 16",
+        ),
+        (
+            "yamauchi-cfbs",
+            "--scenes",
+            "bogus",
+            "unknown scene 'bogus'",
+        ),
+        (
+            "yamauchi-cfbs",
+            "--engines",
+            "grid",
+            "option 'engines' does not apply",
+        ),
         ("nakamaru-3.2", "--fault-ms", "0", "fault-ms '0'"),
-        ("nakamaru-3.2", "--size", "64", "option 'size' does not apply"),
+        (
+            "nakamaru-3.2",
+            "--size",
+            "64",
+            "option 'size' does not apply",
+        ),
     ] {
         expect_input_error(
             &["reproduce", id, flag, value, "--out", "out/never-written"],

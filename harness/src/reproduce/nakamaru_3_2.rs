@@ -69,7 +69,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "table-3.2-memory",
             fidelity: Fidelity::Substituted,
-            why: "the memory of our grid (rss-r layout, counted from its arrays), not rayshade-ss's allocation",
+            why: "the memory of our grid's page layout (rss-r), not rayshade-ss's allocation",
         },
     ],
     run,
@@ -551,7 +551,7 @@ fn document(
         }
     }
     doc.table(t);
-    let pattern = p.claims.first().map_or("", |c| c.claim.as_str());
+    let pattern = &published::claim(&p.claims, "pattern").claim;
     doc.paragraph(format!("Published pattern (000 §3.4): {pattern}"));
     doc
 }

@@ -236,12 +236,7 @@ pub fn series(name: &str, color: usize, pts: &[(f64, f64)]) -> Series {
 
 /// "Source: document; sections. note" for a report's first paragraph.
 pub fn source_line(s: &super::published::Source) -> String {
-    format!(
-        "Source: {}; {}. {}",
-        s.document,
-        s.sections.as_deref().unwrap_or(""),
-        s.note.as_deref().unwrap_or("")
-    )
+    format!("Source: {}. {}", s.cite(), s.note.as_deref().unwrap_or(""))
 }
 
 /// The published file of a `yamauchi-*` table: its source and its claims.

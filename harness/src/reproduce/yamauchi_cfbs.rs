@@ -22,7 +22,7 @@ const EXEC: &str = "003's ray-tracing pass on SPD scenes (003's scene is not ava
 pub const TABLE: Table = Table {
     id: "yamauchi-cfbs",
     seed: "003",
-    source: "003 §3.4.3, §4.3, Figs. 22-24, 36-41",
+    source: "003 §3.4.3, §4.3",
     about: "003 (Yamauchi 1997) §3.4, §4.3: cached frame buffer, queueing model vs simulation",
     runtime: Runtime {
         quick: "seconds",

@@ -22,7 +22,7 @@ const RADIOSITY: &str = "a radiosity figure (Fig. 30-b): there is no radiosity p
 pub const TABLE: Table = Table {
     id: "yamauchi-dynamic-lb",
     seed: "003",
-    source: "003 §4.2.2, Figs. 30, 35; §4.4",
+    source: "003 §4.2.2, Figs. 30, 35",
     about: "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
     runtime: Runtime {
         quick: "seconds",
