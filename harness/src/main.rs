@@ -50,31 +50,7 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
-            if reproduce::find(&a.id).is_ok() {
-                return reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json);
-            }
-            if a.id != "nakamaru-3.2" && (a.max_sf.is_some() || a.fault_ms.is_some()) {
-                return Err(error::input(format!(
-                    "{}: --max-sf and --fault-ms are for nakamaru-3.2 only",
-                    a.id
-                )));
-            }
-            if a.id == "nakamaru-3.2" {
-                return commands::reproduce_thrashing::run(
-                    &a.id,
-                    a.quick,
-                    out,
-                    a.max_sf.as_deref(),
-                    a.fault_ms,
-                    a.json,
-                );
-            }
-            let limits = commands::yamauchi::Limits {
-                size: a.size,
-                max_pes: a.max_pes,
-                scenes: a.scenes.clone(),
-            };
-            commands::reproduce::run(&a.id, a.quick, out, a.threads, &limits, a.json)
+            reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json)
         }
     }
 }

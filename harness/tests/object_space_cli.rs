@@ -41,7 +41,7 @@ fn bad_machine_settings_exit_2() {
             "--out",
             "out/never-written",
         ],
-        "yamauchi-* tables only",
+        "option 'size' does not apply",
     );
 }
 
@@ -130,4 +130,48 @@ fn yamauchi_static_lb_small_run_reports_every_machine() {
         .join("plots/yamauchi-static-lb-tetra6-efficiency.svg")
         .exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn yamauchi_options_are_checked() {
+    for (id, flag, value, needle) in [
+        (
+            "yamauchi-cfbs",
+            "--max-sf",
+            "3",
+            "option 'max-sf' does not apply",
+        ),
+        ("yamauchi-static-lb", "--size", "0", "size '0'"),
+        ("yamauchi-static-lb", "--max-pes", "0", "max-pes '0'"),
+        (
+            "yamauchi-dynamic-lb",
+            "--max-pes",
+            "8",
+            "max-pes must be at least 16",
+        ),
+        (
+            "yamauchi-cfbs",
+            "--scenes",
+            "bogus",
+            "unknown scene 'bogus'",
+        ),
+        (
+            "yamauchi-cfbs",
+            "--engines",
+            "grid",
+            "option 'engines' does not apply",
+        ),
+        ("nakamaru-3.2", "--fault-ms", "0", "fault-ms '0'"),
+        (
+            "nakamaru-3.2",
+            "--size",
+            "64",
+            "option 'size' does not apply",
+        ),
+    ] {
+        expect_input_error(
+            &["reproduce", id, flag, value, "--out", "out/never-written"],
+            needle,
+        );
+    }
 }

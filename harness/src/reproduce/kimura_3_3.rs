@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 pub const TABLE: Table = Table {
     id: "kimura-3.3",
     seed: "001",
-    source: "§3.3–3.5, Table 3.1, 3.3, Figs. 3.12–3.19",
+    source: "§3.3–3.5, Tables 3.1, 3.3",
     about: "001 (Kimura 2007) §3.3-3.5: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
     runtime: Runtime {
         quick: "seconds",

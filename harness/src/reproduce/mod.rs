@@ -17,6 +17,7 @@ mod table;
 mod writer;
 
 mod engine_timing;
+mod object_space_pass;
 
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
@@ -44,6 +45,10 @@ registry! {
     kimura_3_3,
     kimura_simd,
     nakamaru_3_1,
+    nakamaru_3_2,
+    yamauchi_static_lb,
+    yamauchi_dynamic_lb,
+    yamauchi_cfbs,
 }
 
 pub fn find(id: &str) -> Result<&'static Table> {
@@ -80,13 +85,13 @@ pub fn list(as_json: bool) -> Result<()> {
         return Ok(());
     }
     println!(
-        "{:<20} {:<4} {:<28} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} about",
+        "{:<20} {:<4} {:<26} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} about",
         "id", "seed", "table", "F", "S", "M", "NR", "--quick", "full"
     );
     for t in TABLES {
         let n = |f: Fidelity| t.claims.iter().filter(|c| c.fidelity == f).count();
         println!(
-            "{:<20} {:<4} {:<28} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} {}",
+            "{:<20} {:<4} {:<26} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} {}",
             t.id,
             t.seed,
             t.source,
@@ -117,7 +122,6 @@ pub fn run(
         id: table.id,
         quick,
         params: &params,
-        out,
     };
     let output = (table.run)(&ctx)?;
     writer::write(table, out, output, as_json)

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 pub const TABLE: Table = Table {
     id: "spd-stats",
     seed: "SPD",
-    source: "SPD 3.14 README, ray statistics",
+    source: "README, ray statistics",
     about: "SPD 3.14 README: ray statistics of the seven standard scenes (counts within 10%)",
     runtime: Runtime {
         quick: "minutes",

@@ -6,7 +6,6 @@ use crate::error::Result;
 use rtbench_reports::plot::Chart;
 use rtbench_reports::Document;
 use serde_json::json;
-use std::path::Path;
 
 /// How long a table takes on this machine (2 cores): with `--quick`, and in full.
 #[derive(Clone, Copy, Debug)]
@@ -36,8 +35,6 @@ pub struct Ctx<'a> {
     pub id: &'static str,
     pub quick: bool,
     pub params: &'a Params,
-    /// The output folder (the writer fills it; a table only reads it, e.g. to resume).
-    pub out: &'a Path,
 }
 
 /// A PNG to write: path relative to the output folder, RGB8 pixels, square size.

@@ -4,9 +4,9 @@ pub mod camera;
 pub mod crosscheck;
 pub mod out_of_core;
 pub mod paging;
+pub mod pass_003;
 pub mod surface;
 pub mod trace;
-pub mod yamauchi;
 
 use crate::error::{input, Result};
 use crate::source::Source;

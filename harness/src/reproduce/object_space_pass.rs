@@ -1,0 +1,306 @@
+//! What the three `yamauchi-*` tables share: seed 003's own ray-tracing pass
+//! ([`crate::workload::pass_003`]: one primary ray per pixel centre, ≤ 3 reflections, no shadow rays)
+//! executed once per scene on the object-space engine, then timed on many (Mπ)² machine
+//! configurations by the engine's event simulation; the options they take, the records they keep
+//! of a pass and of a simulated run, and their plot helpers.
+
+use super::params::{Param, MAX_PES, SCENES, SIZE, THREADS};
+use super::{Ctx, Image};
+use crate::error::{input, Result};
+use crate::source::Source;
+use crate::workload::{self, pass_003};
+use rayon::prelude::*;
+use rtbench_engines::object_space::config::{Costs, FrameBuffer, ObjectSpaceConfig};
+use rtbench_engines::object_space::machine::{Allocation, Machine};
+use rtbench_engines::object_space::sim::{simulate, SimResult};
+use rtbench_engines::object_space::ObjectSpace;
+use rtbench_reports::plot::{LegendAt, Panel, Point, Series, XyPanel};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The options every `yamauchi-*` table takes.
+pub const PARAMS: &[Param] = &[THREADS, SIZE, MAX_PES, SCENES];
+
+/// One scene, executed once: the engine (its subspaces and primitives) and 003's pass on it.
+pub struct Traced {
+    pub label: String,
+    pub os: ObjectSpace,
+    pub pass: pass_003::Pass,
+    pub trace_s: f64,
+}
+
+impl Traced {
+    /// The pass's image, as `images/<scene>-yamauchi.png`.
+    pub fn image(&self) -> Image {
+        Image {
+            path: self.image_path(),
+            pixels: self.pass.pixels(),
+            size: self.pass.size,
+        }
+    }
+    fn image_path(&self) -> String {
+        format!("images/{}-yamauchi.png", self.label)
+    }
+    pub fn record(&self) -> PassRecord {
+        PassRecord {
+            scene: self.label.clone(),
+            size: self.pass.size,
+            primary: self.pass.primary,
+            secondary: self.pass.secondary,
+            intensity_packets: self.pass.intensity_packets,
+            subspace_visits: self.pass.trace.segs.len(),
+            primitive_tests: self.pass.counters.primitive_tests,
+            trace_s: self.trace_s,
+            image: self.image_path(),
+        }
+    }
+}
+
+/// What a pass did, as every `yamauchi-*` result records it.
+#[derive(Serialize)]
+pub struct PassRecord {
+    pub scene: String,
+    pub size: u32,
+    pub primary: u64,
+    pub secondary: u64,
+    pub intensity_packets: u64,
+    pub subspace_visits: usize,
+    pub primitive_tests: u64,
+    pub trace_s: f64,
+    pub image: String,
+}
+
+/// One simulated run: clocks against a reference time `t1`, over `blocks` processing units.
+#[derive(Serialize)]
+pub struct SimRecord {
+    pub clocks: u64,
+    pub speedup: f64,
+    pub efficiency: f64,
+    pub utilisation: f64,
+    pub imbalance: f64,
+    pub frgu_clocks: u64,
+    pub events: u64,
+    pub packets: u64,
+    pub hops: u64,
+    pub frame_buffer: rtbench_engines::object_space::framebuffer::FrameBufferStats,
+    pub wall_s: f64,
+    pub events_per_s: f64,
+}
+
+impl SimRecord {
+    pub fn new(r: &SimResult, t1: u64, blocks: u64, wall: f64) -> SimRecord {
+        let speedup = t1 as f64 / r.clocks as f64;
+        SimRecord {
+            clocks: r.clocks,
+            speedup,
+            efficiency: speedup / blocks as f64,
+            utilisation: r.utilisation(),
+            imbalance: r.imbalance(),
+            frgu_clocks: r.frgu_clocks,
+            events: r.events,
+            packets: r.packets,
+            hops: r.hops,
+            frame_buffer: r.frame_buffer.clone(),
+            wall_s: wall,
+            events_per_s: r.events as f64 / wall.max(1e-9),
+        }
+    }
+}
+
+/// `size` (default 512, 128 with `--quick`).
+pub fn size(ctx: &Ctx) -> Result<u32> {
+    let size = ctx
+        .params
+        .number::<u32>(SIZE.key, 1)?
+        .unwrap_or(if ctx.quick { 128 } else { 512 });
+    workload::check_size(size)?;
+    Ok(size)
+}
+
+/// `max-pes`, at least 1, or the default.
+pub fn max_pes(ctx: &Ctx, default: u32) -> Result<u32> {
+    Ok(ctx.params.number::<u32>(MAX_PES.key, 1)?.unwrap_or(default))
+}
+
+/// `scenes`, or the default list.
+pub fn scenes(ctx: &Ctx, default: &[&str]) -> Result<Vec<String>> {
+    Ok(ctx
+        .params
+        .scenes()?
+        .unwrap_or_else(|| default.iter().map(|s| s.to_string()).collect()))
+}
+
+/// Builds the engine on each scene (with the given unit costs: the per-test clocks enter the
+/// record) and traces 003's pass at `size`².
+pub fn trace_scenes(scenes: &[String], size: u32, costs: Costs) -> Result<Vec<Traced>> {
+    let mut v = Vec::new();
+    for s in scenes {
+        let src = Source::resolve(s, None, None, None)?;
+        let prepared = workload::prepare(&src)?;
+        let label = prepared.input.scene.name.clone();
+        let config = ObjectSpaceConfig {
+            costs,
+            ..ObjectSpaceConfig::default()
+        };
+        let os = ObjectSpace::build(&prepared.input, config).map_err(|e| input(e.to_string()))?;
+        eprintln!("{label}: tracing 003's pass at {size}x{size} …");
+        let t = Instant::now();
+        let pass = pass_003::trace_pass(&os, &prepared.input.scene, size);
+        let trace_s = t.elapsed().as_secs_f64();
+        v.push(Traced {
+            label,
+            os,
+            pass,
+            trace_s,
+        });
+    }
+    Ok(v)
+}
+
+/// PEs per axis for `pes` (a power of two) on a `dims`-dimensional torus, as even as possible,
+/// the larger counts first.
+fn shape(pes: u32, dims: u8) -> [u32; 3] {
+    let k = pes.trailing_zeros();
+    let mut s = [1u32; 3];
+    for i in 0..dims as u32 {
+        let bits = k / dims as u32 + u32::from(i < k % dims as u32);
+        s[i as usize] = 1 << bits;
+    }
+    s
+}
+
+pub fn machine(pes: u32, dims: u8, allocation: Allocation, rp_blocks: u32) -> Machine {
+    Machine {
+        pes: shape(pes, dims),
+        dims,
+        allocation,
+        rp_blocks,
+    }
+}
+
+/// Simulates each machine on `t` (in parallel over machines) with the given frame buffer:
+/// each run's result and its wall time.
+pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f64)> {
+    let s = t.os.config().subspaces;
+    machines
+        .par_iter()
+        .map(|(m, fb)| {
+            let start = Instant::now();
+            let r = simulate(
+                &t.pass.trace,
+                m,
+                &m.owner_map(s),
+                &t.os.config().costs,
+                *fb,
+                t.pass.size,
+            );
+            (r, start.elapsed().as_secs_f64())
+        })
+        .collect()
+}
+
+/// The powers of two up to `max` (at most 4096).
+pub fn powers(max: u32) -> Vec<u32> {
+    (0..=12).map(|k| 1u32 << k).filter(|&p| p <= max).collect()
+}
+
+/// A line panel with a logarithmic x axis.
+pub fn panel(title: &str, x: &str, y: &str, series: Vec<Series>, legend: LegendAt) -> Panel {
+    Panel::Xy(XyPanel {
+        title: title.into(),
+        x_label: x.into(),
+        y_label: y.into(),
+        x_log: true,
+        y_log: false,
+        x_ticks: Vec::new(),
+        lines: true,
+        legend,
+        series,
+    })
+}
+
+pub fn series(name: &str, color: usize, pts: &[(f64, f64)]) -> Series {
+    Series {
+        name: name.into(),
+        color,
+        points: pts
+            .iter()
+            .map(|&(x, y)| Point {
+                x,
+                y,
+                y_range: None,
+            })
+            .collect(),
+    }
+}
+
+/// "Source: document; sections. note" for a report's first paragraph.
+pub fn source_line(s: &super::published::Source) -> String {
+    format!("Source: {}. {}", s.cite(), s.note.as_deref().unwrap_or(""))
+}
+
+/// The published file of a `yamauchi-*` table: its source and its claims.
+#[derive(serde::Deserialize)]
+pub struct Published {
+    pub source: super::published::Source,
+    pub claims: Vec<PublishedClaim>,
+}
+
+/// A claim of 003 as transcribed, with its figure where the prose gives one.
+#[derive(serde::Deserialize)]
+pub struct PublishedClaim {
+    pub id: String,
+    pub value: Option<f64>,
+}
+
+impl Published {
+    /// The figure of claim `id` (the files are compiled in: a missing one is a broken build,
+    /// caught by the tests).
+    pub fn value(&self, id: &str) -> f64 {
+        self.claims
+            .iter()
+            .find(|c| c.id == id)
+            .and_then(|c| c.value)
+            .unwrap_or_else(|| panic!("published claim '{id}' has no value"))
+    }
+}
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+
+    /// A pass record for tests of the pure analyses.
+    pub fn pass(scene: &str) -> PassRecord {
+        PassRecord {
+            scene: scene.into(),
+            size: 8,
+            primary: 64,
+            secondary: 0,
+            intensity_packets: 0,
+            subspace_visits: 0,
+            primitive_tests: 0,
+            trace_s: 0.0,
+            image: String::new(),
+        }
+    }
+
+    /// A simulated run of `clocks` against `t1` over `blocks` units.
+    pub fn sim(clocks: u64, t1: u64, blocks: u64) -> SimRecord {
+        let r = SimResult {
+            clocks,
+            ..SimResult::default()
+        };
+        SimRecord::new(&r, t1, blocks, 0.0)
+    }
+
+    #[test]
+    fn tori_are_as_even_as_possible_larger_axes_first() {
+        assert_eq!(shape(1, 1), [1, 1, 1]);
+        assert_eq!(shape(32, 1), [32, 1, 1]);
+        assert_eq!(shape(32, 2), [8, 4, 1]);
+        assert_eq!(shape(256, 2), [16, 16, 1]);
+        assert_eq!(shape(128, 3), [8, 4, 4]);
+        assert_eq!(powers(256), vec![1, 2, 4, 8, 16, 32, 64, 128, 256]);
+        assert_eq!(powers(100).last(), Some(&64));
+    }
+}

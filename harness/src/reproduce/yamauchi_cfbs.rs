@@ -1,0 +1,775 @@
+//! `yamauchi-cfbs`: seed 003's cached frame buffer system (Yamauchi 1997, §3.4.3, §4.3): the
+//! analytic queueing model (eqs. 11-21, Table 3) beside the random-arrival simulation, the caches
+//! inside the execution-driven runs of 003's ray-tracing pass on SPD scenes, and faster processors
+//! (Fig. 41: the processor-memory cycle ratio).
+
+use super::object_space_pass::{self as osp, SimRecord, Traced};
+use super::published::{self, Source};
+use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use crate::error::Result;
+use crate::workload;
+use rayon::prelude::*;
+use rtbench_engines::object_space::config::{Costs, FrameBuffer};
+use rtbench_engines::object_space::machine::Allocation;
+use rtbench_engines::object_space::queueing::{self, Model};
+use rtbench_engines::object_space::sim::SimResult;
+use rtbench_reports::plot::{Chart, LegendAt, Panel, XyPanel};
+use rtbench_reports::{Document, Table as DocTable};
+use serde::{Deserialize, Serialize};
+
+const EXEC: &str = "003's ray-tracing pass on SPD scenes (003's scene is not available; its diffuse term came from a radiosity pass there is none of here)";
+
+pub const TABLE: Table = Table {
+    id: "yamauchi-cfbs",
+    seed: "003",
+    source: "§3.4.3, §4.3",
+    about: "003 (Yamauchi 1997) §3.4, §4.3: cached frame buffer, queueing model vs simulation",
+    runtime: Runtime {
+        quick: "seconds",
+        full: "minutes",
+    },
+    params: osp::PARAMS,
+    claims: &[
+        Claim {
+            key: "several-hundred-times",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+        Claim {
+            key: "derived-saturation",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+        Claim {
+            key: "sim-vs-theory",
+            fidelity: Fidelity::Substituted,
+            why: "our random-arrival simulation with fewer packets (50 000 with --quick, 400 000 in full) than 003's 1 000 000 rays",
+        },
+        Claim {
+            key: "hit-rate-60",
+            fidelity: Fidelity::Substituted,
+            why: EXEC,
+        },
+        Claim {
+            key: "lambda-1024",
+            fidelity: Fidelity::Substituted,
+            why: EXEC,
+        },
+        Claim {
+            key: "bursty",
+            fidelity: Fidelity::Substituted,
+            why: EXEC,
+        },
+        Claim {
+            key: "cfbs-at-1024",
+            fidelity: Fidelity::Substituted,
+            why: EXEC,
+        },
+    ],
+    run,
+};
+
+const PUBLISHED: &str = include_str!("../../../data/published/yamauchi-cfbs.json");
+
+#[derive(Deserialize)]
+struct Published {
+    source: Source,
+    claims: Vec<PublishedClaim>,
+}
+
+/// The fields of 003's CFBS claims this table reads.
+#[derive(Deserialize)]
+struct PublishedClaim {
+    id: String,
+    #[serde(default)]
+    claim: String,
+    value: Option<f64>,
+    value_1rpb: Option<f64>,
+    value_32rpb: Option<f64>,
+    range: Option<[f64; 2]>,
+    #[serde(default)]
+    rows: Vec<Derived>,
+}
+
+/// A saturation point the digest derived from eqs. 11-21.
+#[derive(Deserialize)]
+struct Derived {
+    m: u32,
+    saturation: f64,
+}
+
+impl Published {
+    fn claim(&self, id: &str) -> &PublishedClaim {
+        self.claims
+            .iter()
+            .find(|c| c.id == id)
+            .unwrap_or_else(|| panic!("yamauchi-cfbs.json: no claim '{id}'"))
+    }
+}
+
+#[derive(Serialize)]
+struct ModelRow {
+    m: u32,
+    stages: u32,
+    miss: f64,
+    saturation: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    derived: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct CurvePoint {
+    lambda: f64,
+    model_printed: Option<f64>,
+    model_normalised: Option<f64>,
+    simulated: f64,
+}
+
+#[derive(Serialize)]
+struct ExecRun {
+    scene: String,
+    #[serde(flatten)]
+    sim: SimRecord,
+    pes: u32,
+    rp_blocks: u32,
+    cfbs: bool,
+    /// The cache's arity (none without caches).
+    m: Option<u32>,
+    lambda_pe: f64,
+    interval_var_over_mean: f64,
+    interval_var_over_mean_squared: f64,
+    /// The frame buffer's share of the image time after the last RP block.
+    fb_share: f64,
+    hit_rate: f64,
+}
+
+#[derive(Serialize)]
+struct PmcrRow {
+    pmcr: u32,
+    pes: u32,
+    rp_blocks: u32,
+    m: u32,
+    direct: SimRecord,
+    cfbs: SimRecord,
+    lambda_pe: f64,
+    direct_fb_share: f64,
+    cfbs_fb_share: f64,
+    cfbs_hit_rate: f64,
+}
+
+/// Where the model's normalised latency and the simulation's first exceed twice their light-load
+/// value, on the grid of λ.
+#[derive(Serialize)]
+struct Knees {
+    model_saturation: f64,
+    model: Option<f64>,
+    simulated: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct Result_ {
+    id: &'static str,
+    published: serde_json::Value,
+    quick: bool,
+    size: u32,
+    model: Vec<ModelRow>,
+    /// saturation(2-ary 10-stage) / saturation(1024-ary 1-stage), P_M = 0.5.
+    load_ratio: f64,
+    packets_per_point: usize,
+    model_vs_simulation: Vec<CurvePoint>,
+    knees: Knees,
+    execution_driven: Vec<ExecRun>,
+    pmcr: Vec<PmcrRow>,
+    environment: serde_json::Value,
+}
+
+/// The experiment's settings: from the options and `--quick`.
+struct Setup {
+    size: u32,
+    scenes: Vec<String>,
+    packets: usize,
+    blocks: Vec<u32>,
+    /// (PEs, cache arity): 256 with 16-ary, 1024 with 32-ary 2-stage caches.
+    configs: Vec<(u32, u32)>,
+    pmcrs: Vec<u32>,
+    r_pmcr: u32,
+}
+
+fn setup(ctx: &Ctx) -> Result<Setup> {
+    let q = ctx.quick;
+    let max_pes = osp::max_pes(ctx, 1024)?;
+    Ok(Setup {
+        size: osp::size(ctx)?,
+        scenes: osp::scenes(ctx, if q { &["tetra"] } else { &["balls"] })?,
+        packets: if q { 50_000 } else { 400_000 },
+        blocks: if q {
+            vec![1, 4, 16]
+        } else {
+            vec![1, 2, 4, 8, 16, 32]
+        },
+        configs: [(256u32, 16u32), (1024, 32)]
+            .into_iter()
+            .filter(|&(p, _)| p <= max_pes)
+            .collect(),
+        pmcrs: if q {
+            vec![1, 64]
+        } else {
+            vec![1, 4, 16, 64, 256]
+        },
+        r_pmcr: if q { 4 } else { 16 },
+    })
+}
+
+/// Saturation by configuration (P_M = 0.5, beside the digest's values) and by miss rate.
+fn model_rows(p: &Published) -> Vec<ModelRow> {
+    let derived = &p.claim("derived-saturation").rows;
+    let mut rows: Vec<ModelRow> = [(2u32, 10u32), (4, 5), (32, 2), (1024, 1)]
+        .into_iter()
+        .map(|(m, n)| ModelRow {
+            m,
+            stages: n,
+            miss: 0.5,
+            saturation: Model::table3(m, n, 0.5).saturation(),
+            derived: derived.iter().find(|d| d.m == m).map(|d| d.saturation),
+        })
+        .collect();
+    rows.extend([0.1, 0.3, 0.7, 0.9, 1.0].into_iter().map(|pm| ModelRow {
+        m: 4,
+        stages: 5,
+        miss: pm,
+        saturation: Model::table3(4, 5, pm).saturation(),
+        derived: None,
+    }));
+    rows
+}
+
+/// 4-ary 5-stage, P_M = 0.5: the model's latency and the random-arrival simulation's, vs λ.
+fn curve(packets: usize) -> (Vec<CurvePoint>, Knees) {
+    let model = Model::table3(4, 5, 0.5);
+    let sat = model.saturation();
+    let lambdas: Vec<f64> = (0..=16)
+        .map(|k| 1e-7 * 10f64.powf(k as f64 * 0.25))
+        .filter(|&l| l < sat * 20.0)
+        .collect();
+    let sims: Vec<f64> = lambdas
+        .par_iter()
+        .map(|&l| queueing::simulate(&model, l, packets, 1997))
+        .collect();
+    let points: Vec<CurvePoint> = lambdas
+        .iter()
+        .zip(&sims)
+        .map(|(&l, &s)| {
+            let m = model.latency(l);
+            CurvePoint {
+                lambda: l,
+                model_printed: m.map(|v| v.0),
+                model_normalised: m.map(|v| v.1),
+                simulated: s,
+            }
+        })
+        .collect();
+    let light_model = points[0].model_normalised.unwrap_or(f64::INFINITY);
+    let knees = Knees {
+        model_saturation: sat,
+        model: points
+            .iter()
+            .find(|c| c.model_normalised.is_none_or(|v| v > 2.0 * light_model))
+            .map(|c| c.lambda),
+        simulated: points
+            .iter()
+            .find(|c| c.simulated > 2.0 * points[0].simulated)
+            .map(|c| c.lambda),
+    };
+    (points, knees)
+}
+
+fn fb_share(r: &SimResult) -> f64 {
+    r.clocks.saturating_sub(r.pe_clocks) as f64 / r.clocks as f64
+}
+
+/// Direct and cached frame buffers on the 2D skewed torus, each R, each (PEs, arity).
+fn execution_driven(t: &Traced, s: &Setup) -> Vec<ExecRun> {
+    let mut keys = Vec::new();
+    for &(p, m) in &s.configs {
+        for &r in &s.blocks {
+            for fb in [FrameBuffer::Direct, FrameBuffer::Cached { m }] {
+                keys.push((p, r, fb));
+            }
+        }
+    }
+    let machines: Vec<_> = keys
+        .iter()
+        .map(|&(p, r, fb)| (osp::machine(p, 2, Allocation::Skewed, r), fb))
+        .collect();
+    eprintln!("{}: simulating {} machines …", t.label, machines.len());
+    let results = osp::run_all(t, &machines);
+    keys.iter()
+        .zip(&results)
+        .map(|(k, (r, wall))| {
+            let base = keys
+                .iter()
+                .position(|b| *b == (k.0, 1, k.2))
+                .map(|i| results[i].0.clocks)
+                .unwrap_or(r.clocks);
+            let f = &r.frame_buffer;
+            let vm = f.interval_var / f.interval_mean.max(1e-9);
+            let m = match k.2 {
+                FrameBuffer::Cached { m } => Some(m),
+                FrameBuffer::Direct => None,
+            };
+            ExecRun {
+                scene: t.label.clone(),
+                sim: SimRecord::new(r, base, 1, *wall),
+                pes: k.0,
+                rp_blocks: k.1,
+                cfbs: m.is_some(),
+                m,
+                lambda_pe: f.packets as f64 / (k.0 as f64 * r.pe_clocks.max(1) as f64),
+                interval_var_over_mean: vm,
+                interval_var_over_mean_squared: vm / f.interval_mean.max(1e-9),
+                fb_share: f.finish.saturating_sub(r.pe_clocks) as f64 / r.clocks as f64,
+                hit_rate: f.hit_rate(),
+            }
+        })
+        .collect()
+}
+
+/// Table 4's costs with every PE unit `pmcr` times faster (at least 1 clock); the link's hop and
+/// the frame buffer's costs stay.
+fn faster(pmcr: u32) -> Costs {
+    let c = Costs::default();
+    let f = |v: u32| (v / pmcr).max(1);
+    Costs {
+        primary: f(c.primary),
+        triangle: f(c.triangle),
+        sphere: f(c.sphere),
+        cone: f(c.cone),
+        intensity: f(c.intensity),
+        dda_init: f(c.dda_init),
+        dda: f(c.dda),
+        secondary: f(c.secondary),
+        packet: f(c.packet),
+        ..c
+    }
+}
+
+/// 003 Fig. 41: the first scene traced with faster PE units, direct vs cached frame buffer on
+/// the largest configuration.
+fn pmcr_rows(s: &Setup) -> Result<Vec<PmcrRow>> {
+    let (pp, pm) = *s.configs.last().unwrap_or(&(256, 16));
+    let mut rows = Vec::new();
+    for &pmcr in &s.pmcrs {
+        let traced = osp::trace_scenes(&s.scenes[..1.min(s.scenes.len())], s.size, faster(pmcr))?;
+        let Some(t) = traced.first() else { break };
+        let m = osp::machine(pp, 2, Allocation::Skewed, s.r_pmcr);
+        let res = osp::run_all(
+            t,
+            &[(m, FrameBuffer::Direct), (m, FrameBuffer::Cached { m: pm })],
+        );
+        let (d, c) = (&res[0].0, &res[1].0);
+        rows.push(PmcrRow {
+            pmcr,
+            pes: pp,
+            rp_blocks: s.r_pmcr,
+            m: pm,
+            direct: SimRecord::new(d, d.clocks, 1, res[0].1),
+            cfbs: SimRecord::new(c, d.clocks, 1, res[1].1),
+            lambda_pe: d.frame_buffer.packets as f64 / (pp as f64 * d.pe_clocks.max(1) as f64),
+            direct_fb_share: fb_share(d),
+            cfbs_fb_share: fb_share(c),
+            cfbs_hit_rate: c.frame_buffer.hit_rate(),
+        });
+    }
+    Ok(rows)
+}
+
+fn run(ctx: &Ctx) -> Result<Output> {
+    let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
+    let s = setup(ctx)?;
+    let pool = workload::pool(ctx.params.threads()?)?;
+    let model = model_rows(&p);
+    let (points, knees) = pool.install(|| curve(s.packets));
+    let traced = osp::trace_scenes(&s.scenes, s.size, Costs::default())?;
+    let exec: Vec<ExecRun> = traced
+        .iter()
+        .flat_map(|t| pool.install(|| execution_driven(t, &s)))
+        .collect();
+    let pmcr = pool.install(|| pmcr_rows(&s))?;
+    let result = Result_ {
+        id: ctx.id,
+        published: raw,
+        quick: ctx.quick,
+        size: s.size,
+        load_ratio: Model::table3(2, 10, 0.5).saturation()
+            / Model::table3(1024, 1, 0.5).saturation(),
+        model,
+        packets_per_point: s.packets,
+        model_vs_simulation: points,
+        knees,
+        execution_driven: exec,
+        pmcr,
+        environment: environment(pool.current_num_threads()),
+    };
+    let rows = rows(&p, &result);
+    let doc = document(ctx, &p, &result, &s);
+    let mut out = Output::new(&result, rows, doc);
+    out.charts = vec![chart(ctx.id, &result.model_vs_simulation)];
+    out.images = traced.iter().map(Traced::image).collect();
+    Ok(out)
+}
+
+/// "lo–hi" of a measure over some runs.
+fn span(v: impl Iterator<Item = f64>, show: impl Fn(f64) -> String) -> Option<String> {
+    let v: Vec<f64> = v.collect();
+    let lo = v.iter().copied().reduce(f64::min)?;
+    let hi = v.iter().copied().reduce(f64::max)?;
+    Some(format!("{} to {}", show(lo), show(hi)))
+}
+
+/// The comparison rows (pure).
+fn rows(p: &Published, r: &Result_) -> Vec<Row> {
+    let mut rows = model_claim_rows(p, r);
+    let mut scenes: Vec<&str> = r
+        .execution_driven
+        .iter()
+        .map(|e| e.scene.as_str())
+        .collect();
+    scenes.dedup();
+    for scene in scenes {
+        rows.extend(exec_rows(p, scene, &r.execution_driven));
+    }
+    rows
+}
+
+fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
+    let digits = |v: f64| format!("{v:.3e}");
+    let derived: Vec<&ModelRow> = r.model.iter().filter(|m| m.derived.is_some()).collect();
+    let agree = derived
+        .iter()
+        .all(|m| m.derived.map(digits) == Some(digits(m.saturation)));
+    let k = &r.knees;
+    vec![
+        Row::new(
+            "several-hundred-times",
+            "2-ary 10-stage vs 1024-ary 1-stage, P_M = 0.5",
+            "several hundred times the load (judged: 100 to 1000)",
+            format!("{:.0}×", r.load_ratio),
+            Kind::Range,
+            Verdict::of((100.0..1000.0).contains(&r.load_ratio)),
+        ),
+        Row::new(
+            "derived-saturation",
+            "eqs. 11-21, Table 3, P_M = 0.5",
+            derived
+                .iter()
+                .map(|m| format!("{}-ary: {}", m.m, m.derived.map_or("-".into(), digits)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            derived
+                .iter()
+                .map(|m| format!("{}-ary: {}", m.m, digits(m.saturation)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            Kind::Count,
+            Verdict::of(agree),
+        )
+        .with_note("the digest's arithmetic, not 003's: equal to 4 significant digits"),
+        Row::new(
+            "sim-vs-theory",
+            "4-ary 5-stage, P_M = 0.5",
+            p.claim("sim-vs-theory").claim.clone(),
+            format!(
+                "latency doubles at λ ≈ {} (model) and {} (simulation); model saturation {:.3e}",
+                k.model.map_or("-".into(), |v| format!("{v:.2e}")),
+                k.simulated
+                    .map_or("beyond the grid".into(), |v| format!("{v:.2e}")),
+                k.model_saturation
+            ),
+            Kind::Shape,
+            Verdict::Shown,
+        ),
+    ]
+}
+
+/// The execution-driven claims on one scene: shown, and the burstiness judged on its range.
+fn exec_rows(p: &Published, scene: &str, exec: &[ExecRun]) -> Vec<Row> {
+    let runs = || exec.iter().filter(move |e| e.scene == scene);
+    let cached = || runs().filter(|e| e.cfbs);
+    let pct = |v: f64| format!("{:.1}%", v * 100.0);
+    let lam = p.claim("lambda-1024");
+    let lambda_at = |r: u32| {
+        runs()
+            .find(|e| e.pes == 1024 && e.rp_blocks == r && !e.cfbs)
+            .map_or("not run".into(), |e| format!("{:.2e}", e.lambda_pe))
+    };
+    let range = p.claim("bursty").range.unwrap_or([100.0, 1000.0]);
+    let bursty = runs().all(|e| (range[0]..=range[1]).contains(&e.interval_var_over_mean));
+    let gain = |pes: u32| {
+        let best = runs().filter(|e| e.pes == pes).map(|e| e.rp_blocks).max()?;
+        let at = |c: bool| runs().find(|e| e.pes == pes && e.rp_blocks == best && e.cfbs == c);
+        let (d, c) = (at(false)?, at(true)?);
+        Some(format!(
+            "{pes} PEs × {best}: T direct / T cached = {:.3}",
+            d.sim.clocks as f64 / c.sim.clocks as f64
+        ))
+    };
+    let gains: Vec<String> = [256, 1024].into_iter().filter_map(gain).collect();
+    vec![
+        Row::new(
+            "hit-rate-60",
+            scene,
+            format!("about {}", pct(p.claim("hit-rate-60").value.unwrap_or(0.6))),
+            span(cached().map(|e| e.hit_rate), pct).unwrap_or("not run".into()),
+            Kind::Ratio,
+            Verdict::Shown,
+        ),
+        Row::new(
+            "lambda-1024",
+            scene,
+            format!(
+                "1024 PEs: about {:.1e} (R = 1), {:.1e} (R = 32)",
+                lam.value_1rpb.unwrap_or(f64::NAN),
+                lam.value_32rpb.unwrap_or(f64::NAN)
+            ),
+            format!("{} (R = 1), {} (R = 32)", lambda_at(1), lambda_at(32)),
+            Kind::Ratio,
+            Verdict::Shown,
+        ),
+        Row::new(
+            "bursty",
+            scene,
+            format!("interval variance / mean from {} to {}", range[0], range[1]),
+            span(runs().map(|e| e.interval_var_over_mean), |v| {
+                format!("{v:.0}")
+            })
+            .unwrap_or("not run".into()),
+            Kind::Range,
+            if runs().next().is_some() {
+                Verdict::of(bursty)
+            } else {
+                Verdict::NotMeasured
+            },
+        ),
+        Row::new(
+            "cfbs-at-1024",
+            scene,
+            "256 PEs: almost no effect; 1024 PEs: helps from about 16 RP blocks per PE",
+            if gains.is_empty() {
+                "not run".into()
+            } else {
+                gains.join("; ")
+            },
+            Kind::Shape,
+            Verdict::Shown,
+        ),
+    ]
+}
+
+fn document(ctx: &Ctx, p: &Published, r: &Result_, s: &Setup) -> Document {
+    let mut doc = Document::new("yamauchi-cfbs: the cached frame buffer system");
+    doc.paragraph(osp::source_line(&p.source));
+    doc.paragraph(format!(
+        "Measured: `rtbench reproduce {}{}`.",
+        ctx.id,
+        if ctx.quick { " --quick" } else { "" }
+    ));
+    model_section(&mut doc, r);
+    exec_section(&mut doc, r, s);
+    pmcr_section(&mut doc, r, s);
+    let (hit, lam) = (p.claim("hit-rate-60"), p.claim("lambda-1024"));
+    let range = p.claim("bursty").range.unwrap_or([f64::NAN; 2]);
+    doc.paragraph(format!("003 (4.3.2): FBC hit rate about {:.0}%; λ about {:.1e} (1024 PEs × 1 RP block) and {:.1e} (× 32); interval variance {}-{} times the mean; the caches help only at 1024 PEs with about 16 RP blocks or more. 'FB share' is how much of the image time the frame buffer adds after the last RP block finishes.", hit.value.unwrap_or(f64::NAN) * 100.0, lam.value_1rpb.unwrap_or(f64::NAN), lam.value_32rpb.unwrap_or(f64::NAN), range[0], range[1]));
+    doc
+}
+
+fn model_section(doc: &mut Document, r: &Result_) {
+    doc.heading("Queueing model (eqs. 11-21, Table 3)");
+    let mut t = DocTable::new(
+        "",
+        &[
+            "m-ary n-stage",
+            "P_M",
+            "saturation λ_PE (per PE per clock)",
+            "digest's derived value",
+        ],
+    );
+    for m in &r.model {
+        t.push(vec![
+            format!("{}-ary {}-stage", m.m, m.stages),
+            m.miss.to_string(),
+            format!("{:.4e}", m.saturation),
+            m.derived.map_or(String::new(), |d| format!("{d:.4e}")),
+        ]);
+    }
+    doc.table(t);
+    doc.paragraph(format!(
+        "2-ary 10-stage tolerates {:.0}× the load of no CFBS (003: several hundred times).",
+        r.load_ratio
+    ));
+    doc.heading(format!(
+        "4-ary 5-stage, P_M = 0.5: model vs random-arrival simulation ({} packets per point)",
+        r.packets_per_point
+    ));
+    let mut t = DocTable::new(
+        "",
+        &[
+            "λ_PE",
+            "model L_mean as printed",
+            "model L_mean normalised",
+            "simulated L_mean",
+        ],
+    );
+    let show = |v: Option<f64>| v.map_or("saturated".into(), |v| format!("{v:.1}"));
+    for c in &r.model_vs_simulation {
+        t.push(vec![
+            format!("{:.3e}", c.lambda),
+            show(c.model_printed),
+            show(c.model_normalised),
+            format!("{:.1}", c.simulated),
+        ]);
+    }
+    doc.table(t);
+    let k = &r.knees;
+    doc.paragraph(format!("Latency doubles at λ ≈ {} (model, normalised) and {} (simulation), on this grid of λ; model saturation {:.3e}. 003: the simulation saturates about an order of magnitude later.", k.model.map_or("–".into(), |v| format!("{v:.2e}")), k.simulated.map_or("beyond the grid".into(), |v| format!("{v:.2e}")), k.model_saturation));
+    doc.figure(
+        "plots/yamauchi-cfbs-model-vs-simulation.svg",
+        "model vs simulation",
+    );
+}
+
+fn exec_section(doc: &mut Document, r: &Result_, s: &Setup) {
+    let mut scenes: Vec<&str> = r
+        .execution_driven
+        .iter()
+        .map(|e| e.scene.as_str())
+        .collect();
+    scenes.dedup();
+    for scene in scenes {
+        doc.heading(format!(
+            "{scene}: execution-driven, 2D skewed, {0}×{0}",
+            s.size
+        ));
+        let mut t = DocTable::new(
+            "",
+            &[
+                "PEs",
+                "CFBS",
+                "R",
+                "speed-up vs R = 1",
+                "FB share of image time",
+                "hit rate",
+                "λ_PE",
+                "interval var/mean",
+                "var/mean²",
+                "mean latency",
+            ],
+        );
+        for e in r.execution_driven.iter().filter(|e| e.scene == scene) {
+            t.push(vec![
+                e.pes.to_string(),
+                e.m.map_or("none (direct GFB)".into(), |m| format!("{m}-ary 2-stage")),
+                e.rp_blocks.to_string(),
+                format!("{:.2}", e.sim.speedup),
+                format!("{:.3}", e.fb_share),
+                if e.cfbs {
+                    format!("{:.1}%", e.hit_rate * 100.0)
+                } else {
+                    "–".into()
+                },
+                format!("{:.2e}", e.lambda_pe),
+                format!("{:.0}", e.interval_var_over_mean),
+                format!("{:.1}", e.interval_var_over_mean_squared),
+                format!("{:.1}", e.sim.frame_buffer.latency_mean),
+            ]);
+        }
+        doc.table(t);
+    }
+}
+
+fn pmcr_section(doc: &mut Document, r: &Result_, s: &Setup) {
+    let (pp, pm) = *s.configs.last().unwrap_or(&(256, 16));
+    doc.heading(format!(
+        "Processor-memory cycle ratio (003 Fig. 41): {pp} PEs × {} RP blocks, 2D skewed, {}",
+        s.r_pmcr,
+        s.scenes.first().map_or("", |s| s.as_str())
+    ));
+    doc.paragraph("Every PE unit cost (Table 4 but the link's hop) divided by the PMCR; links and frame buffer unchanged.");
+    let cfbs_col = format!("T direct / T with {pm}-ary CFBS");
+    let mut t = DocTable::new(
+        "",
+        &[
+            "PMCR",
+            &cfbs_col,
+            "FB share of image time (direct)",
+            "FB share (CFBS)",
+            "hit rate",
+            "λ_PE",
+            "mean latency direct",
+            "mean latency CFBS",
+        ],
+    );
+    for x in &r.pmcr {
+        t.push(vec![
+            x.pmcr.to_string(),
+            format!("{:.3}", x.direct.clocks as f64 / x.cfbs.clocks as f64),
+            format!("{:.3}", x.direct_fb_share),
+            format!("{:.3}", x.cfbs_fb_share),
+            format!("{:.1}%", x.cfbs_hit_rate * 100.0),
+            format!("{:.2e}", x.lambda_pe),
+            format!("{:.1}", x.direct.frame_buffer.latency_mean),
+            format!("{:.1}", x.cfbs.frame_buffer.latency_mean),
+        ]);
+    }
+    doc.table(t);
+}
+
+fn chart(id: &str, curve: &[CurvePoint]) -> Chart {
+    let mpts: Vec<(f64, f64)> = curve
+        .iter()
+        .filter_map(|c| c.model_normalised.map(|v| (c.lambda, v)))
+        .collect();
+    let spts: Vec<(f64, f64)> = curve.iter().map(|c| (c.lambda, c.simulated)).collect();
+    Chart {
+        stem: format!("{id}-model-vs-simulation"),
+        title: "4-ary 5-stage CFBS, P_M = 0.5: mean latency vs λ_PE".into(),
+        panels: vec![Panel::Xy(XyPanel {
+            title: "mean latency".into(),
+            x_label: "λ_PE (packets per PE per clock)".into(),
+            y_label: "clocks".into(),
+            x_log: true,
+            y_log: true,
+            x_ticks: Vec::new(),
+            lines: true,
+            legend: LegendAt::UpperLeft,
+            series: vec![
+                osp::series("model (normalised)", 1, &mpts),
+                osp::series("random simulation", 2, &spts),
+            ],
+        })],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_model_matches_the_digests_saturation_points() {
+        let (p, _): (Published, _) = published::load("yamauchi-cfbs", PUBLISHED);
+        let rows = model_rows(&p);
+        assert_eq!(rows.iter().filter(|r| r.derived.is_some()).count(), 4);
+        for r in rows.iter().filter(|r| r.derived.is_some()) {
+            let d = r.derived.unwrap();
+            assert!((r.saturation / d - 1.0).abs() < 1e-3, "{}-ary", r.m);
+        }
+        assert!(p.claim("lambda-1024").value_32rpb.is_some());
+        assert_eq!(p.claim("bursty").range, Some([100.0, 1000.0]));
+    }
+
+    #[test]
+    fn faster_units_keep_the_links_cost() {
+        let (c, f) = (Costs::default(), faster(64));
+        assert_eq!(f.triangle, (c.triangle / 64).max(1));
+        assert_eq!(f.hop, c.hop);
+    }
+}
