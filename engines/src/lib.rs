@@ -27,7 +27,8 @@ pub mod reference;
 pub mod store;
 pub mod testing;
 
-pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest};
+pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+pub use geometry::TriangleTest;
 pub use ray::{Hit, Ray};
 
 /// Every engine rtbench knows, available here or not.

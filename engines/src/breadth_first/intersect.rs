@@ -29,9 +29,10 @@ fn face_bit_of(entered: u8) -> u8 {
     face_bit((entered / 2) as usize, entered % 2 == 1)
 }
 use super::Work;
-use crate::engine::{Counters, TriangleTest};
+use crate::engine::Counters;
 use crate::geometry::aabb::{Aabb, SlabRay};
 use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 use std::io;
 

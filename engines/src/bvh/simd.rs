@@ -13,11 +13,12 @@
 
 use super::node::WideNode;
 use super::traverse::{self, Bvh};
-use crate::engine::{Counters, TriangleTest};
+use crate::engine::Counters;
 use crate::geometry::aabb::SlabRay;
 use crate::geometry::triangle_simd::ScalarPackets;
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::triangle_simd::Sse4 as SsePackets;
+use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 
 /// One slab test of a ray against the N children of a node.
@@ -157,9 +158,10 @@ mod x86 {
     use super::super::node::{WideNode, PLANES};
     use super::super::traverse::{self, Bvh};
     use super::ChildTest;
-    use crate::engine::{Counters, TriangleTest};
+    use crate::engine::Counters;
     use crate::geometry::aabb::SlabRay;
     use crate::geometry::triangle_simd::Sse4 as SsePackets;
+    use crate::geometry::TriangleTest;
     use crate::ray::{Hit, Ray};
     use std::arch::x86_64::*;
 

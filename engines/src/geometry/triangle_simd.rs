@@ -18,7 +18,7 @@
 //! and [`closest8`] choose at run time with `is_x86_feature_detected!`.
 
 use super::kernels::f32::{self as k, WatertightRay};
-use crate::engine::TriangleTest;
+use crate::geometry::TriangleTest;
 use glam::Vec3;
 
 /// K triangles, structure-of-arrays: `v[i][a][lane]` is coordinate `a` (x, y, z) of vertex `i`
@@ -225,8 +225,8 @@ pub use x86::{Avx8, Sse4};
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{LaneHits, PacketKernel, TrianglePacket};
-    use crate::engine::TriangleTest;
     use crate::geometry::kernels::f32::WatertightRay;
+    use crate::geometry::TriangleTest;
     use glam::Vec3;
     use std::arch::x86_64::*;
 
@@ -686,7 +686,7 @@ mod x86 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::TriangleTest;
+    use crate::geometry::TriangleTest;
 
     /// A small deterministic generator (64-bit LCG, top bits), in [-1, 1).
     struct Lcg(u64);
