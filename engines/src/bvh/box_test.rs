@@ -1,5 +1,6 @@
-//! The ray–N-box slab test of a wide node, in three forms: scalar (any N, the `simd=off`
-//! fallback), SSE (N = 4) and AVX2 + FMA (N = 8), with `std::arch` intrinsics.
+//! The ray–N-box slab test of a wide node ([`super::node::WideNode`]), beside the node layout
+//! as madmann91/bvh keeps its ray–node test in `node.h`, in three forms: scalar (any N, the
+//! `simd=off` fallback), SSE (N = 4) and AVX2 + FMA (N = 8), with `std::arch` intrinsics.
 //!
 //! All three compute, for each child box, `t_near = max(tmin, near planes · rdir − org·rdir)`
 //! and `t_far = min(tmax, far planes · rdir − org·rdir)` (`org·rdir` widened by a rounding
@@ -8,18 +9,10 @@
 //! and far planes picked once per ray by the direction's signs, as Embree's `TravRay` does, so
 //! no per-box min/max swap). Empty slots hold the empty box, which every form misses.
 //!
-//! The SIMD forms are chosen at run time with `is_x86_feature_detected!`; the whole traversal
-//! loop is compiled inside a `#[target_feature]` function for AVX2 so the intrinsics inline.
+//! Which form a tree is traversed with is chosen at run time in [`super::dispatch`].
 
 use super::node::WideNode;
-use super::traverse::{self, Bvh};
-use crate::engine::Counters;
 use crate::geometry::aabb::SlabRay;
-use crate::geometry::triangle_simd::ScalarPackets;
-#[cfg(target_arch = "x86_64")]
-use crate::geometry::triangle_simd::Sse4 as SsePackets;
-use crate::geometry::TriangleTest;
-use crate::ray::{Hit, Ray};
 
 /// One slab test of a ray against the N children of a node.
 pub trait ChildTest<const N: usize> {
@@ -33,74 +26,6 @@ pub trait ChildTest<const N: usize> {
     /// nothing for the scalar form).
     #[inline(always)]
     fn prefetch(_p: *const u8) {}
-}
-
-/// The batch entry points of one traversal kernel.
-pub type ClosestFn<const N: usize> = fn(&Bvh<N>, &[Ray], &mut [Hit], TriangleTest, &mut Counters);
-pub type AnyFn<const N: usize> = fn(&Bvh<N>, &[Ray], &mut [bool], TriangleTest, &mut Counters);
-
-#[derive(Clone, Copy)]
-pub struct Kernels<const N: usize> {
-    pub closest: ClosestFn<N>,
-    pub any: AnyFn<N>,
-    /// SIMD lanes of the box test (0: scalar).
-    pub lanes: usize,
-    pub name: &'static str,
-}
-
-/// The scalar kernels (any width).
-pub fn scalar<const N: usize>() -> Kernels<N> {
-    Kernels {
-        closest: traverse::closest_batch::<N, Scalar, ScalarPackets>,
-        any: traverse::any_batch::<N, Scalar, ScalarPackets>,
-        lanes: 0,
-        name: "scalar",
-    }
-}
-
-/// SSE kernels for bvh4 (SSE2 is part of x86-64, so always there on that target). On CPUs
-/// with AVX2 and FMA the same 4-wide test is compiled with those (fused multiply-subtract, and
-/// the whole loop, leaf kernels included, in VEX encoding).
-pub fn sse4() -> Option<Kernels<4>> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        Some(if x86::has_avx2_fma() {
-            Kernels {
-                closest: x86::fma4_closest,
-                any: x86::fma4_any,
-                lanes: 4,
-                name: "sse+fma",
-            }
-        } else {
-            Kernels {
-                closest: traverse::closest_batch::<4, x86::Sse4<false>, SsePackets>,
-                any: traverse::any_batch::<4, x86::Sse4<false>, SsePackets>,
-                lanes: 4,
-                name: "sse",
-            }
-        })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        None
-    }
-}
-
-/// AVX2 + FMA kernels for bvh8, when the CPU has both.
-pub fn avx8() -> Option<Kernels<8>> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        x86::has_avx2_fma().then_some(Kernels {
-            closest: x86::avx8_closest,
-            any: x86::avx8_any,
-            lanes: 8,
-            name: "avx2",
-        })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        None
-    }
 }
 
 /// Scalar slab test of each used slot (`0..len`).
@@ -154,15 +79,13 @@ impl<const N: usize> ChildTest<N> for Scalar {
 }
 
 #[cfg(target_arch = "x86_64")]
+pub use x86::{Avx8, Sse4};
+
+#[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::node::{WideNode, PLANES};
-    use super::super::traverse::{self, Bvh};
     use super::ChildTest;
-    use crate::engine::Counters;
     use crate::geometry::aabb::SlabRay;
-    use crate::geometry::triangle_simd::Sse4 as SsePackets;
-    use crate::geometry::TriangleTest;
-    use crate::ray::{Hit, Ray};
     use std::arch::x86_64::*;
 
     /// Offsets (in floats) of the near and far plane rows of a node of width `n`; each is
@@ -176,10 +99,6 @@ mod x86 {
         let far = [r.far_plane(0) * n, r.far_plane(1) * n, r.far_plane(2) * n];
         debug_assert!(near.iter().chain(&far).all(|&o| o + n <= PLANES * n));
         (near, far)
-    }
-
-    pub fn has_avx2_fma() -> bool {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
     }
 
     // ------------------------------------------------------------------ SSE, 4 boxes at once
@@ -239,7 +158,7 @@ mod x86 {
         fn test(node: &WideNode<4>, r: &Sse4Ray, tmin: f32, tmax: f32, dist: &mut [f32; 4]) -> u32 {
             let base = node.planes.as_ptr() as *const f32;
             // SAFETY: SSE is part of the x86-64 baseline, and `FMA` is only set in the kernels
-            // reached through the feature-checked AVX2 + FMA entry points below. `planes` is 6
+            // reached through the feature-checked AVX2 + FMA entry points (`super::dispatch`). `planes` is 6
             // rows of 4 contiguous floats (repr(C) arrays) and every offset is `row · 4` with
             // `row < 6` (`plane_offsets`), so each unaligned load reads 4 floats inside the
             // node; the store writes exactly the 4 floats of `dist`.
@@ -341,159 +260,6 @@ mod x86 {
                 _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
                 _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32
             }
-        }
-    }
-
-    /// Feature-checked entry points whose batch loop is compiled with AVX2 and FMA, so the
-    /// box test's intrinsics (and the leaf kernels) inline into it.
-    macro_rules! avx2_entry {
-        ($closest:ident, $closest_impl:ident, $any:ident, $any_impl:ident, $n:literal, $test:ty) => {
-            pub fn $closest(
-                bvh: &Bvh<$n>,
-                rays: &[Ray],
-                hits: &mut [Hit],
-                t: TriangleTest,
-                c: &mut Counters,
-            ) {
-                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
-                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
-                unsafe { $closest_impl(bvh, rays, hits, t, c) }
-            }
-
-            pub fn $any(
-                bvh: &Bvh<$n>,
-                rays: &[Ray],
-                out: &mut [bool],
-                t: TriangleTest,
-                c: &mut Counters,
-            ) {
-                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
-                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
-                unsafe { $any_impl(bvh, rays, out, t, c) }
-            }
-
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn $closest_impl(
-                bvh: &Bvh<$n>,
-                rays: &[Ray],
-                hits: &mut [Hit],
-                t: TriangleTest,
-                c: &mut Counters,
-            ) {
-                traverse::closest_batch::<$n, $test, SsePackets>(bvh, rays, hits, t, c)
-            }
-
-            #[target_feature(enable = "avx2,fma")]
-            unsafe fn $any_impl(
-                bvh: &Bvh<$n>,
-                rays: &[Ray],
-                out: &mut [bool],
-                t: TriangleTest,
-                c: &mut Counters,
-            ) {
-                traverse::any_batch::<$n, $test, SsePackets>(bvh, rays, out, t, c)
-            }
-        };
-    }
-
-    avx2_entry!(
-        avx8_closest,
-        avx8_closest_impl,
-        avx8_any,
-        avx8_any_impl,
-        8,
-        Avx8
-    );
-    avx2_entry!(
-        fma4_closest,
-        fma4_closest_impl,
-        fma4_any,
-        fma4_any_impl,
-        4,
-        Sse4<true>
-    );
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::bvh::build_bvh;
-    use crate::bvh::config::Config;
-    use crate::engine::Settings;
-    use crate::geometry::Geometry;
-    use glam::Vec3;
-    use rtbench_scenes::generate_scene;
-    use rtbench_scenes::spd::{Options, Program};
-
-    /// Every kernel this CPU can run gives exactly the scalar kernel's hits and node counts on
-    /// the same tree (the SIMD forms only round the entry distances differently, which can
-    /// only matter for rays grazing a box; none of these do), on the tree as spheres and cones
-    /// and tessellated (triangle packets: SIMD against lane by lane).
-    #[test]
-    fn every_kernel_matches_scalar() {
-        for tessellate in [None, Some(2)] {
-            kernels_match_scalar(tessellate);
-        }
-    }
-
-    fn kernels_match_scalar(tessellate: Option<u32>) {
-        let scene = generate_scene(
-            Program::Tree,
-            &Options {
-                size_factor: 4,
-                tessellate,
-                ..Options::standard(Program::Tree)
-            },
-        )
-        .unwrap();
-        let g = Geometry::from_scene(&scene);
-        let c = (g.bounds_min + g.bounds_max) * 0.5;
-        let r = (g.bounds_max - g.bounds_min).length();
-        let rays: Vec<Ray> = (0..400)
-            .map(|i| {
-                let a = i as f32 * 0.0713;
-                let o = c + Vec3::new(a.cos(), 0.4 * (a * 1.7).sin(), a.sin()) * r;
-                let t = c + Vec3::new((a * 5.0).sin(), (a * 3.0).cos(), (a * 2.0).sin()) * 0.25 * r;
-                Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY)
-            })
-            .collect();
-        fn run<const N: usize>(
-            bvh: &Bvh<N>,
-            k: &Kernels<N>,
-            rays: &[Ray],
-        ) -> (Vec<Hit>, Vec<bool>, Counters) {
-            let mut hits = vec![Hit::MISS; rays.len()];
-            let mut any = vec![false; rays.len()];
-            let mut c = Counters::default();
-            (k.closest)(bvh, rays, &mut hits, TriangleTest::Watertight, &mut c);
-            (k.any)(
-                bvh,
-                rays,
-                &mut any,
-                TriangleTest::Watertight,
-                &mut Counters::default(),
-            );
-            (hits, any, c)
-        }
-        let config = |w: usize| Config::parse(w, Settings::new("bvh", vec![])).unwrap();
-        let (bvh4, _) = build_bvh::<4>(&g, &config(4)).unwrap();
-        let want4 = run(&bvh4, &scalar::<4>(), &rays);
-        assert!(want4.0.iter().filter(|h| h.is_hit()).count() > 100);
-        let mut fours: Vec<Kernels<4>> = sse4().into_iter().collect();
-        #[cfg(target_arch = "x86_64")]
-        fours.push(Kernels {
-            closest: traverse::closest_batch::<4, x86::Sse4<false>, SsePackets>,
-            any: traverse::any_batch::<4, x86::Sse4<false>, SsePackets>,
-            lanes: 4,
-            name: "sse",
-        });
-        for k in &fours {
-            assert_eq!(run(&bvh4, k, &rays), want4, "{}", k.name);
-        }
-        let (bvh8, _) = build_bvh::<8>(&g, &config(8)).unwrap();
-        let want8 = run(&bvh8, &scalar::<8>(), &rays);
-        if let Some(k) = avx8() {
-            assert_eq!(run(&bvh8, &k, &rays), want8, "{}", k.name);
         }
     }
 }
