@@ -21,7 +21,6 @@
 //! - Hit records leave in completion order through `out(ray id, hit)`; the caller files them by
 //!   ray id (the thesis's sort by ray id).
 
-use super::dda::{Dda, START};
 use super::voxels::{face_bit, Voxels, MARKED};
 
 #[inline]
@@ -31,6 +30,7 @@ fn face_bit_of(entered: u8) -> u8 {
 use super::Work;
 use crate::engine::Counters;
 use crate::geometry::aabb::{Aabb, SlabRay};
+use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
@@ -92,7 +92,7 @@ fn first_candidate(g: &Voxels, d: &mut Dda, c: &mut Counters) -> bool {
         if is_candidate(g, d) {
             return true;
         }
-        if !d.advance(g) {
+        if !d.advance(g.res) {
             return false;
         }
     }
@@ -212,7 +212,7 @@ impl Work {
                 }
                 // On to the next candidate.
                 loop {
-                    if !s.dda.advance(g) {
+                    if !s.dda.advance(g.res) {
                         s.exhausted = true;
                         break 'walk;
                     }
@@ -318,7 +318,7 @@ impl Work {
             let mut done = (any && s.best.is_hit()) || s.exhausted || s.best_t <= s.covered;
             if !done {
                 loop {
-                    if !s.dda.advance(g) {
+                    if !s.dda.advance(g.res) {
                         done = true;
                         break;
                     }

@@ -4,9 +4,10 @@
 //!
 //! Rays, not objects, are registered in a uniform grid; the scene is streamed from disk once per
 //! pass, sequentially, so its size never makes the engine thrash. Files, one concept each:
-//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4), [`dda`]
-//! (the resumable walk), [`intersect`] (passes, registration, the sweep: Algorithm 3.5),
-//! [`spill`] (the temporary store of an in-memory scene).
+//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4),
+//! [`intersect`] (passes, registration, the sweep: Algorithm 3.5), [`spill`] (the temporary
+//! store of an in-memory scene). The resumable walk each ray keeps between passes is the shared
+//! 3D-DDA ([`crate::geometry::dda`]), the `grid` engine's, so both engines visit the same cells.
 //!
 //! Built from a `BuildInput` (an in-memory scene) it first writes the scene as a store
 //! ([`crate::store`]) in its spill directory; [`BreadthFirst::open`] builds it from a store on
@@ -30,7 +31,6 @@
 //! and the exact I/O of the calls: `io_bytes_read`, `io_read_calls`, `io_seeks`.
 
 pub mod config;
-pub mod dda;
 pub mod intersect;
 pub mod spill;
 pub mod voxels;

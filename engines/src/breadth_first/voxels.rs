@@ -8,6 +8,7 @@
 //! except where that grid would take more than half the memory budget: then n is lowered until
 //! it fits (`BreadthFirst::open`), so a budget-bound run keeps room for rays.
 
+use crate::geometry::dda::Lattice;
 use crate::grid::build::{PAD_CELL, PAD_COORD};
 use crate::grid::config::Resolution;
 use crate::grid::resolution::cells_per_axis;
@@ -30,6 +31,25 @@ pub struct Voxels {
     /// How far boxes are grown against rounding (as the grid engine's).
     pub pad: Vec3,
     pub flags: Vec<u8>,
+}
+
+impl Lattice for Voxels {
+    fn lo(&self) -> Vec3 {
+        self.lo
+    }
+    fn hi(&self) -> Vec3 {
+        self.hi
+    }
+    fn res(&self) -> [u32; 3] {
+        self.res
+    }
+    fn cell(&self) -> Vec3 {
+        self.cell
+    }
+    #[inline(always)]
+    fn cell_of(&self, p: Vec3) -> [u32; 3] {
+        Voxels::cell_of(self, p)
+    }
 }
 
 impl Voxels {

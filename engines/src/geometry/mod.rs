@@ -7,6 +7,7 @@
 //! index of its scene object, so hits name the NFF record.
 
 pub mod aabb;
+pub mod dda;
 pub mod kernels;
 pub mod triangle_simd;
 

@@ -18,6 +18,7 @@ use super::config::{Count, Floor, GridConfig, Insertion, Resolution};
 use super::overlap;
 use super::resolution::{self, MAX_CELLS};
 use crate::engine::EngineError;
+use crate::geometry::dda::Lattice;
 use crate::geometry::Geometry;
 use glam::{DVec3, Vec3};
 use rtbench_scenes::{Scene, Shape};
@@ -47,6 +48,25 @@ pub struct Cells {
     pub refs: Vec<u32>,
     /// How far primitive boxes (and the grid's box) are grown against rounding, per axis.
     pub pad: Vec3,
+}
+
+impl Lattice for Cells {
+    fn lo(&self) -> Vec3 {
+        self.lo
+    }
+    fn hi(&self) -> Vec3 {
+        self.hi
+    }
+    fn res(&self) -> [u32; 3] {
+        self.res
+    }
+    fn cell(&self) -> Vec3 {
+        self.cell
+    }
+    #[inline(always)]
+    fn cell_of(&self, p: Vec3) -> [u32; 3] {
+        Cells::cell_of(self, p)
+    }
 }
 
 impl Cells {
