@@ -9,10 +9,13 @@
 //! and far planes picked once per ray by the direction's signs, as Embree's `TravRay` does, so
 //! no per-box min/max swap). Empty slots hold the empty box, which every form misses.
 //!
-//! Which form a tree is traversed with is chosen at run time in [`super::dispatch`].
+//! The forms are implemented for the lane types of [`crate::geometry::lanes`] (`Scalar`,
+//! `Sse4`, `Avx8`), the vocabulary of the triangle packet test too. Which form a tree is
+//! traversed with is chosen at run time in [`super::dispatch`].
 
 use super::node::WideNode;
 use crate::geometry::aabb::SlabRay;
+use crate::geometry::lanes::Scalar;
 
 /// One slab test of a ray against the N children of a node.
 pub trait ChildTest<const N: usize> {
@@ -28,11 +31,9 @@ pub trait ChildTest<const N: usize> {
     fn prefetch(_p: *const u8) {}
 }
 
-/// Scalar slab test of each used slot (`0..len`).
-pub struct Scalar;
-
+/// The ray as the scalar slab test wants it (each used slot, `0..len`, one after the other).
 #[derive(Clone, Copy)]
-pub struct ScalarRay {
+pub struct ScalarSlabRay {
     rdir: [f32; 3],
     org_near: [f32; 3],
     org_far: [f32; 3],
@@ -41,11 +42,11 @@ pub struct ScalarRay {
 }
 
 impl<const N: usize> ChildTest<N> for Scalar {
-    type Ray = ScalarRay;
+    type Ray = ScalarSlabRay;
 
     #[inline(always)]
-    fn prepare(r: &SlabRay) -> ScalarRay {
-        ScalarRay {
+    fn prepare(r: &SlabRay) -> ScalarSlabRay {
+        ScalarSlabRay {
             rdir: r.rdir.to_array(),
             org_near: r.org_rdir_near.to_array(),
             org_far: r.org_rdir_far.to_array(),
@@ -55,7 +56,13 @@ impl<const N: usize> ChildTest<N> for Scalar {
     }
 
     #[inline(always)]
-    fn test(node: &WideNode<N>, r: &ScalarRay, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32 {
+    fn test(
+        node: &WideNode<N>,
+        r: &ScalarSlabRay,
+        tmin: f32,
+        tmax: f32,
+        dist: &mut [f32; N],
+    ) -> u32 {
         let p = &node.planes;
         let (nx, ny, nz) = (&p[r.near[0]], &p[r.near[1]], &p[r.near[2]]);
         let (fx, fy, fz) = (&p[r.far[0]], &p[r.far[1]], &p[r.far[2]]);
@@ -79,13 +86,11 @@ impl<const N: usize> ChildTest<N> for Scalar {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx8, Sse4};
-
-#[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::node::{WideNode, PLANES};
     use super::ChildTest;
     use crate::geometry::aabb::SlabRay;
+    use crate::geometry::lanes::{Avx8, Sse4};
     use std::arch::x86_64::*;
 
     /// Offsets (in floats) of the near and far plane rows of a node of width `n`; each is
@@ -103,15 +108,13 @@ mod x86 {
 
     // ------------------------------------------------------------------ SSE, 4 boxes at once
 
-    /// 4 boxes at once in 128-bit registers; `FMA` fuses the plane distance's multiply and
-    /// subtract (only instantiated inside the AVX2 + FMA entry points).
-    pub struct Sse4<const FMA: bool>;
-
+    /// The ray splatted into lanes (`__m128` or `__m256`), with the offsets of the near and far
+    /// plane rows.
     #[derive(Clone, Copy)]
-    pub struct Sse4Ray {
-        rdir: [__m128; 3],
-        org_near: [__m128; 3],
-        org_far: [__m128; 3],
+    pub struct SlabRayLanes<R> {
+        rdir: [R; 3],
+        org_near: [R; 3],
+        org_far: [R; 3],
         near: [usize; 3],
         far: [usize; 3],
     }
@@ -127,8 +130,10 @@ mod x86 {
         }
     }
 
+    /// 4 boxes at once in 128-bit registers; `FMA` fuses the plane distance's multiply and
+    /// subtract (only instantiated inside the AVX2 + FMA entry points).
     impl<const FMA: bool> ChildTest<4> for Sse4<FMA> {
-        type Ray = Sse4Ray;
+        type Ray = SlabRayLanes<__m128>;
 
         #[inline(always)]
         fn prefetch(p: *const u8) {
@@ -136,7 +141,7 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn prepare(r: &SlabRay) -> Sse4Ray {
+        fn prepare(r: &SlabRay) -> SlabRayLanes<__m128> {
             let (near, far) = plane_offsets(r, 4);
             let splat = |v: f32| {
                 let lanes = [v; 4];
@@ -145,7 +150,7 @@ mod x86 {
                 unsafe { _mm_loadu_ps(lanes.as_ptr()) }
             };
             let (d, on, of) = (r.rdir, r.org_rdir_near, r.org_rdir_far);
-            Sse4Ray {
+            SlabRayLanes {
                 rdir: [splat(d.x), splat(d.y), splat(d.z)],
                 org_near: [splat(on.x), splat(on.y), splat(on.z)],
                 org_far: [splat(of.x), splat(of.y), splat(of.z)],
@@ -155,7 +160,13 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn test(node: &WideNode<4>, r: &Sse4Ray, tmin: f32, tmax: f32, dist: &mut [f32; 4]) -> u32 {
+        fn test(
+            node: &WideNode<4>,
+            r: &SlabRayLanes<__m128>,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 4],
+        ) -> u32 {
             let base = node.planes.as_ptr() as *const f32;
             // SAFETY: SSE is part of the x86-64 baseline, and `FMA` is only set in the kernels
             // reached through the feature-checked AVX2 + FMA entry points (`super::dispatch`). `planes` is 6
@@ -188,19 +199,9 @@ mod x86 {
 
     // ------------------------------------------------------------ AVX2 + FMA, 8 boxes at once
 
-    pub struct Avx8;
-
-    #[derive(Clone, Copy)]
-    pub struct Avx8Ray {
-        rdir: [__m256; 3],
-        org_near: [__m256; 3],
-        org_far: [__m256; 3],
-        near: [usize; 3],
-        far: [usize; 3],
-    }
-
+    /// 8 boxes at once in 256-bit registers, with FMA.
     impl ChildTest<8> for Avx8 {
-        type Ray = Avx8Ray;
+        type Ray = SlabRayLanes<__m256>;
 
         #[inline(always)]
         fn prefetch(p: *const u8) {
@@ -208,13 +209,13 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn prepare(r: &SlabRay) -> Avx8Ray {
+        fn prepare(r: &SlabRay) -> SlabRayLanes<__m256> {
             let (near, far) = plane_offsets(r, 8);
             let (d, on, of) = (r.rdir, r.org_rdir_near, r.org_rdir_far);
             // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`), which run
             // only on CPUs with both; `set1` only broadcasts a value.
             unsafe {
-                Avx8Ray {
+                SlabRayLanes {
                     rdir: [
                         _mm256_set1_ps(d.x),
                         _mm256_set1_ps(d.y),
@@ -237,7 +238,13 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn test(node: &WideNode<8>, r: &Avx8Ray, tmin: f32, tmax: f32, dist: &mut [f32; 8]) -> u32 {
+        fn test(
+            node: &WideNode<8>,
+            r: &SlabRayLanes<__m256>,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 8],
+        ) -> u32 {
             let base = node.planes.as_ptr() as *const f32;
             // SAFETY: AVX2 and FMA are present (only reached through the feature-checked entry
             // points of `avx2_entry!`). `planes` is 6 rows of 8 contiguous floats and every offset is

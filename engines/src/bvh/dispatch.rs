@@ -3,14 +3,11 @@
 //! `is_x86_feature_detected!`. The whole traversal loop is compiled inside a
 //! `#[target_feature]` function for AVX2 so the box test's intrinsics inline.
 
-use super::box_test::Scalar;
-#[cfg(target_arch = "x86_64")]
-use super::box_test::Sse4;
 use super::traverse::{self, Bvh};
 use crate::engine::Counters;
-use crate::geometry::triangle_simd::ScalarPackets;
+use crate::geometry::lanes::Scalar;
 #[cfg(target_arch = "x86_64")]
-use crate::geometry::triangle_simd::Sse4 as SsePackets;
+use crate::geometry::lanes::{Avx8, Sse4};
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 
@@ -30,8 +27,8 @@ pub struct Kernels<const N: usize> {
 /// The scalar kernels (any width).
 pub fn scalar<const N: usize>() -> Kernels<N> {
     Kernels {
-        closest: traverse::closest_batch::<N, Scalar, ScalarPackets>,
-        any: traverse::any_batch::<N, Scalar, ScalarPackets>,
+        closest: traverse::closest_batch::<N, Scalar, Scalar>,
+        any: traverse::any_batch::<N, Scalar, Scalar>,
         lanes: 0,
         name: "scalar",
     }
@@ -43,7 +40,7 @@ pub fn scalar<const N: usize>() -> Kernels<N> {
 pub fn sse4() -> Option<Kernels<4>> {
     #[cfg(target_arch = "x86_64")]
     {
-        Some(if x86::has_avx2_fma() {
+        Some(if Avx8::available() {
             Kernels {
                 closest: x86::fma4_closest,
                 any: x86::fma4_any,
@@ -52,8 +49,8 @@ pub fn sse4() -> Option<Kernels<4>> {
             }
         } else {
             Kernels {
-                closest: traverse::closest_batch::<4, Sse4<false>, SsePackets>,
-                any: traverse::any_batch::<4, Sse4<false>, SsePackets>,
+                closest: traverse::closest_batch::<4, Sse4<false>, Sse4>,
+                any: traverse::any_batch::<4, Sse4<false>, Sse4>,
                 lanes: 4,
                 name: "sse",
             }
@@ -69,7 +66,7 @@ pub fn sse4() -> Option<Kernels<4>> {
 pub fn avx8() -> Option<Kernels<8>> {
     #[cfg(target_arch = "x86_64")]
     {
-        x86::has_avx2_fma().then_some(Kernels {
+        Avx8::available().then_some(Kernels {
             closest: x86::avx8_closest,
             any: x86::avx8_any,
             lanes: 8,
@@ -84,16 +81,11 @@ pub fn avx8() -> Option<Kernels<8>> {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::super::box_test::{Avx8, Sse4};
     use super::super::traverse::{self, Bvh};
     use crate::engine::Counters;
-    use crate::geometry::triangle_simd::Sse4 as SsePackets;
+    use crate::geometry::lanes::{Avx8, Sse4};
     use crate::geometry::TriangleTest;
     use crate::ray::{Hit, Ray};
-
-    pub fn has_avx2_fma() -> bool {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-    }
 
     /// Feature-checked entry points whose batch loop is compiled with AVX2 and FMA, so the
     /// box test's intrinsics (and the leaf kernels) inline into it.
@@ -106,7 +98,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
+                assert!(Avx8::available(), "this kernel needs AVX2 and FMA");
                 // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
                 unsafe { $closest_impl(bvh, rays, hits, t, c) }
             }
@@ -118,7 +110,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                assert!(has_avx2_fma(), "this kernel needs AVX2 and FMA");
+                assert!(Avx8::available(), "this kernel needs AVX2 and FMA");
                 // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
                 unsafe { $any_impl(bvh, rays, out, t, c) }
             }
@@ -131,7 +123,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::closest_batch::<$n, $test, SsePackets>(bvh, rays, hits, t, c)
+                traverse::closest_batch::<$n, $test, Sse4>(bvh, rays, hits, t, c)
             }
 
             #[target_feature(enable = "avx2,fma")]
@@ -142,7 +134,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::any_batch::<$n, $test, SsePackets>(bvh, rays, out, t, c)
+                traverse::any_batch::<$n, $test, Sse4>(bvh, rays, out, t, c)
             }
         };
     }
@@ -233,8 +225,8 @@ mod tests {
         let mut fours: Vec<Kernels<4>> = sse4().into_iter().collect();
         #[cfg(target_arch = "x86_64")]
         fours.push(Kernels {
-            closest: traverse::closest_batch::<4, Sse4<false>, SsePackets>,
-            any: traverse::any_batch::<4, Sse4<false>, SsePackets>,
+            closest: traverse::closest_batch::<4, Sse4<false>, Sse4>,
+            any: traverse::any_batch::<4, Sse4<false>, Sse4>,
             lanes: 4,
             name: "sse",
         });

@@ -9,6 +9,7 @@
 pub mod aabb;
 pub mod dda;
 pub mod kernels;
+pub mod lanes;
 pub mod triangle_simd;
 
 use crate::ray::Ray;
