@@ -22,19 +22,49 @@
 //!   ray id (the thesis's sort by ray id).
 
 use super::voxels::{face_bit, Voxels, MARKED};
-
-#[inline]
-fn face_bit_of(entered: u8) -> u8 {
-    face_bit((entered / 2) as usize, entered % 2 == 1)
-}
-use super::Work;
 use crate::engine::Counters;
 use crate::geometry::aabb::{Aabb, SlabRay};
 use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
+use crate::store::{BboxReader, GeometryReader, IoCounters, ObjectRecord};
 use std::io;
+
+#[inline]
+fn face_bit_of(entered: u8) -> u8 {
+    face_bit((entered / 2) as usize, entered % 2 == 1)
+}
+
+/// What the engine works with during a call: the grid, the rays in memory and their
+/// registrations, and the two files.
+pub struct Work {
+    pub(super) voxels: Voxels,
+    /// Per voxel, the first registration of its list.
+    pub(super) head: Vec<u32>,
+    pub(super) regs: Vec<Reg>,
+    pub(super) regs_capacity: usize,
+    pub(super) slots: Vec<Slot>,
+    /// Rays in memory at most.
+    pub(super) capacity: usize,
+    pub(super) initial_count: u32,
+    pub(super) inverse: bool,
+    pub(super) bbox: BboxReader,
+    pub(super) geometry: GeometryReader,
+    pub(super) record: ObjectRecord,
+    /// The floor group: (object id, its record), held in memory.
+    pub(super) floor: Vec<(u32, ObjectRecord)>,
+    /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
+    pub(super) extent: f32,
+}
+
+impl Work {
+    pub(super) fn io(&self) -> IoCounters {
+        let mut io = self.bbox.file.io;
+        io.add(&self.geometry.file.io);
+        io
+    }
+}
 
 /// No registration: the end of a voxel's list.
 const NONE: u32 = u32::MAX;

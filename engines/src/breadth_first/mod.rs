@@ -46,7 +46,7 @@ use crate::store::{
 };
 use config::{BreadthFirstConfig, Floor, Registration};
 use glam::Vec3;
-use intersect::{Reg, Slot};
+use intersect::Work;
 use spill::SpillDir;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -74,36 +74,6 @@ fn err(reason: String) -> EngineError {
 fn build_engine(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
     let config = BreadthFirstConfig::from_settings(settings)?;
     Ok(Box::new(BreadthFirst::from_scene(input, config)?))
-}
-
-/// What the engine works with during a call: the grid, the rays in memory and their
-/// registrations, and the two files.
-pub struct Work {
-    voxels: Voxels,
-    /// Per voxel, the first registration of its list.
-    head: Vec<u32>,
-    regs: Vec<Reg>,
-    regs_capacity: usize,
-    slots: Vec<Slot>,
-    /// Rays in memory at most.
-    capacity: usize,
-    initial_count: u32,
-    inverse: bool,
-    bbox: BboxReader,
-    geometry: GeometryReader,
-    record: ObjectRecord,
-    /// The floor group: (object id, its record), held in memory.
-    floor: Vec<(u32, ObjectRecord)>,
-    /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
-    extent: f32,
-}
-
-impl Work {
-    fn io(&self) -> IoCounters {
-        let mut io = self.bbox.file.io;
-        io.add(&self.geometry.file.io);
-        io
-    }
 }
 
 /// The `grid` engine's floor test ([`crate::grid::build::floor_objects`]) on a bounding box:

@@ -52,7 +52,6 @@ use shadow_cache::ShadowCache;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
-use traverse::Local;
 
 /// The registry entry of the `grid` engine.
 pub fn info() -> EngineInfo {
@@ -150,6 +149,24 @@ impl Grid {
 
     pub fn config(&self) -> &GridConfig {
         &self.config
+    }
+}
+
+/// Counts kept in locals during a batch and added to `Counters` once at its end.
+#[derive(Default)]
+pub struct Local {
+    pub(super) culled: u64,
+    pub(super) cache_misses: u64,
+}
+
+impl Local {
+    pub fn flush(&self, c: &mut Counters, cull: bool, cache: bool) {
+        if cull {
+            *c.extra.entry("voxel_culled".into()).or_insert(0) += self.culled;
+        }
+        if cache {
+            *c.extra.entry("shadow_cache_misses".into()).or_insert(0) += self.cache_misses;
+        }
     }
 }
 

@@ -25,7 +25,7 @@
 
 use super::mailbox::Mailbox;
 use super::shadow_cache::{Key, ShadowCache};
-use super::Grid;
+use super::{Grid, Local};
 use crate::engine::Counters;
 use crate::geometry::dda;
 use crate::geometry::kernels::f32::WatertightRay;
@@ -42,24 +42,6 @@ impl RaySetup {
     pub(super) fn new(ray: &Ray) -> RaySetup {
         RaySetup {
             wt: WatertightRay::new(ray.dir),
-        }
-    }
-}
-
-/// Counts kept in locals during a batch and added to `Counters` once at its end.
-#[derive(Default)]
-pub struct Local {
-    culled: u64,
-    cache_misses: u64,
-}
-
-impl Local {
-    pub fn flush(&self, c: &mut Counters, cull: bool, cache: bool) {
-        if cull {
-            *c.extra.entry("voxel_culled".into()).or_insert(0) += self.culled;
-        }
-        if cache {
-            *c.extra.entry("shadow_cache_misses".into()).or_insert(0) += self.cache_misses;
         }
     }
 }
