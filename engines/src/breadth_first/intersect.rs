@@ -110,7 +110,7 @@ pub fn reg_bytes() -> u64 {
 
 #[inline]
 fn is_candidate(g: &Voxels, d: &Dda) -> bool {
-    let f = g.flags[g.index(d.voxel())];
+    let f = g.flags[g.lattice.index(d.voxel())];
     // `entered` is 2·axis + side, the numbering of `face_bit(axis, side)`.
     f & MARKED != 0 && (d.entered == START || f & face_bit_of(d.entered) != 0)
 }
@@ -122,7 +122,7 @@ fn first_candidate(g: &Voxels, d: &mut Dda, c: &mut Counters) -> bool {
         if is_candidate(g, d) {
             return true;
         }
-        if !d.advance(g.res) {
+        if !d.advance(g.lattice.res) {
             return false;
         }
     }
@@ -174,7 +174,8 @@ impl Work {
                 let found = if any && best.is_hit() {
                     None
                 } else {
-                    Dda::start(&seg, g).and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
+                    Dda::start(&seg, &g.lattice)
+                        .and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
                 };
                 match found {
                     None => out(id, best),
@@ -227,7 +228,7 @@ impl Work {
             let mut k = 0;
             'walk: loop {
                 let v = s.dda.voxel();
-                let vi = g.index(v) as u32;
+                let vi = g.lattice.index(v) as u32;
                 self.regs.push(Reg {
                     voxel: vi,
                     slot: si as u32,
@@ -242,7 +243,7 @@ impl Work {
                 }
                 // On to the next candidate.
                 loop {
-                    if !s.dda.advance(g.res) {
+                    if !s.dda.advance(g.lattice.res) {
                         s.exhausted = true;
                         break 'walk;
                     }
@@ -276,7 +277,7 @@ impl Work {
             let mut loaded = false;
             for cz in a[2]..=z[2] {
                 for cy in a[1]..=z[1] {
-                    let row = g.index([0, cy, cz]);
+                    let row = g.lattice.index([0, cy, cz]);
                     for cx in a[0]..=z[0] {
                         let mut r = self.head[row + cx as usize];
                         while r != NONE {
@@ -348,7 +349,7 @@ impl Work {
             let mut done = (any && s.best.is_hit()) || s.exhausted || s.best_t <= s.covered;
             if !done {
                 loop {
-                    if !s.dda.advance(g.res) {
+                    if !s.dda.advance(g.lattice.res) {
                         done = true;
                         break;
                     }

@@ -190,9 +190,9 @@ impl BreadthFirst {
 
         let mut stats = BTreeMap::new();
         stats.insert("preprocess_s".into(), preprocess_s);
-        stats.insert("res_x".into(), voxels.res[0] as f64);
-        stats.insert("res_y".into(), voxels.res[1] as f64);
-        stats.insert("res_z".into(), voxels.res[2] as f64);
+        stats.insert("res_x".into(), voxels.lattice.res[0] as f64);
+        stats.insert("res_y".into(), voxels.lattice.res[1] as f64);
+        stats.insert("res_z".into(), voxels.lattice.res[2] as f64);
         stats.insert("voxels".into(), nvox as f64);
         stats.insert("marked_voxels".into(), voxels.marked_count() as f64);
         stats.insert("objects".into(), header.objects as f64);

@@ -25,14 +25,44 @@ pub const MIN_MOVE: f32 = 1e-18;
 /// Which face the walk entered the current cell by: `START` for the first cell.
 pub const START: u8 = 6;
 
-/// A uniform grid as the walk needs it: its box, resolution and cell size, and the cell that
-/// holds a point (clamped into the grid).
-pub trait Lattice {
-    fn lo(&self) -> Vec3;
-    fn hi(&self) -> Vec3;
-    fn res(&self) -> [u32; 3];
-    fn cell(&self) -> Vec3;
-    fn cell_of(&self, p: Vec3) -> [u32; 3];
+/// A uniform grid's frame, shared by every grid of rtbench (the `grid` engine's cells, the
+/// breadth-first engine's voxels, the object-space engine's subspaces): its box, resolution and
+/// cell size. Cell (x, y, z) has index `x + res_x·(y + res_y·z)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lattice {
+    pub lo: Vec3,
+    pub hi: Vec3,
+    pub res: [u32; 3],
+    pub cell: Vec3,
+    pub inv_cell: Vec3,
+}
+
+impl Lattice {
+    /// The box `lo`–`hi` cut into `res` cells per axis.
+    pub fn new(lo: Vec3, hi: Vec3, res: [u32; 3]) -> Lattice {
+        let resv = Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
+        Lattice {
+            lo,
+            hi,
+            res,
+            cell: (hi - lo) / resv,
+            inv_cell: resv / (hi - lo),
+        }
+    }
+
+    /// The cell coordinates of point `p`, clamped into the grid.
+    #[inline]
+    pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
+        let q = (p - self.lo) * self.inv_cell;
+        [0, 1, 2].map(|i| (q[i].max(0.0) as u32).min(self.res[i] - 1))
+    }
+
+    /// Linear index of cell (x, y, z).
+    #[inline]
+    pub fn index(&self, c: [u32; 3]) -> usize {
+        c[0] as usize
+            + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
+    }
 }
 
 /// The state of one ray's walk: the current cell and, per axis, its step and next wall.
@@ -56,15 +86,15 @@ impl Dda {
     /// The walk's first cell (where the segment `[tmin, tmax]` enters the grid's box), or `None`
     /// when the segment misses the box.
     #[inline(always)]
-    pub fn start(ray: &Ray, g: &impl Lattice) -> Option<Dda> {
+    pub fn start(ray: &Ray, g: &Lattice) -> Option<Dda> {
         Dda::start_at(ray, g).map(|(d, _)| d)
     }
 
     /// [`Dda::start`], and the t where the segment enters the grid's box.
     #[inline(always)]
-    pub fn start_at(ray: &Ray, g: &impl Lattice) -> Option<(Dda, f32)> {
+    pub fn start_at(ray: &Ray, g: &Lattice) -> Option<(Dda, f32)> {
         let d = ray.dir.to_array();
-        let (lo, hi, cell) = (g.lo(), g.hi(), g.cell());
+        let (lo, hi, cell) = (g.lo, g.hi, g.cell);
         let (mut t0, mut t1) = (ray.tmin, ray.tmax);
         let mut inv = [0.0f32; 3];
         for i in 0..3 {
@@ -178,11 +208,11 @@ impl Dda {
 /// crosses the cell's exit wall (not clipped to the ray's end: clip with [`Dda::t_end`]); the
 /// ray ends in the cell whose `t_wall` reaches it.
 #[inline(always)]
-pub fn walk(g: &impl Lattice, ray: &Ray, mut visit: impl FnMut(&Dda, f32, f32) -> bool) {
+pub fn walk(g: &Lattice, ray: &Ray, mut visit: impl FnMut(&Dda, f32, f32) -> bool) {
     let Some((mut d, mut t_enter)) = Dda::start_at(ray, g) else {
         return;
     };
-    let res = g.res();
+    let res = g.res;
     loop {
         let t_wall = d.t_wall();
         if visit(&d, t_enter, t_wall) || !d.advance(res) {

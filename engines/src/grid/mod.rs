@@ -111,9 +111,9 @@ impl Grid {
         stats.insert("cells".into(), cells.count() as f64);
         stats.insert("empty_cells".into(), cells.empty_count() as f64);
         stats.insert("references".into(), refs);
-        stats.insert("res_x".into(), cells.res[0] as f64);
-        stats.insert("res_y".into(), cells.res[1] as f64);
-        stats.insert("res_z".into(), cells.res[2] as f64);
+        stats.insert("res_x".into(), cells.lattice.res[0] as f64);
+        stats.insert("res_y".into(), cells.lattice.res[1] as f64);
+        stats.insert("res_z".into(), cells.lattice.res[2] as f64);
         stats.insert("n".into(), built.n as f64);
         stats.insert("grid_primitives".into(), built.grid_prims as f64);
         stats.insert("floor_primitives".into(), built.floor.len() as f64);

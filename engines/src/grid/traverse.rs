@@ -52,8 +52,8 @@ impl Grid {
     /// or ends: the shared 3D-DDA ([`crate::geometry::dda`]), `t_exit` clipped to the ray's end.
     #[inline(always)]
     pub(super) fn walk(&self, ray: &Ray, mut visit: impl FnMut(usize, f32, f32) -> bool) {
-        let res = self.cells.res;
-        dda::walk(&self.cells, ray, |d, t_enter, t_wall| {
+        let res = self.cells.lattice.res;
+        dda::walk(&self.cells.lattice, ray, |d, t_enter, t_wall| {
             visit(d.index(res), t_enter, t_wall.min(d.t_end()))
         })
     }
@@ -250,7 +250,7 @@ fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3, Vec3) {
 /// "cells visited by this pixel's ray").
 #[cfg(test)]
 pub fn cells_along(grid: &Grid, ray: &Ray) -> Vec<[u32; 3]> {
-    let r = grid.cells.res;
+    let r = grid.cells.lattice.res;
     let mut out = Vec::new();
     grid.walk(ray, |c, _, _| {
         let c = c as u32;

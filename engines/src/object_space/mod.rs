@@ -133,7 +133,7 @@ impl ObjectSpace {
     /// Whether `p` lies inside the subspace grid's box.
     pub fn inside(&self, p: glam::Vec3) -> bool {
         let g = &self.subspaces;
-        !g.refs.is_empty() && p.cmpge(g.lo).all() && p.cmple(g.hi).all()
+        !g.refs.is_empty() && p.cmpge(g.lattice.lo).all() && p.cmple(g.lattice.hi).all()
     }
 
     /// Traces one ray through the subspaces, appending a [`Segment`] per subspace visited:
@@ -152,8 +152,8 @@ impl ObjectSpace {
         let mut r = *ray;
         let mut best = u32::MAX;
         let (mut bu, mut bv) = (0.0, 0.0);
-        let res = g.res;
-        dda::walk(g, ray, |d, _, t_exit| {
+        let res = g.lattice.res;
+        dda::walk(&g.lattice, ray, |d, _, t_exit| {
             let s = d.index(res) as u32;
             c.cells_visited += 1;
             let list = g.prims_in(s as usize);
