@@ -197,24 +197,3 @@ pub struct EngineInfo {
 
 /// How an engine is built from a scene and its settings.
 pub type BuildFn = fn(&BuildInput, Settings) -> Result<Box<dyn Engine>, EngineError>;
-
-/// The ray–triangle test an engine that uses the shared kernels should call.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub enum TriangleTest {
-    /// Woop, Benthin and Wald 2013: no gaps or double hits along shared edges.
-    #[default]
-    Watertight,
-    /// Möller and Trumbore 1997: the classic, a little faster.
-    Moller,
-}
-
-impl FromStr for TriangleTest {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "watertight" => Ok(TriangleTest::Watertight),
-            "moller" | "moller-trumbore" => Ok(TriangleTest::Moller),
-            _ => Err("expected watertight or moller".into()),
-        }
-    }
-}

@@ -27,7 +27,8 @@ pub mod reference;
 pub mod store;
 pub mod testing;
 
-pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest};
+pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+pub use geometry::TriangleTest;
 pub use ray::{Hit, Ray};
 
 /// Every engine rtbench knows, available here or not.
@@ -44,9 +45,34 @@ pub fn registry() -> Vec<EngineInfo> {
         object_space::info(),
     ];
     if testing::enabled() {
-        v.extend(testing::infos());
+        v.extend(test_infos());
     }
     v
+}
+
+/// The engines for rtbench's own tests ([`testing`]); the wrappers build their inner engine
+/// with [`build_engine`].
+fn test_infos() -> Vec<EngineInfo> {
+    vec![
+        EngineInfo {
+            name: "test-slow",
+            description: "test only: another engine, slowed by RTBENCH_TEST_SLOWDOWN",
+            available: || Ok(()),
+            build: |input, s| testing::build_slow(input, s, build_engine),
+        },
+        EngineInfo {
+            name: "test-panic",
+            description: "test only: panics in its first query",
+            available: || Ok(()),
+            build: testing::build_panic,
+        },
+        EngineInfo {
+            name: "test-hog",
+            description: "test only: allocates `bytes` bytes at build",
+            available: || Ok(()),
+            build: |input, s| testing::build_hog(input, s, build_engine),
+        },
+    ]
 }
 
 /// Finds an engine by name, checks it is available, and builds it with `key=value` settings.

@@ -8,7 +8,7 @@
 //! - `test-panic`: panics in its first query (a crashing engine).
 //! - `test-hog`: allocates and touches `bytes` bytes at build (an engine that outgrows memory).
 
-use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::engine::{BuildInput, Counters, Engine, EngineError, Settings};
 use crate::ray::{Hit, Ray};
 use std::time::Instant;
 
@@ -16,28 +16,11 @@ pub fn enabled() -> bool {
     std::env::var("RTBENCH_TEST_ENGINES").is_ok_and(|v| v == "1")
 }
 
-pub fn infos() -> Vec<EngineInfo> {
-    vec![
-        EngineInfo {
-            name: "test-slow",
-            description: "test only: another engine, slowed by RTBENCH_TEST_SLOWDOWN",
-            available: || Ok(()),
-            build: build_slow,
-        },
-        EngineInfo {
-            name: "test-panic",
-            description: "test only: panics in its first query",
-            available: || Ok(()),
-            build: build_panic,
-        },
-        EngineInfo {
-            name: "test-hog",
-            description: "test only: allocates `bytes` bytes at build",
-            available: || Ok(()),
-            build: build_hog,
-        },
-    ]
-}
+/// How a wrapper builds the engine it wraps, by name: the registry's `build_engine`, handed in
+/// by the registry's entries ([`crate::registry`]), so this module does not depend on the
+/// registry that lists it.
+pub type InnerBuild =
+    fn(&str, &BuildInput, Vec<(String, String)>) -> Result<Box<dyn Engine>, EngineError>;
 
 struct Slow {
     inner: Box<dyn Engine>,
@@ -67,7 +50,11 @@ impl Engine for Slow {
     }
 }
 
-fn build_slow(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineError> {
+pub fn build_slow(
+    input: &BuildInput,
+    mut s: Settings,
+    build: InnerBuild,
+) -> Result<Box<dyn Engine>, EngineError> {
     let inner: String = s.get("inner", "bvh4".to_string())?;
     s.finish()?;
     let factor = std::env::var("RTBENCH_TEST_SLOWDOWN")
@@ -76,7 +63,7 @@ fn build_slow(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, En
         .unwrap_or(0.0)
         .max(0.0);
     Ok(Box::new(Slow {
-        inner: crate::build_engine(&inner, input, vec![])?,
+        inner: build(&inner, input, vec![])?,
         factor,
     }))
 }
@@ -95,7 +82,7 @@ impl Engine for Panics {
     }
 }
 
-fn build_panic(_: &BuildInput, s: Settings) -> Result<Box<dyn Engine>, EngineError> {
+pub fn build_panic(_: &BuildInput, s: Settings) -> Result<Box<dyn Engine>, EngineError> {
     s.finish()?;
     Ok(Box::new(Panics))
 }
@@ -117,12 +104,16 @@ impl Engine for Hog {
     }
 }
 
-fn build_hog(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineError> {
+pub fn build_hog(
+    input: &BuildInput,
+    mut s: Settings,
+    build: InnerBuild,
+) -> Result<Box<dyn Engine>, EngineError> {
     let bytes: usize = s.get("bytes", 1usize << 30)?;
     s.finish()?;
     // Touch every page so the memory is resident, then hold it while tracing.
     let held = vec![1u8; bytes];
-    let inner = crate::build_engine("bvh2", input, vec![])?;
+    let inner = build("bvh2", input, vec![])?;
     // Hold long enough for a memory watcher polling every 20 ms to see it.
     std::thread::sleep(std::time::Duration::from_millis(300));
     Ok(Box::new(Hog { inner, held }))

@@ -1,6 +1,7 @@
 //! Settings of the `breadth-first` engine, parsed from `key=value` strings.
 
-use crate::engine::{EngineError, Settings, TriangleTest};
+use crate::engine::{EngineError, Settings};
+use crate::geometry::TriangleTest;
 use std::path::PathBuf;
 use std::str::FromStr;
 

@@ -21,19 +21,50 @@
 //! - Hit records leave in completion order through `out(ray id, hit)`; the caller files them by
 //!   ray id (the thesis's sort by ray id).
 
-use super::dda::{Dda, START};
 use super::voxels::{face_bit, Voxels, MARKED};
+use crate::engine::Counters;
+use crate::geometry::aabb::{Aabb, SlabRay};
+use crate::geometry::dda::{Dda, START};
+use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::TriangleTest;
+use crate::ray::{Hit, Ray};
+use crate::store::{BboxReader, GeometryReader, IoCounters, ObjectRecord};
+use std::io;
 
 #[inline]
 fn face_bit_of(entered: u8) -> u8 {
     face_bit((entered / 2) as usize, entered % 2 == 1)
 }
-use super::Work;
-use crate::engine::{Counters, TriangleTest};
-use crate::geometry::aabb::{Aabb, SlabRay};
-use crate::geometry::kernels::f32::WatertightRay;
-use crate::ray::{Hit, Ray};
-use std::io;
+
+/// What the engine works with during a call: the grid, the rays in memory and their
+/// registrations, and the two files.
+pub struct Work {
+    pub(super) voxels: Voxels,
+    /// Per voxel, the first registration of its list.
+    pub(super) head: Vec<u32>,
+    pub(super) regs: Vec<Reg>,
+    pub(super) regs_capacity: usize,
+    pub(super) slots: Vec<Slot>,
+    /// Rays in memory at most.
+    pub(super) capacity: usize,
+    pub(super) initial_count: u32,
+    pub(super) inverse: bool,
+    pub(super) bbox: BboxReader,
+    pub(super) geometry: GeometryReader,
+    pub(super) record: ObjectRecord,
+    /// The floor group: (object id, its record), held in memory.
+    pub(super) floor: Vec<(u32, ObjectRecord)>,
+    /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
+    pub(super) extent: f32,
+}
+
+impl Work {
+    pub(super) fn io(&self) -> IoCounters {
+        let mut io = self.bbox.file.io;
+        io.add(&self.geometry.file.io);
+        io
+    }
+}
 
 /// No registration: the end of a voxel's list.
 const NONE: u32 = u32::MAX;
@@ -79,7 +110,7 @@ pub fn reg_bytes() -> u64 {
 
 #[inline]
 fn is_candidate(g: &Voxels, d: &Dda) -> bool {
-    let f = g.flags[g.index(d.voxel())];
+    let f = g.flags[g.lattice.index(d.voxel())];
     // `entered` is 2·axis + side, the numbering of `face_bit(axis, side)`.
     f & MARKED != 0 && (d.entered == START || f & face_bit_of(d.entered) != 0)
 }
@@ -91,7 +122,7 @@ fn first_candidate(g: &Voxels, d: &mut Dda, c: &mut Counters) -> bool {
         if is_candidate(g, d) {
             return true;
         }
-        if !d.advance(g) {
+        if !d.advance(g.lattice.res) {
             return false;
         }
     }
@@ -143,7 +174,8 @@ impl Work {
                 let found = if any && best.is_hit() {
                     None
                 } else {
-                    Dda::start(&seg, g).and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
+                    Dda::start(&seg, &g.lattice)
+                        .and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
                 };
                 match found {
                     None => out(id, best),
@@ -196,7 +228,7 @@ impl Work {
             let mut k = 0;
             'walk: loop {
                 let v = s.dda.voxel();
-                let vi = g.index(v) as u32;
+                let vi = g.lattice.index(v) as u32;
                 self.regs.push(Reg {
                     voxel: vi,
                     slot: si as u32,
@@ -211,7 +243,7 @@ impl Work {
                 }
                 // On to the next candidate.
                 loop {
-                    if !s.dda.advance(g) {
+                    if !s.dda.advance(g.lattice.res) {
                         s.exhausted = true;
                         break 'walk;
                     }
@@ -245,7 +277,7 @@ impl Work {
             let mut loaded = false;
             for cz in a[2]..=z[2] {
                 for cy in a[1]..=z[1] {
-                    let row = g.index([0, cy, cz]);
+                    let row = g.lattice.index([0, cy, cz]);
                     for cx in a[0]..=z[0] {
                         let mut r = self.head[row + cx as usize];
                         while r != NONE {
@@ -317,7 +349,7 @@ impl Work {
             let mut done = (any && s.best.is_hit()) || s.exhausted || s.best_t <= s.covered;
             if !done {
                 loop {
-                    if !s.dda.advance(g) {
+                    if !s.dda.advance(g.lattice.res) {
                         done = true;
                         break;
                     }

@@ -4,9 +4,10 @@
 //!
 //! Rays, not objects, are registered in a uniform grid; the scene is streamed from disk once per
 //! pass, sequentially, so its size never makes the engine thrash. Files, one concept each:
-//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4), [`dda`]
-//! (the resumable walk), [`intersect`] (passes, registration, the sweep: Algorithm 3.5),
-//! [`spill`] (the temporary store of an in-memory scene).
+//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4),
+//! [`intersect`] (passes, registration, the sweep: Algorithm 3.5), [`spill`] (the temporary
+//! store of an in-memory scene). The resumable walk each ray keeps between passes is the shared
+//! 3D-DDA ([`crate::geometry::dda`]), the `grid` engine's, so both engines visit the same cells.
 //!
 //! Built from a `BuildInput` (an in-memory scene) it first writes the scene as a store
 //! ([`crate::store`]) in its spill directory; [`BreadthFirst::open`] builds it from a store on
@@ -30,7 +31,6 @@
 //! and the exact I/O of the calls: `io_bytes_read`, `io_read_calls`, `io_seeks`.
 
 pub mod config;
-pub mod dda;
 pub mod intersect;
 pub mod spill;
 pub mod voxels;
@@ -46,7 +46,7 @@ use crate::store::{
 };
 use config::{BreadthFirstConfig, Floor, Registration};
 use glam::Vec3;
-use intersect::{Reg, Slot};
+use intersect::Work;
 use spill::SpillDir;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -74,36 +74,6 @@ fn err(reason: String) -> EngineError {
 fn build_engine(input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
     let config = BreadthFirstConfig::from_settings(settings)?;
     Ok(Box::new(BreadthFirst::from_scene(input, config)?))
-}
-
-/// What the engine works with during a call: the grid, the rays in memory and their
-/// registrations, and the two files.
-pub struct Work {
-    voxels: Voxels,
-    /// Per voxel, the first registration of its list.
-    head: Vec<u32>,
-    regs: Vec<Reg>,
-    regs_capacity: usize,
-    slots: Vec<Slot>,
-    /// Rays in memory at most.
-    capacity: usize,
-    initial_count: u32,
-    inverse: bool,
-    bbox: BboxReader,
-    geometry: GeometryReader,
-    record: ObjectRecord,
-    /// The floor group: (object id, its record), held in memory.
-    floor: Vec<(u32, ObjectRecord)>,
-    /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
-    extent: f32,
-}
-
-impl Work {
-    fn io(&self) -> IoCounters {
-        let mut io = self.bbox.file.io;
-        io.add(&self.geometry.file.io);
-        io
-    }
 }
 
 /// The `grid` engine's floor test ([`crate::grid::build::floor_objects`]) on a bounding box:
@@ -220,9 +190,9 @@ impl BreadthFirst {
 
         let mut stats = BTreeMap::new();
         stats.insert("preprocess_s".into(), preprocess_s);
-        stats.insert("res_x".into(), voxels.res[0] as f64);
-        stats.insert("res_y".into(), voxels.res[1] as f64);
-        stats.insert("res_z".into(), voxels.res[2] as f64);
+        stats.insert("res_x".into(), voxels.lattice.res[0] as f64);
+        stats.insert("res_y".into(), voxels.lattice.res[1] as f64);
+        stats.insert("res_z".into(), voxels.lattice.res[2] as f64);
         stats.insert("voxels".into(), nvox as f64);
         stats.insert("marked_voxels".into(), voxels.marked_count() as f64);
         stats.insert("objects".into(), header.objects as f64);

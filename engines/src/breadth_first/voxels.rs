@@ -8,6 +8,7 @@
 //! except where that grid would take more than half the memory budget: then n is lowered until
 //! it fits (`BreadthFirst::open`), so a budget-bound run keeps room for rays.
 
+use crate::geometry::dda::Lattice;
 use crate::grid::build::{PAD_CELL, PAD_COORD};
 use crate::grid::config::Resolution;
 use crate::grid::resolution::cells_per_axis;
@@ -22,11 +23,8 @@ pub fn face_bit(axis: usize, max: bool) -> u8 {
 }
 
 pub struct Voxels {
-    pub lo: Vec3,
-    pub hi: Vec3,
-    pub res: [u32; 3],
-    pub cell: Vec3,
-    pub inv_cell: Vec3,
+    /// The grid's box, resolution and voxel size.
+    pub lattice: Lattice,
     /// How far boxes are grown against rounding (as the grid engine's).
     pub pad: Vec3,
     pub flags: Vec<u8>,
@@ -39,11 +37,7 @@ impl Voxels {
         if !(lo.is_finite() && hi.is_finite()) || n == 0 {
             // No primitive: one empty voxel that no ray is registered in.
             return Voxels {
-                lo: Vec3::ZERO,
-                hi: Vec3::ONE,
-                res: [1; 3],
-                cell: Vec3::ONE,
-                inv_cell: Vec3::ONE,
+                lattice: Lattice::new(Vec3::ZERO, Vec3::ONE, [1; 3]),
                 pad: Vec3::ZERO,
                 flags: vec![0],
             };
@@ -54,14 +48,10 @@ impl Voxels {
         hi += Vec3::splat(pad0);
         let extent = (hi - lo).as_dvec3().to_array();
         let res = cells_per_axis(Resolution::CubeRoot, extent, n as usize, 1.0, [0.0; 3]);
-        let resv = Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
-        let cell = (hi - lo) / resv;
+        let lattice = Lattice::new(lo, hi, res);
+        let cell = lattice.cell;
         Voxels {
-            lo,
-            hi,
-            res,
-            cell,
-            inv_cell: resv / (hi - lo),
+            lattice,
             pad: Vec3::splat(PAD_COORD * magnitude) + cell * PAD_CELL,
             flags: vec![0; res.iter().map(|&r| r as usize).product()],
         }
@@ -73,26 +63,16 @@ impl Voxels {
 
     /// The largest resolution along an axis (the r of the registration count policies).
     pub fn max_res(&self) -> u32 {
-        self.res.into_iter().max().unwrap_or(1)
-    }
-
-    /// The cell coordinates of point `p`, clamped into the grid.
-    #[inline]
-    pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
-        let q = (p - self.lo) * self.inv_cell;
-        [0, 1, 2].map(|i| (q[i].max(0.0) as u32).min(self.res[i] - 1))
-    }
-
-    #[inline]
-    pub fn index(&self, c: [u32; 3]) -> usize {
-        c[0] as usize
-            + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
+        self.lattice.res.into_iter().max().unwrap_or(1)
     }
 
     /// The box of voxels a (padded) bounding box reaches, as the grid engine registers it.
     #[inline]
     pub fn range(&self, lo: Vec3, hi: Vec3) -> ([u32; 3], [u32; 3]) {
-        (self.cell_of(lo - self.pad), self.cell_of(hi + self.pad))
+        (
+            self.lattice.cell_of(lo - self.pad),
+            self.lattice.cell_of(hi + self.pad),
+        )
     }
 
     /// Algorithm 3.4's loop body for one object: mark the voxels its box reaches, and the faces
@@ -104,7 +84,7 @@ impl Voxels {
         let (a, z) = self.range(lo, hi);
         for cz in a[2]..=z[2] {
             for cy in a[1]..=z[1] {
-                let row = self.index([0, cy, cz]);
+                let row = self.lattice.index([0, cy, cz]);
                 for cx in a[0]..=z[0] {
                     let mut f = MARKED;
                     for (axis, c) in [(0, cx), (1, cy), (2, cz)] {

@@ -20,7 +20,8 @@
 
 use super::node::MAX_LEAF_PRIMS;
 use super::tree::MAX_WIDTH;
-use crate::engine::{EngineError, Settings, TriangleTest};
+use crate::engine::{EngineError, Settings};
+use crate::geometry::TriangleTest;
 use std::str::FromStr;
 
 /// How the binary tree (or, with `wide=direct`, the N-ary tree) is split.

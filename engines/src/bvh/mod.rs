@@ -5,19 +5,21 @@
 //! SAH, binned SAH; [`config::Builder`]) → a binary tree collapsed to N-wide
 //! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
 //! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
-//! ([`simd`]). Leaves hold up to `leaf` primitives of the shared [`Geometry`], copied in
-//! leaf order: triangles in packets of 4 tested with the shared SIMD triangle kernel, other
-//! primitives tested with the shared scalar kernels (`Prim::intersect`); see [`leaf`].
+//! ([`box_test`], picked at run time by [`dispatch`]). Leaves hold up to `leaf` primitives of
+//! the shared [`Geometry`], copied in leaf order: triangles in packets of 4 tested with the
+//! shared SIMD triangle kernel, other primitives tested with the shared scalar kernels
+//! (`Prim::intersect`); see [`leaf`].
 //!
 //! Settings: see [`config`].
 
+pub mod box_test;
 pub mod build_median;
 pub mod build_sah;
 pub mod collapse;
 pub mod config;
+pub mod dispatch;
 pub mod leaf;
 pub mod node;
-pub mod simd;
 pub mod stats;
 pub mod traverse;
 pub mod tree;
@@ -29,8 +31,8 @@ use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Setti
 use crate::geometry::{Geometry, Prim};
 use crate::ray::{Hit, Ray};
 use config::{Builder, Config, WideMethod};
+use dispatch::Kernels;
 use node::{flatten, WideNode, MAX_TRAVERSAL_PRIMS};
-use simd::Kernels;
 use std::collections::BTreeMap;
 use std::time::Instant;
 use traverse::Bvh;
@@ -51,7 +53,7 @@ pub fn info4() -> EngineInfo {
         name: "bvh4",
         description: "4-wide BVH (seed 001), children's boxes side by side, SSE ray-4-box test",
         available: || Ok(()),
-        build: |input, settings| build_engine::<4>(input, settings, simd::sse4),
+        build: |input, settings| build_engine::<4>(input, settings, dispatch::sse4),
     }
 }
 
@@ -60,7 +62,7 @@ pub fn info8() -> EngineInfo {
         name: "bvh8",
         description: "8-wide BVH, children's boxes side by side, AVX2 ray-8-box test",
         available: || Ok(()),
-        build: |input, settings| build_engine::<8>(input, settings, simd::avx8),
+        build: |input, settings| build_engine::<8>(input, settings, dispatch::avx8),
     }
 }
 
@@ -231,9 +233,9 @@ fn build_engine<const N: usize>(
     let build_s = start.elapsed().as_secs_f64();
     // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
     let kernels = if config.simd {
-        simd_kernels().unwrap_or_else(simd::scalar::<N>)
+        simd_kernels().unwrap_or_else(dispatch::scalar::<N>)
     } else {
-        simd::scalar::<N>()
+        dispatch::scalar::<N>()
     };
     let mut stats = BTreeMap::new();
     tree_stats.insert_into(&mut stats);

@@ -5,8 +5,9 @@
 use super::config::{Builder, Config, WideMethod};
 use super::stats::TreeStats;
 use super::*;
-use crate::engine::{BuildInput, Settings, TriangleTest};
+use crate::engine::{BuildInput, Settings};
 use crate::geometry::kernels::f32::WatertightRay;
+use crate::geometry::TriangleTest;
 use glam::Vec3;
 use rtbench_scenes::generate_scene;
 use rtbench_scenes::spd::{Options, Program};

@@ -18,15 +18,16 @@
 //! `primitive_hits` counts the triangles of a packet that hit within the segment as it was
 //! when the packet was tested (testing one by one counts only those that shrink it).
 
+use super::box_test::ChildTest;
 use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
-use super::simd::ChildTest;
 use super::tree::MAX_DEPTH;
-use crate::engine::{Counters, TriangleTest};
+use crate::engine::Counters;
 use crate::geometry::aabb::SlabRay;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::triangle_simd::{LaneHits, PacketKernel};
 use crate::geometry::Prim;
+use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 
 /// The widest tree traversed (bvh8; wider trees are built for statistics only).

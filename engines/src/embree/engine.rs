@@ -1,9 +1,9 @@
 //! The built `embree` engine: set-up with a few raw calls, tracing with raw `rtcIntersect1` /
 //! `rtcOccluded1` (no error check per ray).
 
+use super::config::{EmbreeConfig, Quality};
 use super::raw::{self, Device, Geometry, RayHit, Scene};
 use super::user::{self, UserPrims};
-use super::{EmbreeConfig, Quality};
 use crate::engine::{BuildInput, Counters, Engine, EngineError};
 use crate::geometry::Prim;
 use crate::ray::{Hit, Ray};

@@ -4,7 +4,7 @@
 //! with its inverse direction and `origin × inverse`, so a plane at coordinate `p` is crossed at
 //! `t = p·rdir − org_rdir`; for each axis the near plane is chosen by the sign of the direction
 //! (Williams et al. 2005), so no min/max swap is needed per box. The SIMD forms of the same test
-//! (4 and 8 boxes at once) live with the BVH engines (`bvh/simd.rs`) and use the same
+//! (4 and 8 boxes at once) live with the BVH engines (`bvh/box_test.rs`) and use the same
 //! [`SlabRay`].
 
 use crate::ray::Ray;

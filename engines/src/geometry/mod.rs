@@ -7,14 +7,38 @@
 //! index of its scene object, so hits name the NFF record.
 
 pub mod aabb;
+pub mod dda;
 pub mod kernels;
+pub mod lanes;
 pub mod triangle_simd;
 
-use crate::engine::TriangleTest;
 use crate::ray::Ray;
 use glam::Vec3;
 use kernels::f32 as k;
 use rtbench_scenes::{triangulate, Scene, ShapeRef};
+use serde::Serialize;
+use std::str::FromStr;
+
+/// The ray–triangle test an engine that uses the shared kernels should call.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum TriangleTest {
+    /// Woop, Benthin and Wald 2013: no gaps or double hits along shared edges.
+    #[default]
+    Watertight,
+    /// Möller and Trumbore 1997: the classic, a little faster.
+    Moller,
+}
+
+impl FromStr for TriangleTest {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "watertight" => Ok(TriangleTest::Watertight),
+            "moller" | "moller-trumbore" => Ok(TriangleTest::Moller),
+            _ => Err("expected watertight or moller".into()),
+        }
+    }
+}
 
 /// One prepared primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -12,13 +12,17 @@
 //! double precision on an edge included. So the watertight packet test keeps its promise (no
 //! gaps, no double hits on shared edges), and engines may mix packet and scalar tests freely.
 //!
-//! Three forms of [`PacketKernel`]: [`ScalarPackets`] (any width, lane by lane through the
-//! scalar kernels; the fallback), `Sse4` (4 lanes, SSE2, part of the x86-64 baseline) and
-//! `Avx8` (8 lanes, AVX2; callers must check the CPU, see [`Avx8::available`]). [`closest4`]
-//! and [`closest8`] choose at run time with `is_x86_feature_detected!`.
+//! Three forms of [`PacketKernel`], one per lane type of [`super::lanes`] (the vocabulary the
+//! BVH's box test uses too): [`Scalar`] (any width, lane by lane through the scalar kernels;
+//! the fallback), [`Sse4`] (4 lanes, SSE2, part of the x86-64 baseline) and [`Avx8`] (8 lanes,
+//! AVX2; callers must check the CPU, see [`Avx8::available`]). [`closest4`] and [`closest8`]
+//! choose at run time with `is_x86_feature_detected!`.
 
 use super::kernels::f32::{self as k, WatertightRay};
-use crate::engine::TriangleTest;
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Sse4;
+use super::lanes::{Avx8, Scalar};
+use crate::geometry::TriangleTest;
 use glam::Vec3;
 
 /// K triangles, structure-of-arrays: `v[i][a][lane]` is coordinate `a` (x, y, z) of vertex `i`
@@ -109,22 +113,21 @@ pub trait PacketKernel<const K: usize> {
     ) -> u32;
 }
 
-/// Lane by lane through the scalar kernels (any width; the fallback and the reference).
-pub struct ScalarPackets;
-
+/// The ray as the scalar form wants it (lane by lane through the scalar kernels; any width; the
+/// fallback and the reference).
 #[derive(Clone, Copy)]
-pub struct ScalarRay {
+pub struct ScalarTriangleRay {
     origin: Vec3,
     dir: Vec3,
     wt: WatertightRay,
 }
 
-impl<const K: usize> PacketKernel<K> for ScalarPackets {
-    type Ray = ScalarRay;
+impl<const K: usize> PacketKernel<K> for Scalar {
+    type Ray = ScalarTriangleRay;
 
     #[inline(always)]
-    fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> ScalarRay {
-        ScalarRay {
+    fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> ScalarTriangleRay {
+        ScalarTriangleRay {
             origin,
             dir,
             wt: *wt,
@@ -134,7 +137,7 @@ impl<const K: usize> PacketKernel<K> for ScalarPackets {
     #[inline(always)]
     fn test<const W: bool>(
         p: &TrianglePacket<K>,
-        r: &ScalarRay,
+        r: &ScalarTriangleRay,
         tmin: f32,
         tmax: f32,
         hits: &mut LaneHits<K>,
@@ -174,7 +177,7 @@ pub fn closest4(
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        closest_with::<4, ScalarPackets>(p, origin, dir, test, tmin, tmax)
+        closest_with::<4, Scalar>(p, origin, dir, test, tmin, tmax)
     }
 }
 
@@ -193,7 +196,7 @@ pub fn closest8(
         // SAFETY: the CPU has AVX2 and FMA (checked just above), all the callee requires.
         return unsafe { x86::closest8_avx2(p, origin, dir, test, tmin, tmax) };
     }
-    closest_with::<8, ScalarPackets>(p, origin, dir, test, tmin, tmax)
+    closest_with::<8, Scalar>(p, origin, dir, test, tmin, tmax)
 }
 
 /// Nearest hit among a packet's triangles with the form `P`.
@@ -220,13 +223,11 @@ pub fn closest_with<const K: usize, P: PacketKernel<K>>(
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx8, Sse4};
-
-#[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{LaneHits, PacketKernel, TrianglePacket};
-    use crate::engine::TriangleTest;
     use crate::geometry::kernels::f32::WatertightRay;
+    use crate::geometry::lanes::{Avx8, Sse4};
+    use crate::geometry::TriangleTest;
     use glam::Vec3;
     use std::arch::x86_64::*;
 
@@ -426,7 +427,7 @@ mod x86 {
 
     /// A ray splatted into lanes: origin, direction, and the watertight shear with its axes.
     #[derive(Clone, Copy)]
-    pub struct LanesRay<L> {
+    pub struct TriangleRayLanes<L> {
         o: [L; 3],
         d: [L; 3],
         /// sx, sy, sz of the watertight set-up.
@@ -436,8 +437,8 @@ mod x86 {
     }
 
     #[inline(always)]
-    unsafe fn prepare<L: Lanes>(o: Vec3, d: Vec3, wt: &WatertightRay) -> LanesRay<L> {
-        LanesRay {
+    unsafe fn prepare<L: Lanes>(o: Vec3, d: Vec3, wt: &WatertightRay) -> TriangleRayLanes<L> {
+        TriangleRayLanes {
             o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
             d: [L::splat(d.x), L::splat(d.y), L::splat(d.z)],
             s: [L::splat(wt.sx), L::splat(wt.sy), L::splat(wt.sz)],
@@ -456,7 +457,7 @@ mod x86 {
     #[inline(always)]
     unsafe fn watertight<L: Lanes, const K: usize>(
         p: &TrianglePacket<K>,
-        r: &LanesRay<L>,
+        r: &TriangleRayLanes<L>,
         tmin: f32,
         tmax: f32,
         hits: &mut LaneHits<K>,
@@ -543,7 +544,7 @@ mod x86 {
     #[inline(always)]
     unsafe fn moller<L: Lanes, const K: usize>(
         p: &TrianglePacket<K>,
-        r: &LanesRay<L>,
+        r: &TriangleRayLanes<L>,
         tmin: f32,
         tmax: f32,
         hits: &mut LaneHits<K>,
@@ -592,10 +593,8 @@ mod x86 {
     }
 
     /// 4 triangles per instruction, SSE2 (x86-64 baseline: safe to use anywhere on x86-64).
-    pub struct Sse4;
-
     impl PacketKernel<4> for Sse4 {
-        type Ray = LanesRay<__m128>;
+        type Ray = TriangleRayLanes<__m128>;
 
         #[inline(always)]
         fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray {
@@ -626,17 +625,8 @@ mod x86 {
 
     /// 8 triangles per instruction, AVX. Only for code that has checked [`Avx8::available`]
     /// (the BVH's AVX2 + FMA entry points; [`super::closest8`]).
-    pub struct Avx8;
-
-    impl Avx8 {
-        /// The CPU has what this form (and the BVH entry points that compile it in) needs.
-        pub fn available() -> bool {
-            is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-        }
-    }
-
     impl PacketKernel<8> for Avx8 {
-        type Ray = LanesRay<__m256>;
+        type Ray = TriangleRayLanes<__m256>;
 
         #[inline(always)]
         fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray {
@@ -686,7 +676,7 @@ mod x86 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::TriangleTest;
+    use crate::geometry::TriangleTest;
 
     /// A small deterministic generator (64-bit LCG, top bits), in [-1, 1).
     struct Lcg(u64);
@@ -784,7 +774,7 @@ mod tests {
                         let want = scalar_closest(chunk, o, d, test, 0.0, tmax);
                         let got = closest(&p, o, d, test, 0.0, tmax);
                         assert_eq!(got, want, "{form} {test:?}: ray {o} {d}, {chunk:?}");
-                        let lanes = closest_with::<K, ScalarPackets>(&p, o, d, test, 0.0, tmax);
+                        let lanes = closest_with::<K, Scalar>(&p, o, d, test, 0.0, tmax);
                         assert_eq!(lanes, want, "scalar packets {test:?}: ray {o} {d}");
                         hits += want.is_some() as usize;
                     }

@@ -18,6 +18,7 @@ use super::config::{Count, Floor, GridConfig, Insertion, Resolution};
 use super::overlap;
 use super::resolution::{self, MAX_CELLS};
 use crate::engine::EngineError;
+use crate::geometry::dda::Lattice;
 use crate::geometry::Geometry;
 use glam::{DVec3, Vec3};
 use rtbench_scenes::{Scene, Shape};
@@ -35,11 +36,8 @@ pub(crate) const PAD_CELL: f32 = 1e-5;
 /// The uniform grid itself: its box, its resolution and its compact cell lists.
 #[derive(Clone, Debug, Default)]
 pub struct Cells {
-    pub lo: Vec3,
-    pub hi: Vec3,
-    pub res: [u32; 3],
-    pub cell: Vec3,
-    pub inv_cell: Vec3,
+    /// The grid's box, resolution and cell size.
+    pub lattice: Lattice,
     /// `offsets[c]..offsets[c + 1]` is cell c's range of `refs`; cell (x, y, z) is
     /// c = x + res_x·(y + res_y·z).
     pub offsets: Vec<u32>,
@@ -60,18 +58,6 @@ impl Cells {
 
     pub fn bytes(&self) -> u64 {
         ((self.offsets.len() + self.refs.len()) * 4) as u64
-    }
-
-    /// The cell coordinates of point `p`, clamped into the grid.
-    pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
-        let q = (p - self.lo) * self.inv_cell;
-        [0, 1, 2].map(|i| (q[i].max(0.0) as u32).min(self.res[i] - 1))
-    }
-
-    /// Linear index of cell (x, y, z).
-    pub fn index(&self, c: [u32; 3]) -> usize {
-        c[0] as usize
-            + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
     }
 
     /// Primitives registered in cell `c`.
@@ -162,7 +148,10 @@ pub fn build(
     if inside.is_empty() {
         return Ok(Built {
             cells: Cells {
-                res: [1; 3],
+                lattice: Lattice {
+                    res: [1; 3],
+                    ..Lattice::default()
+                },
                 offsets: vec![0, 0],
                 ..Cells::default()
             },
@@ -212,18 +201,13 @@ pub fn build(
             )));
         }
     }
-    let resv = Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
-    let cell = (hi - lo) / resv;
-    let inv_cell = resv / (hi - lo);
+    let lattice = Lattice::new(lo, hi, res);
+    let cell = lattice.cell;
     let pad = Vec3::splat(PAD_COORD * magnitude) + cell * PAD_CELL;
     let ncells = resolution::total(res) as usize;
 
     let mut cells = Cells {
-        lo,
-        hi,
-        res,
-        cell,
-        inv_cell,
+        lattice,
         offsets: Vec::new(),
         refs: Vec::new(),
         pad,
@@ -231,7 +215,10 @@ pub fn build(
 
     // The range of cells a primitive's padded bounding box reaches.
     let range = |b: &(Vec3, Vec3)| -> ([u32; 3], [u32; 3]) {
-        (cells.cell_of(b.0 - pad), cells.cell_of(b.1 + pad))
+        (
+            cells.lattice.cell_of(b.0 - pad),
+            cells.lattice.cell_of(b.1 + pad),
+        )
     };
     let exact = config.insertion == Insertion::Exact;
     let (lo64, cell64, pad64) = (lo.as_dvec3(), cell.as_dvec3(), pad.as_dvec3());
@@ -252,7 +239,7 @@ pub fn build(
                 answers.push(k);
             }
             if k {
-                counts[cells.index(c)] += 1;
+                counts[cells.lattice.index(c)] += 1;
             }
         });
     }
@@ -284,7 +271,7 @@ pub fn build(
                 true
             };
             if keep {
-                let i = cells.index(c);
+                let i = cells.lattice.index(c);
                 refs[fill[i] as usize] = p;
                 fill[i] += 1;
             }

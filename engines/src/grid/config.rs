@@ -1,7 +1,8 @@
 //! The `grid` engine's typed settings, parsed from `key=value` strings (see the module docs of
 //! [`super`] for the table of keys).
 
-use crate::engine::{EngineError, Settings, TriangleTest};
+use crate::engine::{EngineError, Settings};
+use crate::geometry::TriangleTest;
 use std::str::FromStr;
 
 /// How many cells the grid has along each axis (see [`super::resolution`]).

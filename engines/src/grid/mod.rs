@@ -52,7 +52,6 @@ use shadow_cache::ShadowCache;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
-use traverse::Local;
 
 /// The registry entry of the `grid` engine.
 pub fn info() -> EngineInfo {
@@ -112,9 +111,9 @@ impl Grid {
         stats.insert("cells".into(), cells.count() as f64);
         stats.insert("empty_cells".into(), cells.empty_count() as f64);
         stats.insert("references".into(), refs);
-        stats.insert("res_x".into(), cells.res[0] as f64);
-        stats.insert("res_y".into(), cells.res[1] as f64);
-        stats.insert("res_z".into(), cells.res[2] as f64);
+        stats.insert("res_x".into(), cells.lattice.res[0] as f64);
+        stats.insert("res_y".into(), cells.lattice.res[1] as f64);
+        stats.insert("res_z".into(), cells.lattice.res[2] as f64);
         stats.insert("n".into(), built.n as f64);
         stats.insert("grid_primitives".into(), built.grid_prims as f64);
         stats.insert("floor_primitives".into(), built.floor.len() as f64);
@@ -150,6 +149,24 @@ impl Grid {
 
     pub fn config(&self) -> &GridConfig {
         &self.config
+    }
+}
+
+/// Counts kept in locals during a batch and added to `Counters` once at its end.
+#[derive(Default)]
+pub struct Local {
+    pub(super) culled: u64,
+    pub(super) cache_misses: u64,
+}
+
+impl Local {
+    pub fn flush(&self, c: &mut Counters, cull: bool, cache: bool) {
+        if cull {
+            *c.extra.entry("voxel_culled".into()).or_insert(0) += self.culled;
+        }
+        if cache {
+            *c.extra.entry("shadow_cache_misses".into()).or_insert(0) += self.cache_misses;
+        }
     }
 }
 

@@ -91,10 +91,9 @@ impl Grid {
         if self.cells.refs.is_empty() {
             return;
         }
-        let s = super::traverse::RaySetup::new(&r);
         let g = &self.cells;
         let segment = r;
-        self.walk(&segment, &s, |cell, _, t_exit| {
+        self.walk(&segment, |cell, _, t_exit| {
             out((layout.offsets + cell as u64 * 4) / PAGE);
             let (a, b) = (g.offsets[cell] as u64, g.offsets[cell + 1] as u64);
             for i in a..b {

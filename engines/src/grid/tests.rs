@@ -6,8 +6,9 @@ use super::config::{Count, Floor, GridConfig, Insertion, Resolution};
 use super::resolution::{cells_per_axis, total, MAX_CELLS};
 use super::traverse::cells_along;
 use super::{overlap, Grid};
-use crate::engine::{BuildInput, Counters, Engine, EngineError, Settings, TriangleTest};
+use crate::engine::{BuildInput, Counters, Engine, EngineError, Settings};
 use crate::geometry::Geometry;
+use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 use glam::{DVec3, Vec3};
 use rtbench_scenes::spd::{Options, Program};
@@ -380,15 +381,15 @@ fn compact_layout_and_build_stats() {
     let input = corners();
     let bbox = grid(&input, &[("res", "4,4,4")]);
     let c = bbox.cells();
-    assert_eq!(c.res, [4, 4, 4]);
+    assert_eq!(c.lattice.res, [4, 4, 4]);
     assert_eq!(c.offsets.len(), 65);
     // Each sphere's box [0,1]³ reaches the neighbouring cells by the padding: 8 cells each.
     assert_eq!(c.refs.len(), 16);
     assert_eq!(*c.offsets.last().unwrap() as usize, c.refs.len());
-    assert_eq!(c.prims_in(c.index([0, 0, 0])), &[0]);
-    assert_eq!(c.prims_in(c.index([1, 1, 1])), &[0]);
-    assert_eq!(c.prims_in(c.index([2, 2, 2])), &[1]);
-    assert!(c.prims_in(c.index([3, 0, 0])).is_empty());
+    assert_eq!(c.prims_in(c.lattice.index([0, 0, 0])), &[0]);
+    assert_eq!(c.prims_in(c.lattice.index([1, 1, 1])), &[0]);
+    assert_eq!(c.prims_in(c.lattice.index([2, 2, 2])), &[1]);
+    assert!(c.prims_in(c.lattice.index([3, 0, 0])).is_empty());
     let s = bbox.build_stats();
     assert_eq!(s["cells"], 64.0);
     assert_eq!(s["references"], 16.0);
@@ -398,9 +399,9 @@ fn compact_layout_and_build_stats() {
     let exact = grid(&input, &[("res", "4,4,4"), ("insert", "exact")]);
     let c = exact.cells();
     assert_eq!(c.refs.len(), 8);
-    assert_eq!(c.prims_in(c.index([1, 0, 0])), &[0]);
-    assert!(c.prims_in(c.index([1, 1, 0])).is_empty());
-    assert!(c.prims_in(c.index([1, 1, 1])).is_empty());
+    assert_eq!(c.prims_in(c.lattice.index([1, 0, 0])), &[0]);
+    assert!(c.prims_in(c.lattice.index([1, 1, 0])).is_empty());
+    assert!(c.prims_in(c.lattice.index([1, 1, 1])).is_empty());
     assert!(exact.structure_bytes() >= (65 + 8) * 4);
 }
 
@@ -731,7 +732,7 @@ fn floor_goes_out_of_the_grid_when_asked() {
             // Without the floor the grid shrinks to the objects standing on it.
             let (a, b) = (inside.cells(), out.cells());
             assert!(
-                (b.hi - b.lo).length() < (a.hi - a.lo).length(),
+                (b.lattice.hi - b.lattice.lo).length() < (a.lattice.hi - a.lattice.lo).length(),
                 "{program:?}"
             );
         }

@@ -1,5 +1,6 @@
-//! Tracing rays through the grid: 3D-DDA (Amanatides and Woo 1987; seed 000 §1.1, seed 002 §1.5)
-//! over the cells the ray crosses, near to far, testing the primitives registered in each.
+//! Tracing rays through the grid: 3D-DDA (Amanatides and Woo 1987; seed 000 §1.1, seed 002 §1.5;
+//! the shared walk of [`crate::geometry::dda`]) over the cells the ray crosses, near to far,
+//! testing the primitives registered in each.
 //!
 //! Closest hit. Seed 002 §1.6: a hit counts only once traversal has reached the cell that holds
 //! it, because a primitive spanning several cells may be hit in a later cell, beyond another
@@ -24,60 +25,23 @@
 
 use super::mailbox::Mailbox;
 use super::shadow_cache::{Key, ShadowCache};
-use super::Grid;
+use super::{Grid, Local};
 use crate::engine::Counters;
+use crate::geometry::dda;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::ray::{Hit, Ray};
 use glam::Vec3;
 
-/// Direction components smaller than this count as zero (as the shared slab test's
-/// `MIN_RCP_INPUT`): the ray is taken as parallel to that axis's walls.
-const MIN_MOVE: f32 = 1e-18;
-
-/// Per-ray set-up shared by every primitive test and by the walk.
+/// Per-ray set-up shared by every primitive test.
 pub(super) struct RaySetup {
-    /// 1/d per axis, or 0 along an axis the ray does not move on.
-    inv: [f32; 3],
-    /// Whether the ray moves along each axis: |d| at least [`MIN_MOVE`], so that 1/d and the
-    /// walls' distances stay finite.
-    moves: [bool; 3],
     wt: WatertightRay,
 }
 
 impl RaySetup {
     #[inline]
     pub(super) fn new(ray: &Ray) -> RaySetup {
-        let d = ray.dir.to_array();
-        let mut inv = [0.0; 3];
-        let mut moves = [false; 3];
-        for i in 0..3 {
-            if d[i].abs() >= MIN_MOVE {
-                inv[i] = 1.0 / d[i];
-                moves[i] = true;
-            }
-        }
         RaySetup {
-            inv,
-            moves,
             wt: WatertightRay::new(ray.dir),
-        }
-    }
-}
-
-/// Counts kept in locals during a batch and added to `Counters` once at its end.
-#[derive(Default)]
-pub struct Local {
-    culled: u64,
-    cache_misses: u64,
-}
-
-impl Local {
-    pub fn flush(&self, c: &mut Counters, cull: bool, cache: bool) {
-        if cull {
-            *c.extra.entry("voxel_culled".into()).or_insert(0) += self.culled;
-        }
-        if cache {
-            *c.extra.entry("shadow_cache_misses".into()).or_insert(0) += self.cache_misses;
         }
     }
 }
@@ -85,102 +49,13 @@ impl Local {
 impl Grid {
     /// Walks the cells `ray` crosses within `[ray.tmin, ray.tmax]`, near to far, calling
     /// `visit(cell, t_enter, t_exit)` for each until it returns true or the ray leaves the grid
-    /// or ends. Amanatides–Woo: per axis the t of the next wall, stepping the axis whose wall
-    /// comes first. A wall's t is computed from its plane's index k as `base + k·delta` (base the
-    /// t of plane 0) rather than accumulated, so rounding does not drift along long rays. The
-    /// three axes are spelled out (no indexing by axis) so that the state stays in registers.
+    /// or ends: the shared 3D-DDA ([`crate::geometry::dda`]), `t_exit` clipped to the ray's end.
     #[inline(always)]
-    pub(super) fn walk(
-        &self,
-        ray: &Ray,
-        s: &RaySetup,
-        mut visit: impl FnMut(usize, f32, f32) -> bool,
-    ) {
-        let g = &self.cells;
-        // Clip the segment to the grid's box (the slab test of the DDA's set-up, which also
-        // needs the exit distance and the axes the ray does not move along).
-        let (mut t0, mut t1) = (ray.tmin, ray.tmax);
-        for i in 0..3 {
-            let o = ray.origin[i];
-            if s.moves[i] {
-                let ta = (g.lo[i] - o) * s.inv[i];
-                let tb = (g.hi[i] - o) * s.inv[i];
-                t0 = t0.max(ta.min(tb));
-                t1 = t1.min(ta.max(tb));
-            } else if o < g.lo[i] || o > g.hi[i] {
-                return;
-            }
-        }
-        if t0.is_nan() || t1.is_nan() || t0 > t1 {
-            return;
-        }
-        let start = g.cell_of(ray.at(t0));
-        let res = [g.res[0] as i32, g.res[1] as i32, g.res[2] as i32];
-        let stride = [1i64, res[0] as i64, res[0] as i64 * res[1] as i64];
-        // Per axis: cell index, its step and the index past the grid, the wall's plane index k
-        // (as f32), t of plane 0, t between planes, and t of the next wall.
-        let axis = |i: usize| {
-            let idx = start[i] as i32;
-            if !s.moves[i] {
-                return (idx, 0, -1, 0.0f32, 0.0f32, 0.0f32, f32::INFINITY, 0i64);
-            }
-            let base = (g.lo[i] - ray.origin[i]) * s.inv[i];
-            let delta = g.cell[i] * s.inv[i];
-            let (step, out, k) = if s.inv[i] > 0.0 {
-                (1, res[i], (idx + 1) as f32)
-            } else {
-                (-1, -1, idx as f32)
-            };
-            (
-                idx,
-                step,
-                out,
-                k,
-                base,
-                delta,
-                base + k * delta,
-                step as i64 * stride[i],
-            )
-        };
-        let (mut ix, sx, ox, mut kx, bx, dx, mut tx, jx) = axis(0);
-        let (mut iy, sy, oy, mut ky, by, dy, mut ty, jy) = axis(1);
-        let (mut iz, sz, oz, mut kz, bz, dz, mut tz, jz) = axis(2);
-        let mut id = start[0] as i64 + stride[1] * start[1] as i64 + stride[2] * start[2] as i64;
-        let mut t_enter = t0;
-        loop {
-            let t_exit = tx.min(ty).min(tz);
-            if visit(id as usize, t_enter, t_exit.min(t1)) || t_exit >= t1 {
-                return;
-            }
-            t_enter = t_exit;
-            // Ties go to x, then y: the next step takes the other axis, so a ray through an
-            // edge visits one of the two side cells (both are padded to hold what touches it).
-            if tx <= ty && tx <= tz {
-                ix += sx;
-                if ix == ox {
-                    return;
-                }
-                id += jx;
-                kx += sx as f32;
-                tx = bx + kx * dx;
-            } else if ty <= tz {
-                iy += sy;
-                if iy == oy {
-                    return;
-                }
-                id += jy;
-                ky += sy as f32;
-                ty = by + ky * dy;
-            } else {
-                iz += sz;
-                if iz == oz {
-                    return;
-                }
-                id += jz;
-                kz += sz as f32;
-                tz = bz + kz * dz;
-            }
-        }
+    pub(super) fn walk(&self, ray: &Ray, mut visit: impl FnMut(usize, f32, f32) -> bool) {
+        let res = self.cells.lattice.res;
+        dda::walk(&self.cells.lattice, ray, |d, t_enter, t_wall| {
+            visit(d.index(res), t_enter, t_wall.min(d.t_end()))
+        })
     }
 
     /// The nearest hit of one ray.
@@ -215,7 +90,7 @@ impl Grid {
             let g = &self.cells;
             // The walk covers the segment left after the floor.
             let segment = r;
-            self.walk(&segment, &s, |cell, t_enter, t_exit| {
+            self.walk(&segment, |cell, t_enter, t_exit| {
                 c.cells_visited += 1;
                 let list = g.prims_in(cell);
                 if list.is_empty() {
@@ -313,7 +188,7 @@ impl Grid {
         if blocker == u32::MAX && !self.cells.refs.is_empty() {
             let cull = !self.prim_bounds.is_empty();
             let g = &self.cells;
-            self.walk(ray, &s, |cell, t_enter, t_exit| {
+            self.walk(ray, |cell, t_enter, t_exit| {
                 c.cells_visited += 1;
                 let list = g.prims_in(cell);
                 if list.is_empty() {
@@ -375,10 +250,9 @@ fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3, Vec3) {
 /// "cells visited by this pixel's ray").
 #[cfg(test)]
 pub fn cells_along(grid: &Grid, ray: &Ray) -> Vec<[u32; 3]> {
-    let s = RaySetup::new(ray);
-    let r = grid.cells.res;
+    let r = grid.cells.lattice.res;
     let mut out = Vec::new();
-    grid.walk(ray, &s, |c, _, _| {
+    grid.walk(ray, |c, _, _| {
         let c = c as u32;
         out.push([c % r[0], (c / r[0]) % r[1], c / (r[0] * r[1])]);
         false

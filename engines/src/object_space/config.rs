@@ -2,7 +2,8 @@
 //! keys is in the module docs of [`super`]).
 
 use super::machine::{Allocation, Machine};
-use crate::engine::{EngineError, Settings, TriangleTest};
+use crate::engine::{EngineError, Settings};
+use crate::geometry::TriangleTest;
 
 /// 003's Table 4 unit costs and Table 5's frame-buffer costs, in simulation clocks (1 clock =
 /// 25 ns = one byte on a 40 MB/s link; 003 §4.2.1). Every cost is a whole number of clocks

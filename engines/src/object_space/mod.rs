@@ -10,10 +10,11 @@
 //! rays, intensity packets into the frame buffer) is traced by the harness (`rtbench reproduce
 //! yamauchi-*`) with [`ObjectSpace::execute`] and timed with [`sim::simulate`].
 //!
-//! Files: [`config`] (settings, Table 4 costs), [`machine`] (torus, allocations), [`walk`] (the
-//! subspace 3D-DDA), [`trace`] (what execution records), [`sim`] (the event simulation),
+//! Files: [`config`] (settings, Table 4 costs), [`machine`] (torus, allocations), [`trace`] (what execution records), [`sim`] (the event simulation),
 //! [`framebuffer`] (GFB and the cached frame buffer system), [`queueing`] (003's analytic
-//! model of the CFBS and a random-arrival simulation of it).
+//! model of the CFBS and a random-arrival simulation of it). The walk from subspace to subspace
+//! (003 §2.4: "the next subspace is computed with 3DDDA" [Fujimoto et al., ARTS]) is the shared
+//! 3D-DDA, [`crate::geometry::dda`].
 //!
 //! Settings (`key=value`):
 //!
@@ -39,12 +40,12 @@ pub mod machine;
 pub mod queueing;
 pub mod sim;
 pub mod trace;
-pub mod walk;
 
 #[cfg(test)]
 mod tests;
 
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
+use crate::geometry::dda;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::{Geometry, Prim};
 use crate::grid::build::{self, Cells};
@@ -132,7 +133,7 @@ impl ObjectSpace {
     /// Whether `p` lies inside the subspace grid's box.
     pub fn inside(&self, p: glam::Vec3) -> bool {
         let g = &self.subspaces;
-        !g.refs.is_empty() && p.cmpge(g.lo).all() && p.cmple(g.hi).all()
+        !g.refs.is_empty() && p.cmpge(g.lattice.lo).all() && p.cmple(g.lattice.hi).all()
     }
 
     /// Traces one ray through the subspaces, appending a [`Segment`] per subspace visited:
@@ -151,7 +152,9 @@ impl ObjectSpace {
         let mut r = *ray;
         let mut best = u32::MAX;
         let (mut bu, mut bv) = (0.0, 0.0);
-        walk::walk(g, ray, |s, _, t_exit| {
+        let res = g.lattice.res;
+        dda::walk(&g.lattice, ray, |d, _, t_exit| {
+            let s = d.index(res) as u32;
             c.cells_visited += 1;
             let list = g.prims_in(s as usize);
             if list.is_empty() {

@@ -13,11 +13,10 @@
 //!
 //! obvhs counts no nodes; the counters give primitive tests and hits only.
 
-use crate::engine::{
-    BuildInput, Counters, Engine, EngineError, EngineInfo, Settings, TriangleTest,
-};
+use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::Prim;
+use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 use obvhs::aabb::Aabb as OAabb;
 use obvhs::bvh2::Bvh2;

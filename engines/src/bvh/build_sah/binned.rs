@@ -1,0 +1,240 @@
+//! Wald 2007's binned SAH split search.
+
+use super::{axes, split_cost, Range, Split, Splitter};
+use crate::bvh::tree::BuildPrims;
+use crate::geometry::aabb::Aabb;
+use glam::{UVec3, Vec3A};
+
+/// A box in SIMD registers (glam's `Vec3A`): the binned builder's inner loops grow boxes
+/// millions of times, and `Vec3A`'s min/max are single SSE instructions.
+#[derive(Clone, Copy, Debug)]
+struct Box3A {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Box3A {
+    const EMPTY: Box3A = Box3A {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+    };
+
+    #[inline(always)]
+    fn grow(&mut self, b: &Box3A) {
+        self.lo = self.lo.min(b.lo);
+        self.hi = self.hi.max(b.hi);
+    }
+
+    #[inline(always)]
+    fn grow_point(&mut self, p: Vec3A) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    /// The box centre, computed as `BuildPrims` does (`Aabb::centre`).
+    #[inline(always)]
+    fn centre(&self) -> Vec3A {
+        (self.lo + self.hi) * 0.5
+    }
+
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let e = (self.hi - self.lo).max(Vec3A::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.lo.into(), self.hi.into())
+    }
+}
+
+/// Wald 2007's binned SAH: the centroid bounds of the range are cut into `bins` equal bins per
+/// axis; one pass over the primitives counts and bounds them per bin on all three axes, and the
+/// `bins − 1` planes between bins are evaluated with a prefix/suffix sweep over the bins. The
+/// range is then partitioned in place, which also gives both sides' bounds. Primitive boxes
+/// are kept contiguous (Embree's `PrimRef`), with their indices alongside.
+pub struct Binned {
+    boxes: Vec<Box3A>,
+    ids: Vec<u32>,
+    nb: usize,
+    bins: Vec<[Bin; 3]>,
+    right_area: Vec<f32>,
+    right_count: Vec<usize>,
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Box3A,
+    count: usize,
+}
+
+impl Bin {
+    const EMPTY: Bin = Bin {
+        bounds: Box3A::EMPTY,
+        count: 0,
+    };
+}
+
+impl Binned {
+    pub fn new(prims: &BuildPrims, bins: usize) -> Binned {
+        let nb = bins.clamp(2, 256);
+        Binned {
+            boxes: prims
+                .bounds
+                .iter()
+                .map(|b| Box3A {
+                    lo: b.lo.into(),
+                    hi: b.hi.into(),
+                })
+                .collect(),
+            ids: (0..prims.len() as u32).collect(),
+            nb,
+            bins: vec![[Bin::EMPTY; 3]; nb],
+            right_area: vec![0.0; nb],
+            right_count: vec![0; nb],
+        }
+    }
+
+    fn range(&self, start: usize, end: usize) -> Range {
+        let mut bounds = Box3A::EMPTY;
+        let mut centroids = Box3A::EMPTY;
+        for p in &self.boxes[start..end] {
+            bounds.grow(p);
+            centroids.grow_point(p.centre());
+        }
+        Range {
+            start,
+            end,
+            bounds: bounds.aabb(),
+            centroids: centroids.aabb(),
+        }
+    }
+
+    fn median(&mut self, r: &Range, axis: usize) -> Split {
+        let k = r.len() / 2;
+        // Select on (centre, index) pairs, then reorder boxes and indices to match.
+        let mut keyed: Vec<(f32, u32, Box3A)> = (r.start..r.end)
+            .map(|i| (self.boxes[i].centre()[axis], self.ids[i], self.boxes[i]))
+            .collect();
+        keyed.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        for (i, (_, id, b)) in keyed.into_iter().enumerate() {
+            self.ids[r.start + i] = id;
+            self.boxes[r.start + i] = b;
+        }
+        let mid = r.start + k;
+        Split {
+            left: self.range(r.start, mid),
+            right: self.range(mid, r.end),
+            axis,
+            cost: f32::INFINITY,
+        }
+    }
+}
+
+impl Splitter for Binned {
+    fn root(&self) -> Range {
+        self.range(0, self.boxes.len())
+    }
+
+    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
+        debug_assert!(r.len() >= 2);
+        let cb = r.centroids;
+        if median {
+            return self.median(r, axis.unwrap_or_else(|| cb.largest_axis()));
+        }
+        // Small ranges use fewer bins: 2n bins separate n centres about as well as 32, and
+        // clearing and sweeping 3 × 32 bins would dominate the millions of splits near the
+        // leaves.
+        let nb = self.nb.min(2 * r.len());
+        let ext = Vec3A::from(cb.extent());
+        let cb_lo = Vec3A::from(cb.lo);
+        // Bins per unit length on each axis; 0 on a flat axis puts everything in bin 0, where
+        // no plane has primitives on both sides.
+        let scale = Vec3A::select(
+            ext.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(nb as f32 * (1.0 - 1e-6)) / ext,
+            Vec3A::ZERO,
+        );
+        let last = UVec3::splat(nb as u32 - 1);
+        let bin_of = |c: Vec3A| ((c - cb_lo) * scale).max(Vec3A::ZERO).as_uvec3().min(last);
+        self.bins[..nb].fill([Bin::EMPTY; 3]);
+        for p in &self.boxes[r.start..r.end] {
+            let k = bin_of(p.centre());
+            for a in 0..3 {
+                let bin = &mut self.bins[k[a] as usize][a];
+                bin.bounds.grow(p);
+                bin.count += 1;
+            }
+        }
+        let mut best: Option<(usize, u32, f32)> = None; // (axis, plane, Σ A·N)
+        for a in axes(axis) {
+            let mut acc = Box3A::EMPTY;
+            let mut count = 0;
+            for k in (1..nb).rev() {
+                acc.grow(&self.bins[k][a].bounds);
+                count += self.bins[k][a].count;
+                self.right_area[k] = acc.half_area();
+                self.right_count[k] = count;
+            }
+            let mut l = Box3A::EMPTY;
+            let mut lc = 0;
+            for k in 1..nb {
+                l.grow(&self.bins[k - 1][a].bounds);
+                lc += self.bins[k - 1][a].count;
+                let rc = self.right_count[k];
+                if lc > 0 && rc > 0 {
+                    let c = l.half_area() * lc as f32 + self.right_area[k] * rc as f32;
+                    if best.is_none_or(|b| c < b.2) {
+                        best = Some((a, k as u32, c));
+                    }
+                }
+            }
+        }
+        let Some((a, plane, c)) = best else {
+            // All centres coincide (on the allowed axes): any equal-count split.
+            return self.median(r, axis.unwrap_or_else(|| cb.largest_axis()));
+        };
+        // Partition in place, bounding both sides on the way.
+        let boxes = &mut self.boxes[r.start..r.end];
+        let ids = &mut self.ids[r.start..r.end];
+        let (mut i, mut j) = (0, boxes.len());
+        let (mut lb, mut lcb, mut rb, mut rcb) =
+            (Box3A::EMPTY, Box3A::EMPTY, Box3A::EMPTY, Box3A::EMPTY);
+        while i < j {
+            let p = boxes[i];
+            let centre = p.centre();
+            if bin_of(centre)[a] < plane {
+                lb.grow(&p);
+                lcb.grow_point(centre);
+                i += 1;
+            } else {
+                rb.grow(&p);
+                rcb.grow_point(centre);
+                j -= 1;
+                boxes.swap(i, j);
+                ids.swap(i, j);
+            }
+        }
+        let mid = r.start + i;
+        Split {
+            left: Range {
+                start: r.start,
+                end: mid,
+                bounds: lb.aabb(),
+                centroids: lcb.aabb(),
+            },
+            right: Range {
+                start: mid,
+                end: r.end,
+                bounds: rb.aabb(),
+                centroids: rcb.aabb(),
+            },
+            axis: a,
+            cost: split_cost(c, r.bounds.half_area()),
+        }
+    }
+
+    fn into_order(self) -> Vec<u32> {
+        self.ids
+    }
+}

@@ -1,0 +1,223 @@
+//! The one 3D-DDA of rtbench (Amanatides and Woo 1987; seed 000 §1.1 and §1.3, seed 002 §1.5,
+//! seed 003 §2.4): the walk of a ray through the cells of a uniform grid, near to far, used by
+//! the `grid` engine (cells), the breadth-first engine (voxels) and the object-space engine
+//! (subspaces).
+//!
+//! It is resumable: [`Dda`] is the walker's whole state, so a caller can step it, stop, keep it
+//! with the ray and continue later (the breadth-first engine keeps it per ray in memory between
+//! passes, seed 000 §1.3: "per ray: origin, direction and 3DDDA state"). [`walk`] drives it to
+//! the end for the engines that walk a ray in one go.
+//!
+//! Per axis it keeps the t of the next wall and steps across whichever comes first. A wall's t
+//! is computed from its plane index k as `base + k·delta` (base the t of plane 0) rather than
+//! accumulated, so rounding does not drift along long rays. Ties step x, then y, then z: a ray
+//! through an edge visits one of the side cells (registration is padded so both hold what
+//! touches the edge). Stepping spells out the three axes (constant indices), so a walk held in
+//! a local stays in registers.
+
+use crate::ray::Ray;
+use glam::Vec3;
+
+/// Direction components smaller than this count as zero (as the shared slab test's
+/// `MIN_RCP_INPUT`): the ray is taken as parallel to that axis's walls.
+pub const MIN_MOVE: f32 = 1e-18;
+
+/// Which face the walk entered the current cell by: `START` for the first cell.
+pub const START: u8 = 6;
+
+/// A uniform grid's frame, shared by every grid of rtbench (the `grid` engine's cells, the
+/// breadth-first engine's voxels, the object-space engine's subspaces): its box, resolution and
+/// cell size. Cell (x, y, z) has index `x + res_x·(y + res_y·z)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lattice {
+    pub lo: Vec3,
+    pub hi: Vec3,
+    pub res: [u32; 3],
+    pub cell: Vec3,
+    pub inv_cell: Vec3,
+}
+
+impl Lattice {
+    /// The box `lo`–`hi` cut into `res` cells per axis.
+    pub fn new(lo: Vec3, hi: Vec3, res: [u32; 3]) -> Lattice {
+        let resv = Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
+        Lattice {
+            lo,
+            hi,
+            res,
+            cell: (hi - lo) / resv,
+            inv_cell: resv / (hi - lo),
+        }
+    }
+
+    /// The cell coordinates of point `p`, clamped into the grid.
+    #[inline]
+    pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
+        let q = (p - self.lo) * self.inv_cell;
+        [0, 1, 2].map(|i| (q[i].max(0.0) as u32).min(self.res[i] - 1))
+    }
+
+    /// Linear index of cell (x, y, z).
+    #[inline]
+    pub fn index(&self, c: [u32; 3]) -> usize {
+        c[0] as usize
+            + self.res[0] as usize * (c[1] as usize + self.res[1] as usize * c[2] as usize)
+    }
+}
+
+/// The state of one ray's walk: the current cell and, per axis, its step and next wall.
+#[derive(Clone, Copy, Debug)]
+pub struct Dda {
+    /// The current cell (x, y, z).
+    pub idx: [i32; 3],
+    step: [i32; 3],
+    k: [f32; 3],
+    base: [f32; 3],
+    delta: [f32; 3],
+    t_next: [f32; 3],
+    /// End of the walk: the ray's tmax or its exit from the grid.
+    t_end: f32,
+    /// The face the current cell was entered by, as 0–5 (2·axis + 1 when entered moving down
+    /// that axis, i.e. by the cell's max face), or [`START`].
+    pub entered: u8,
+}
+
+impl Dda {
+    /// The walk's first cell (where the segment `[tmin, tmax]` enters the grid's box), or `None`
+    /// when the segment misses the box.
+    #[inline(always)]
+    pub fn start(ray: &Ray, g: &Lattice) -> Option<Dda> {
+        Dda::start_at(ray, g).map(|(d, _)| d)
+    }
+
+    /// [`Dda::start`], and the t where the segment enters the grid's box.
+    #[inline(always)]
+    pub fn start_at(ray: &Ray, g: &Lattice) -> Option<(Dda, f32)> {
+        let d = ray.dir.to_array();
+        let (lo, hi, cell) = (g.lo, g.hi, g.cell);
+        let (mut t0, mut t1) = (ray.tmin, ray.tmax);
+        let mut inv = [0.0f32; 3];
+        for i in 0..3 {
+            let o = ray.origin[i];
+            if d[i].abs() >= MIN_MOVE {
+                inv[i] = 1.0 / d[i];
+                let ta = (lo[i] - o) * inv[i];
+                let tb = (hi[i] - o) * inv[i];
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            } else if o < lo[i] || o > hi[i] {
+                return None;
+            }
+        }
+        if t0.is_nan() || t1.is_nan() || t0 > t1 {
+            return None;
+        }
+        let start = g.cell_of(ray.at(t0));
+        let mut w = Dda {
+            idx: [0; 3],
+            step: [0; 3],
+            k: [0.0; 3],
+            base: [0.0; 3],
+            delta: [0.0; 3],
+            t_next: [f32::INFINITY; 3],
+            t_end: t1,
+            entered: START,
+        };
+        for i in 0..3 {
+            w.idx[i] = start[i] as i32;
+            if d[i].abs() < MIN_MOVE {
+                continue;
+            }
+            w.base[i] = (lo[i] - ray.origin[i]) * inv[i];
+            w.delta[i] = cell[i] * inv[i];
+            if inv[i] > 0.0 {
+                w.step[i] = 1;
+                w.k[i] = (w.idx[i] + 1) as f32;
+            } else {
+                w.step[i] = -1;
+                w.k[i] = w.idx[i] as f32;
+            }
+            w.t_next[i] = w.base[i] + w.k[i] * w.delta[i];
+        }
+        Some((w, t0))
+    }
+
+    /// Where the ray crosses the current cell's exit wall (not clipped to the walk's end).
+    #[inline(always)]
+    pub fn t_wall(&self) -> f32 {
+        self.t_next[0].min(self.t_next[1]).min(self.t_next[2])
+    }
+
+    /// Where the ray leaves the current cell or ends in it.
+    #[inline(always)]
+    pub fn t_exit(&self) -> f32 {
+        self.t_wall().min(self.t_end)
+    }
+
+    /// The end of the walk: the ray's tmax or its exit from the grid.
+    #[inline(always)]
+    pub fn t_end(&self) -> f32 {
+        self.t_end
+    }
+
+    /// The current cell as (x, y, z).
+    #[inline(always)]
+    pub fn voxel(&self) -> [u32; 3] {
+        self.idx.map(|i| i as u32)
+    }
+
+    /// The current cell's index `x + res_x·(y + res_y·z)`.
+    #[inline(always)]
+    pub fn index(&self, res: [u32; 3]) -> usize {
+        let [x, y, z] = self.voxel();
+        x as usize + res[0] as usize * (y as usize + res[1] as usize * z as usize)
+    }
+
+    /// Steps into the next cell; false when the ray ends first or leaves the grid (`res`).
+    #[inline(always)]
+    pub fn advance(&mut self, res: [u32; 3]) -> bool {
+        let (tx, ty, tz) = (self.t_next[0], self.t_next[1], self.t_next[2]);
+        if tx.min(ty).min(tz) >= self.t_end {
+            return false;
+        }
+        if tx <= ty && tx <= tz {
+            self.step_axis::<0>(res)
+        } else if ty <= tz {
+            self.step_axis::<1>(res)
+        } else {
+            self.step_axis::<2>(res)
+        }
+    }
+
+    #[inline(always)]
+    fn step_axis<const A: usize>(&mut self, res: [u32; 3]) -> bool {
+        self.idx[A] += self.step[A];
+        if self.idx[A] < 0 || self.idx[A] >= res[A] as i32 {
+            return false;
+        }
+        self.k[A] += self.step[A] as f32;
+        self.t_next[A] = self.base[A] + self.k[A] * self.delta[A];
+        // Moving up an axis enters by the cell's min face.
+        self.entered = (2 * A + (self.step[A] < 0) as usize) as u8;
+        true
+    }
+}
+
+/// Calls `visit(walk, t_enter, t_wall)` for each cell `ray` crosses within `[tmin, tmax]`, near
+/// to far, until it returns true or the ray leaves the grid or ends. `t_wall` is where the ray
+/// crosses the cell's exit wall (not clipped to the ray's end: clip with [`Dda::t_end`]); the
+/// ray ends in the cell whose `t_wall` reaches it.
+#[inline(always)]
+pub fn walk(g: &Lattice, ray: &Ray, mut visit: impl FnMut(&Dda, f32, f32) -> bool) {
+    let Some((mut d, mut t_enter)) = Dda::start_at(ray, g) else {
+        return;
+    };
+    let res = g.res;
+    loop {
+        let t_wall = d.t_wall();
+        if visit(&d, t_enter, t_wall) || !d.advance(res) {
+            return;
+        }
+        t_enter = t_wall;
+    }
+}
