@@ -100,6 +100,17 @@ pub use crate::grid::config::Floor;
 pub const DEFAULT_MEMORY: u64 = 1 << 30;
 pub const DEFAULT_BUFFER: u64 = 1 << 16;
 
+/// MemTotal + SwapTotal of `/proc/meminfo`, in bytes (None where it cannot be read): no memory
+/// budget above it can be allocated, so none is accepted.
+pub fn machine_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb = |key: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line.split_whitespace().nth(1)?.parse().ok()
+    };
+    Some((kb("MemTotal:")? + kb("SwapTotal:").unwrap_or(0)).saturating_mul(1024))
+}
+
 fn bad(key: &str, value: &str, reason: &str) -> EngineError {
     EngineError::BadValue {
         engine: "breadth-first".into(),
@@ -120,6 +131,22 @@ impl BreadthFirstConfig {
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
+        }
+        if let Some(machine) = machine_memory() {
+            if memory > machine {
+                return Err(bad(
+                    "memory",
+                    &format!("{memory}B"),
+                    &format!("more than this machine's memory and swap ({machine} B)"),
+                ));
+            }
+        }
+        if buffer.saturating_mul(2) > memory {
+            return Err(bad(
+                "buffer",
+                &format!("{buffer}B"),
+                &format!("the two file buffers must fit in memory={memory}B"),
+            ));
         }
         Ok(BreadthFirstConfig {
             memory,

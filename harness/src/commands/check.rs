@@ -41,6 +41,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     }
     let settings = workload::parse_settings(&a.set)?;
     let src = Source::from_args(scene, &a.opts)?;
+    workload::check_scene_fits(&src, a.opts.force)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (tested, _) = workload::build(engine, &prepared.input, settings)?;

@@ -16,6 +16,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         return run_store(a, store, settings);
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
+    workload::check_scene_fits(&src, a.scene.opts.force)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
