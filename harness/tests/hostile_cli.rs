@@ -114,7 +114,7 @@ fn absurd_settings_and_limits_are_refused() {
     ];
     for (set, needle) in [
         ("memory=18446744073709551615B", "memory"),
-        ("buffer=18446744073709551615B", "buffer"),
+        ("buffer=18446744073709551615B", "buffer=18446744073709551615B"),
         ("memory=99999999999999999999999B", "memory"),
     ] {
         let mut args = base.to_vec();
@@ -285,4 +285,94 @@ fn compare_with_nothing_matched_or_runs_lost_is_no_clean_bill() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("B lacks 1"));
+}
+
+/// Rewrites header.json with `edit` and puts its checksum right in both binary files: what a
+/// careless tool (or a hand) would do, so that the header's own checks are what refuses it.
+fn edit_header(store: &str, edit: impl Fn(&str) -> String) {
+    let dir = std::path::Path::new(store);
+    let text = std::fs::read_to_string(dir.join("header.json")).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text);
+    std::fs::write(dir.join("header.json"), &edited).unwrap();
+    // CRC-32 (IEEE), bitwise: the tests need no crate for it.
+    let mut crc = !0u32;
+    for b in edited.bytes() {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 { (crc >> 1) ^ 0xedb8_8320 } else { crc >> 1 };
+        }
+    }
+    for name in ["bbox.bin", "geometry.bin"] {
+        let p = dir.join(name);
+        let mut b = std::fs::read(&p).unwrap();
+        b[12..16].copy_from_slice(&(!crc).to_le_bytes());
+        std::fs::write(&p, &b).unwrap();
+    }
+}
+
+#[test]
+fn corrupt_stores_are_refused() {
+    let d = Dir::new("store");
+    let render = |store: &str, set: &str| {
+        vec![
+            "render".to_string(),
+            "--scene".into(),
+            store.into(),
+            "--engine".into(),
+            "breadth-first".into(),
+            "--size".into(),
+            "16".into(),
+            "--set".into(),
+            set.into(),
+        ]
+    };
+    let fresh = |name: &str| {
+        let store = d.join(name);
+        let out = rtbench(&["scene", "store", "tetra", "--sf", "1", "-o", &store]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        store
+    };
+    let run = |args: Vec<String>, needle: &str| {
+        let a: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        expect_input_error(&a, needle);
+    };
+    // No materials for the objects (was a panic in the out-of-core workload).
+    let s = fresh("nomat");
+    edit_header(&s, |t| {
+        let mut v: serde_json::Value = serde_json::from_str(t).unwrap();
+        v["materials"] = serde_json::json!([]);
+        serde_json::to_string_pretty(&v).unwrap()
+    });
+    run(render(&s, "memory=1MiB"), "no materials");
+    // A record length of 4 GB (was a 4.2 GB allocation), with and without the full check.
+    for verify in ["verify=full", "verify=records"] {
+        let s = fresh(&format!("len-{verify}"));
+        let p = std::path::Path::new(&s).join("geometry.bin");
+        let mut b = std::fs::read(&p).unwrap();
+        b[16..20].copy_from_slice(&[0xf0, 0xff, 0xff, 0xff]);
+        std::fs::write(&p, &b).unwrap();
+        run(render(&s, verify), "does not fit the file");
+    }
+    // "objects": 1 (rendered one object, exit 0).
+    let s = fresh("objects");
+    edit_header(&s, |t| t.replace("\"objects\": 4", "\"objects\": 1"));
+    run(render(&s, "memory=1MiB"), "bbox_bytes");
+    // A flipped bit in header.json, with its checksum left as it was.
+    let s = fresh("flip");
+    let p = std::path::Path::new(&s).join("header.json");
+    let mut b = std::fs::read(&p).unwrap();
+    let at = b.len() / 2;
+    b[at] ^= 4;
+    std::fs::write(&p, &b).unwrap();
+    let out = rtbench(&render(&s, "memory=1MiB").iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    // A view with from = at in the header.
+    let s = fresh("view");
+    edit_header(&s, |t| {
+        let mut v: serde_json::Value = serde_json::from_str(t).unwrap();
+        v["view"]["at"] = v["view"]["from"].clone();
+        serde_json::to_string_pretty(&v).unwrap()
+    });
+    run(render(&s, "memory=1MiB"), "same point");
 }

@@ -93,6 +93,9 @@ pub struct BreadthFirstConfig {
     /// Floor and backdrop polygons in their own group, out of the grid (seed 000 §1.2: "for
     /// balls and tree the base plate was excluded"), or in it.
     pub floor: Floor,
+    /// Check every record of a store when it is opened (`verify=full`, the default), not only
+    /// those the algorithm reads (`verify=records`).
+    pub verify: bool,
 }
 
 pub use crate::grid::config::Floor;
@@ -128,6 +131,12 @@ impl BreadthFirstConfig {
         let buffer = s.get("buffer", Bytes(DEFAULT_BUFFER))?.0;
         let triangle = s.get("triangle", TriangleTest::Watertight)?;
         let floor = s.get("floor", Floor::Out)?;
+        let verify: String = s.get("verify", "full".to_string())?;
+        let verify = match verify.as_str() {
+            "full" => true,
+            "records" => false,
+            v => return Err(bad("verify", v, "full or records")),
+        };
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -143,9 +152,9 @@ impl BreadthFirstConfig {
         }
         if buffer.saturating_mul(2) > memory {
             return Err(bad(
-                "buffer",
-                &format!("{buffer}B"),
-                &format!("the two file buffers must fit in memory={memory}B"),
+                "memory",
+                &format!("{memory}B"),
+                &format!("too small for the two file buffers of buffer={buffer}B"),
             ));
         }
         Ok(BreadthFirstConfig {
@@ -155,6 +164,7 @@ impl BreadthFirstConfig {
             buffer,
             triangle,
             floor,
+            verify,
         })
     }
 }
