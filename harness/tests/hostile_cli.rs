@@ -83,7 +83,7 @@ fn out_of_range_coordinates_and_bad_radii_are_refused_at_load() {
 }
 
 #[test]
-fn nan_rays_are_misses_in_the_wide_bvhs() {
+fn a_valid_scene_agrees_with_embree_in_the_wide_bvhs() {
     // Valid scene, every engine agrees with Embree on the same rays.
     let d = Dir::new("agree");
     let f = d.file("ok.nff", &scene(GOOD_VIEW, "s 0 0 0 1\ns 2 0 0 1\n"));

@@ -6,7 +6,7 @@ use rtbench_tests::fuzz::{corpus_dir, run, Target};
 #[test]
 fn mutated_inputs_never_panic_nor_hang() {
     // One test for the three readers: the driver swaps the process's panic hook while it runs.
-    for (t, n) in [(Target::Nff, 20_000), (Target::Store, 3_000), (Target::Results, 3_000)] {
+    for (t, n) in [(Target::Nff, 5_000), (Target::Store, 800), (Target::Results, 800)] {
         let o = run(t, n, 14, &corpus_dir());
         assert_eq!(o.inputs, n);
         if let Some((input, msg)) = &o.first_panic {

@@ -59,8 +59,29 @@ pub fn build(
     settings: Vec<(String, String)>,
 ) -> Result<(Box<dyn Engine>, f64)> {
     let t = Instant::now();
-    let e = build_engine(name, input, settings)?;
+    let e = stdout_to_stderr(|| build_engine(name, input, settings))?;
     Ok((e, t.elapsed().as_secs_f64()))
+}
+
+/// Runs `f` with file descriptor 1 pointing at stderr: what a library prints on stdout (Embree
+/// with `verbose=1`) must not break `--json`, which owns stdout.
+fn stdout_to_stderr<T>(f: impl FnOnce() -> T) -> T {
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    // SAFETY: dup/dup2/close on descriptors 1 and 2 and on the one dup returns; Rust's stdout is
+    // flushed first, and nothing of ours writes to it until descriptor 1 is restored.
+    let saved = unsafe { libc::dup(1) };
+    if saved < 0 || unsafe { libc::dup2(2, 1) } < 0 {
+        return f();
+    }
+    let r = f();
+    // SAFETY: as above; `saved` is ours and closed once.
+    unsafe {
+        libc::fflush(std::ptr::null_mut());
+        libc::dup2(saved, 1);
+        libc::close(saved);
+    }
+    r
 }
 
 /// Threads this machine runs at once (`std::thread::available_parallelism`, 1 if unknown).
