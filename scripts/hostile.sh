@@ -13,7 +13,7 @@ FLIPS=${2:-200}
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 B=${3:-$ROOT/target/release/rtbench}
 [ -x "$B" ] || { echo "hostile.sh: $B not built (cargo build --release -p rtbench)" >&2; exit 2; }
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/rtbench-hostile.XXXXXX")
+WORK=$(mktemp -d -t rtbench-hostile.XXXXXX)
 trap 'rm -rf "$WORK"' EXIT
 LIMIT_S=10
 MEM_KB=$((4 * 1024 * 1024))

@@ -11,7 +11,7 @@ SEED=${2:-14}
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 B=${3:-$ROOT/target/release/rtbench}
 [ -x "$B" ] || { echo "store_bitflips.sh: $B not built (cargo build --release -p rtbench)" >&2; exit 2; }
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/rtbench-bitflips.XXXXXX")
+WORK=$(mktemp -d -t rtbench-bitflips.XXXXXX)
 trap 'rm -rf "$WORK"' EXIT
 RANDOM=$SEED
 

@@ -114,7 +114,10 @@ fn absurd_settings_and_limits_are_refused() {
     ];
     for (set, needle) in [
         ("memory=18446744073709551615B", "memory"),
-        ("buffer=18446744073709551615B", "buffer=18446744073709551615B"),
+        (
+            "buffer=18446744073709551615B",
+            "buffer=18446744073709551615B",
+        ),
         ("memory=99999999999999999999999B", "memory"),
     ] {
         let mut args = base.to_vec();
@@ -300,7 +303,11 @@ fn edit_header(store: &str, edit: impl Fn(&str) -> String) {
     for b in edited.bytes() {
         crc ^= b as u32;
         for _ in 0..8 {
-            crc = if crc & 1 != 0 { (crc >> 1) ^ 0xedb8_8320 } else { crc >> 1 };
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
         }
     }
     for name in ["bbox.bin", "geometry.bin"] {
@@ -330,7 +337,11 @@ fn corrupt_stores_are_refused() {
     let fresh = |name: &str| {
         let store = d.join(name);
         let out = rtbench(&["scene", "store", "tetra", "--sf", "1", "-o", &store]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         store
     };
     let run = |args: Vec<String>, needle: &str| {
@@ -365,8 +376,18 @@ fn corrupt_stores_are_refused() {
     let at = b.len() / 2;
     b[at] ^= 4;
     std::fs::write(&p, &b).unwrap();
-    let out = rtbench(&render(&s, "memory=1MiB").iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = rtbench(
+        &render(&s, "memory=1MiB")
+            .iter()
+            .map(|s| s.as_str())
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // A view with from = at in the header.
     let s = fresh("view");
     edit_header(&s, |t| {

@@ -46,6 +46,8 @@ pub struct Outcome {
     /// Inputs the reader accepted (the rest it refused with an error).
     pub accepted: u64,
     pub panics: u64,
+    /// Store inputs accepted although a byte differs from their seed: a corruption read as good.
+    pub corrupt_accepted: u64,
     /// The first input that panicked, with the panic's message.
     pub first_panic: Option<(Vec<u8>, String)>,
     pub slowest: Duration,
@@ -272,7 +274,12 @@ pub fn run(target: Target, n: u64, seed: u64, corpus: &Path) -> Outcome {
         o.slowest = o.slowest.max(t.elapsed());
         o.inputs += 1;
         match r {
-            Ok(true) => o.accepted += 1,
+            Ok(true) => {
+                o.accepted += 1;
+                if target == Target::Store && files[which].1 != s[which].1 {
+                    o.corrupt_accepted += 1;
+                }
+            }
             Ok(false) => {}
             Err(p) => {
                 o.panics += 1;

@@ -42,6 +42,20 @@ pub fn prepare(src: &Source) -> Result<Prepared> {
     })
 }
 
+/// `--json` owns stdout: a setting that makes a library print there (Embree's `verbose`, which
+/// writes on stdout from C++) is refused with it.
+pub fn check_json_settings(json: bool, settings: &[(String, String)]) -> Result<()> {
+    if let Some((_, v)) = settings
+        .iter()
+        .find(|(k, v)| json && k == "verbose" && v != "0")
+    {
+        return Err(input(format!(
+            "--set verbose={v}: Embree prints on stdout, which --json owns (drop one of them)"
+        )));
+    }
+    Ok(())
+}
+
 /// Parses `--set key=value` arguments.
 pub fn parse_settings(set: &[String]) -> Result<Vec<(String, String)>> {
     set.iter()
@@ -59,29 +73,8 @@ pub fn build(
     settings: Vec<(String, String)>,
 ) -> Result<(Box<dyn Engine>, f64)> {
     let t = Instant::now();
-    let e = stdout_to_stderr(|| build_engine(name, input, settings))?;
+    let e = build_engine(name, input, settings)?;
     Ok((e, t.elapsed().as_secs_f64()))
-}
-
-/// Runs `f` with file descriptor 1 pointing at stderr: what a library prints on stdout (Embree
-/// with `verbose=1`) must not break `--json`, which owns stdout.
-fn stdout_to_stderr<T>(f: impl FnOnce() -> T) -> T {
-    use std::io::Write;
-    let _ = std::io::stdout().flush();
-    // SAFETY: dup/dup2/close on descriptors 1 and 2 and on the one dup returns; Rust's stdout is
-    // flushed first, and nothing of ours writes to it until descriptor 1 is restored.
-    let saved = unsafe { libc::dup(1) };
-    if saved < 0 || unsafe { libc::dup2(2, 1) } < 0 {
-        return f();
-    }
-    let r = f();
-    // SAFETY: as above; `saved` is ours and closed once.
-    unsafe {
-        libc::fflush(std::ptr::null_mut());
-        libc::dup2(saved, 1);
-        libc::close(saved);
-    }
-    r
 }
 
 /// Threads this machine runs at once (`std::thread::available_parallelism`, 1 if unknown).
