@@ -161,14 +161,17 @@ fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, 
     // coordinates (a sphere at 1e30: index out of bounds in bvh2_to_cwbvh). Scenes are checked at
     // load (rtbench_scenes::validate::MAX_COORD); a scene built another way is refused here, and
     // a panic inside the crate all the same is reported as the peer's failure.
-    if !(extent <= OBVHS_MAX_COORD)
+    if !g.prims.is_empty() && (extent.is_nan() || extent > OBVHS_MAX_COORD)
         || boxes
             .iter()
             .any(|b| !b.lo.iter().chain(&b.hi).all(|x| x.is_finite()))
     {
         return Err(EngineError::Build {
             engine: "obvhs".into(),
-            reason: format!("coordinates up to {extent:e} (the obvhs crate is given at most {OBVHS_MAX_COORD:e})"),
+            reason: format!(
+                "coordinates up to {extent:e} (the obvhs crate is given at most \
+                 {OBVHS_MAX_COORD:e})"
+            ),
         });
     }
     let mut core = Duration::default();

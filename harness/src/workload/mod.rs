@@ -125,7 +125,7 @@ pub fn memory_available() -> Option<u64> {
     };
     // SAFETY: getrlimit writes only into `lim`, which we own.
     let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) };
-    let limit = (rc == 0 && lim.rlim_cur != libc::RLIM_INFINITY).then_some(lim.rlim_cur as u64);
+    let limit = (rc == 0 && lim.rlim_cur != libc::RLIM_INFINITY).then_some(lim.rlim_cur);
     match (mem, limit) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
