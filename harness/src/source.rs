@@ -45,10 +45,11 @@ impl Source {
         let path = PathBuf::from(scene);
         if !scene.ends_with(".nff") && !path.exists() {
             // Neither a program nor a file: say both.
-            return Err(input(format!(
-                "'{}' is no SPD program, nor an NFF file",
-                nff::read::shown_upto(scene, 200)
-            )));
+            let msg = format!(
+                "{}; nor is '{scene}' an NFF file",
+                scene.parse::<Program>().unwrap_err()
+            );
+            return Err(input(nff::read::shown_upto(&msg, 400)));
         }
         if sf.is_some() || hash.is_some() {
             return Err(input(format!(

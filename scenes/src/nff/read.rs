@@ -32,7 +32,14 @@ pub fn shown(t: &str) -> String {
 
 /// [`shown`] with room for `max` characters (file names).
 pub fn shown_upto(t: &str, max: usize) -> String {
-    let mut s: String = t.chars().take(max).flat_map(char::escape_default).collect();
+    let mut s = String::new();
+    for c in t.chars().take(max) {
+        if c.is_control() {
+            s.extend(c.escape_default());
+        } else {
+            s.push(c);
+        }
+    }
     if t.chars().nth(max).is_some() {
         s.push('…');
     }
