@@ -23,6 +23,16 @@ impl Ray {
         }
     }
 
+    /// Origin and direction finite, tmin and tmax not NaN (tmax may be +∞). Engines answer any
+    /// other ray as a miss (not occluded), never by indexing with what a NaN test let through.
+    #[inline(always)]
+    pub fn is_traceable(&self) -> bool {
+        self.origin.is_finite()
+            && self.dir.is_finite()
+            && !self.tmin.is_nan()
+            && !self.tmax.is_nan()
+    }
+
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + self.dir * t
     }

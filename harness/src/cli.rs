@@ -62,7 +62,8 @@ pub struct PlanArgs {
     /// Repeats of each run (min, median, max are reported).
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
-    /// Threads: a list of counts and/or `all`, e.g. `1,all`.
+    /// Threads: a list of counts and/or `all`, e.g. `1,all` (a count above the available
+    /// parallelism is refused).
     #[arg(long, default_value = "1")]
     pub threads: String,
     #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
@@ -135,6 +136,7 @@ pub struct RunOneArgs {
     pub engine: String,
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Threads (at most the available parallelism; more is refused with exit 2).
     #[arg(long)]
     pub threads: Option<usize>,
     #[arg(long, default_value_t = 3)]
@@ -166,6 +168,7 @@ pub struct ReproduceArgs {
     /// (beside the HDD-like 8 ms and the SSD-like 0.1 ms).
     #[arg(long)]
     pub fault_ms: Option<f64>,
+    /// Threads (at most the available parallelism; more is refused with exit 2).
     #[arg(long)]
     pub threads: Option<usize>,
     /// yamauchi-* only: image size of 003's pass (default 512, 128 with --quick).
@@ -242,6 +245,10 @@ pub struct SceneOpts {
     /// mount's hash function.
     #[arg(long, value_parser = parse_hash)]
     pub hash: Option<MountHash>,
+    /// Load a generated scene even when its estimated memory passes what this machine has
+    /// available (render, check, tree-stats refuse it otherwise).
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn parse_hash(s: &str) -> Result<MountHash, String> {
@@ -269,7 +276,7 @@ pub struct RenderArgs {
     /// Image size in pixels (rays go through the (size+1)² pixel corners).
     #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
     pub size: u32,
-    /// Threads for tracing (default: all cores).
+    /// Threads for tracing (default: all cores; more than the machine runs at once is refused).
     #[arg(long)]
     pub threads: Option<usize>,
     #[arg(long)]
@@ -313,6 +320,7 @@ pub struct CheckArgs {
     /// Minimum hit agreement (fraction of rays) for the check to pass (default 0.9999).
     #[arg(long)]
     pub threshold: Option<f64>,
+    /// Threads (at most the available parallelism; more is refused with exit 2).
     #[arg(long)]
     pub threads: Option<usize>,
     #[arg(long)]

@@ -1,5 +1,23 @@
 //! `rtbench`: the command-line harness. See ../shared/CLI.md for the contract.
 
+// Every `print!`/`println!` of this crate goes through these: a failed write to stdout (`> /dev/full`)
+// is kept and reported once at the end (exit 2) instead of std's panic. Defined before the
+// modules so that their textual scope covers them all.
+macro_rules! println {
+    () => {
+        $crate::output::write_stdout(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+macro_rules! print {
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!($($arg)*))
+    };
+}
+
 mod cli;
 mod commands;
 mod error;
@@ -111,7 +129,7 @@ fn main() {
             std::process::exit(2);
         }
     };
-    if let Err(e) = run(cli) {
+    if let Err(e) = run(cli).and_then(|()| output::stdout_status()) {
         eprintln!("rtbench: {e}");
         std::process::exit(e.exit_code());
     }

@@ -54,6 +54,33 @@ pub fn write_png(path: &Path, pixels: &[u8], size: u32) -> Result<()> {
     })
 }
 
+/// The first error writing to stdout (a full disk, a closed pipe when SIGPIPE is ignored):
+/// later writes are skipped and `main` ends with it (exit 2), never a panic.
+static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex::new(None);
+
+/// What the crate's `print!`/`println!` do (they shadow std's, see main.rs): write to stdout,
+/// keeping the first error instead of panicking.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) {
+    let mut failed = STDOUT_ERROR.lock().unwrap_or_else(|e| e.into_inner());
+    if failed.is_some() {
+        return;
+    }
+    let mut o = std::io::stdout().lock();
+    if let Err(e) = o.write_fmt(args) {
+        *failed = Some(e);
+    }
+}
+
+/// Flushes stdout; the first error any write to it met, if any.
+pub fn stdout_status() -> Result<()> {
+    let flushed = std::io::stdout().lock().flush();
+    let mut failed = STDOUT_ERROR.lock().unwrap_or_else(|e| e.into_inner());
+    match failed.take().map_or(flushed, Err) {
+        Ok(()) => Ok(()),
+        Err(e) => Err(input(format!("stdout: cannot write: {e}"))),
+    }
+}
+
 /// Prints one JSON document on stdout (the `--json` contract).
 pub fn print_json(v: &serde_json::Value) {
     println!(

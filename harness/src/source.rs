@@ -2,6 +2,7 @@
 
 use crate::error::{input, Result};
 use rtbench_scenes::spd::{self, MountHash, Options, Program};
+use rtbench_scenes::validate::Validating;
 use rtbench_scenes::{nff, Scene, SceneCollector, Sink};
 use std::path::PathBuf;
 
@@ -44,10 +45,11 @@ impl Source {
         let path = PathBuf::from(scene);
         if !scene.ends_with(".nff") && !path.exists() {
             // Neither a program nor a file: say both.
-            return Err(input(format!(
+            let msg = format!(
                 "{}; nor is '{scene}' an NFF file",
                 scene.parse::<Program>().unwrap_err()
-            )));
+            );
+            return Err(input(nff::read::shown_upto(&msg, 400)));
         }
         if sf.is_some() || hash.is_some() {
             return Err(input(format!(
@@ -59,8 +61,21 @@ impl Source {
                 "--tessellate applies to SPD programs, not to the file {scene}"
             )));
         }
-        if !path.is_file() {
-            return Err(input(format!("{scene}: no such file")));
+        match std::fs::metadata(&path) {
+            Err(e) => return Err(input(format!("{}: {e}", nff::read::shown_upto(scene, 200)))),
+            Ok(m) if m.is_dir() => {
+                return Err(input(format!(
+                    "{}: is a directory",
+                    nff::read::shown_upto(scene, 200)
+                )))
+            }
+            Ok(m) if !m.is_file() => {
+                return Err(input(format!(
+                    "{}: not a regular file",
+                    nff::read::shown_upto(scene, 200)
+                )))
+            }
+            Ok(_) => {}
         }
         Ok(Source::File(path))
     }
@@ -68,7 +83,13 @@ impl Source {
     /// Streams the scene into `sink`, never holding it.
     pub fn stream(&self, sink: &mut dyn Sink) -> Result<()> {
         match self {
-            Source::Program(p, o) => Ok(spd::generate(*p, o, sink)?),
+            Source::Program(p, o) => {
+                // Generated scenes pass the same checks as files (rtbench_scenes::validate).
+                let mut v = Validating::new(sink);
+                spd::generate(*p, o, &mut v)?;
+                v.finish()
+                    .map_err(|e| input(format!("{}: {e}", self.label())))
+            }
             Source::File(path) => Ok(nff::read_nff_file(path, sink)?),
         }
     }

@@ -88,6 +88,14 @@ impl Comparison {
         !self.regressions.is_empty()
     }
 
+    /// Runs of A that B lacks: a set that lost runs is no clean bill (`rtbench compare` exits 1).
+    pub fn missing_in_b(&self) -> usize {
+        self.notes
+            .iter()
+            .filter(|f| f.kind == FindingKind::OnlyInA)
+            .count()
+    }
+
     /// The comparison as Markdown: a verdict, then regressions, improvements and notes as tables.
     pub fn to_markdown(&self) -> String {
         let mut s = String::new();
@@ -112,6 +120,14 @@ impl Comparison {
                 "**{} regression{}.**",
                 self.regressions.len(),
                 if self.regressions.len() == 1 { "" } else { "s" }
+            )
+        } else if self.matched == 0 {
+            "**Nothing compared: no run of A is in B.**".to_string()
+        } else if self.missing_in_b() > 0 {
+            format!(
+                "**No regression in the {} matched runs, but B lacks {} of A's runs.**",
+                self.matched,
+                self.missing_in_b()
             )
         } else {
             "**No regression.**".to_string()

@@ -216,12 +216,17 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>, ReadError> {
             })
         }
     };
+    parse_results(&text, &path.display().to_string())
+}
+
+/// The run records of a results.jsonl text (`path` names it in errors).
+pub fn parse_results(text: &str, path: &str) -> Result<Vec<RunRecord>, ReadError> {
     text.lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
             serde_json::from_str(l).map_err(|e| ReadError::Parse {
-                path: path.display().to_string(),
+                path: path.to_string(),
                 line: i + 1,
                 message: e.to_string(),
             })

@@ -202,6 +202,28 @@ fn failures_and_unmatched_runs_are_reported() {
 }
 
 #[test]
+fn lost_runs_and_no_match_are_no_clean_bill() {
+    let a = base();
+    let mut b = base();
+    b.pop();
+    let c = compare_sets(&a, &b, 5.0);
+    assert!(!c.is_regression());
+    assert_eq!(c.missing_in_b(), 1);
+    assert!(
+        c.to_markdown().contains("B lacks 1 of A's runs"),
+        "{}",
+        c.to_markdown()
+    );
+    let c = compare_sets(&a, &[], 5.0);
+    assert_eq!(c.matched, 0);
+    assert!(
+        c.to_markdown().contains("Nothing compared"),
+        "{}",
+        c.to_markdown()
+    );
+}
+
+#[test]
 fn no_embree_no_time_comparison() {
     let a = vec![run("bvh2", "teapot", 3, 1.0)];
     let mut b = a.clone();

@@ -18,6 +18,7 @@ pub mod nff;
 pub mod sink;
 pub mod spd;
 pub mod triangulate;
+pub mod validate;
 
 pub use model::{Bounds, Light, Material, Object, Scene, Shape, ShapeRef, View};
 pub use sink::{CountingSink, SceneCollector, Sink};

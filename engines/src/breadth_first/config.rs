@@ -94,12 +94,26 @@ pub struct BreadthFirstConfig {
     /// Floor and backdrop polygons in their own group, out of the grid (seed 000 §1.2: "for
     /// balls and tree the base plate was excluded"), or in it.
     pub floor: Floor,
+    /// Check every record of a store when it is opened (`verify=full`, the default), not only
+    /// those the algorithm reads (`verify=records`).
+    pub verify: bool,
 }
 
 pub use crate::grid::config::Floor;
 
 pub const DEFAULT_MEMORY: u64 = 1 << 30;
 pub const DEFAULT_BUFFER: u64 = 1 << 16;
+
+/// MemTotal + SwapTotal of `/proc/meminfo`, in bytes (None where it cannot be read): no memory
+/// budget above it can be allocated, so none is accepted.
+pub fn machine_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb = |key: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line.split_whitespace().nth(1)?.parse().ok()
+    };
+    Some((kb("MemTotal:")? + kb("SwapTotal:").unwrap_or(0)).saturating_mul(1024))
+}
 
 fn bad(key: &str, value: &str, reason: &str) -> EngineError {
     EngineError::BadValue {
@@ -118,9 +132,31 @@ impl BreadthFirstConfig {
         let buffer = s.get("buffer", Bytes(DEFAULT_BUFFER))?.0;
         let triangle = s.get("triangle", TriangleTest::Watertight)?;
         let floor = s.get("floor", Floor::Out)?;
+        let verify: String = s.get("verify", "full".to_string())?;
+        let verify = match verify.as_str() {
+            "full" => true,
+            "records" => false,
+            v => return Err(bad("verify", v, "full or records")),
+        };
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
+        }
+        if let Some(machine) = machine_memory() {
+            if memory > machine {
+                return Err(bad(
+                    "memory",
+                    &format!("{memory}B"),
+                    &format!("more than this machine's memory and swap ({machine} B)"),
+                ));
+            }
+        }
+        if buffer.saturating_mul(2) > memory {
+            return Err(bad(
+                "memory",
+                &format!("{memory}B"),
+                &format!("too small for the two file buffers of buffer={buffer}B"),
+            ));
         }
         Ok(BreadthFirstConfig {
             memory,
@@ -129,6 +165,7 @@ impl BreadthFirstConfig {
             buffer,
             triangle,
             floor,
+            verify,
         })
     }
 }

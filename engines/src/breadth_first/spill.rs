@@ -17,6 +17,7 @@ impl SpillDir {
         let parent = parent
             .map(Path::to_path_buf)
             .unwrap_or_else(std::env::temp_dir);
+        remove_stale(&parent);
         let path = parent.join(format!(
             "rtbench-bf-{}-{}",
             std::process::id(),
@@ -34,6 +35,31 @@ impl SpillDir {
     /// The path as error messages show it.
     pub fn shown(&self) -> String {
         format!("spill directory {}", self.path.display())
+    }
+}
+
+/// Removes the spill directories of processes that are gone (a run killed at its time limit
+/// could not remove its own), where `/proc` tells which processes live.
+fn remove_stale(parent: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix("rtbench-bf-"))
+            .and_then(|n| n.split('-').next())
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
     }
 }
 

@@ -168,6 +168,9 @@ fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bo
     stack: &mut [Entry; STACK_SIZE],
     tally: &mut Tally,
 ) -> Hit {
+    if !ray.is_traceable() {
+        return Hit::MISS;
+    }
     let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
@@ -293,6 +296,9 @@ fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
     stack: &mut [u32; STACK_SIZE],
     tally: &mut Tally,
 ) -> bool {
+    if !ray.is_traceable() {
+        return false;
+    }
     let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);

@@ -119,6 +119,9 @@ pub struct Obvhs {
 /// Widening of the primitives' boxes, relative to the scene's largest coordinate (64 ε).
 const BOX_PAD: f32 = 64.0 * f32::EPSILON;
 
+/// Largest coordinate handed to the obvhs crate (the scene limit, rtbench_scenes::validate).
+const OBVHS_MAX_COORD: f32 = 1e7;
+
 fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, EngineError> {
     let layout = settings.get("layout", Layout::Cwbvh)?;
     let preset = settings.get("preset", Preset("medium"))?;
@@ -153,25 +156,39 @@ fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, 
     if leaf > 0 {
         params.max_prims_per_leaf = leaf;
     }
+    // The crate's compressed wide BVH quantises boxes relative to the scene and panicked on far
+    // coordinates (a sphere at 1e30: index out of bounds in bvh2_to_cwbvh). Scenes are checked at
+    // load (rtbench_scenes::validate::MAX_COORD); a scene built another way is refused here, and
+    // a panic inside the crate all the same is reported as the peer's failure.
+    if !g.prims.is_empty() && (extent.is_nan() || extent > OBVHS_MAX_COORD)
+        || boxes
+            .iter()
+            .any(|b| !b.lo.iter().chain(&b.hi).all(|x| x.is_finite()))
+    {
+        return Err(EngineError::Build {
+            engine: "obvhs".into(),
+            reason: format!(
+                "coordinates up to {extent:e} (the obvhs crate is given at most \
+                 {OBVHS_MAX_COORD:e})"
+            ),
+        });
+    }
     let mut core = Duration::default();
-    let (tree, indices, node_bytes, nodes) = if g.prims.is_empty() {
-        (Tree::Bvh2(Bvh2::default()), Vec::new(), 0, 0)
-    } else {
-        match layout {
-            Layout::Bvh2 => {
-                let t = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut core);
-                let idx = t.primitive_indices.clone();
-                let nb = std::mem::size_of_val(t.nodes.as_slice());
-                let n = t.nodes.len();
-                (Tree::Bvh2(t), idx, nb, n)
-            }
-            Layout::Cwbvh => {
-                let t = obvhs::cwbvh::builder::build_cwbvh(&boxes, params, &mut core);
-                let idx = t.primitive_indices.clone();
-                let nb = std::mem::size_of_val(t.nodes.as_slice());
-                let n = t.nodes.len();
-                (Tree::Cwbvh(t), idx, nb, n)
-            }
+    let built = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        build_tree(&boxes, layout, params, &mut core)
+    }));
+    let (tree, indices, node_bytes, nodes) = match built {
+        Ok(t) => t,
+        Err(p) => {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            return Err(EngineError::Build {
+                engine: "obvhs".into(),
+                reason: format!("the obvhs crate failed while building: {what}"),
+            });
         }
     };
     let prims: Vec<Prim> = indices.iter().map(|&i| g.prims[i as usize]).collect();
@@ -193,6 +210,35 @@ fn build(input: &BuildInput, mut settings: Settings) -> Result<Box<dyn Engine>, 
         triangle,
         stats,
     }))
+}
+
+/// The crate's tree over `boxes`: (tree, primitive order, node bytes, nodes).
+fn build_tree(
+    boxes: &[PrimBox],
+    layout: Layout,
+    params: BvhBuildParams,
+    core: &mut Duration,
+) -> (Tree, Vec<u32>, usize, usize) {
+    if boxes.is_empty() {
+        (Tree::Bvh2(Bvh2::default()), Vec::new(), 0, 0)
+    } else {
+        match layout {
+            Layout::Bvh2 => {
+                let t = obvhs::bvh2::builder::build_bvh2(boxes, params, core);
+                let idx = t.primitive_indices.clone();
+                let nb = std::mem::size_of_val(t.nodes.as_slice());
+                let n = t.nodes.len();
+                (Tree::Bvh2(t), idx, nb, n)
+            }
+            Layout::Cwbvh => {
+                let t = obvhs::cwbvh::builder::build_cwbvh(boxes, params, core);
+                let idx = t.primitive_indices.clone();
+                let nb = std::mem::size_of_val(t.nodes.as_slice());
+                let n = t.nodes.len();
+                (Tree::Cwbvh(t), idx, nb, n)
+            }
+        }
+    }
 }
 
 /// Our ray in obvhs's form. A −0.0 direction component is passed as +0.0 (the same ray): the
@@ -239,6 +285,9 @@ impl Obvhs {
     }
 
     fn closest(&self, ray: &Ray, c: &mut Counters) -> Hit {
+        if !ray.is_traceable() {
+            return Hit::MISS;
+        }
         let wt = WatertightRay::new(ray.dir);
         let mut last = (usize::MAX, 0.0, 0.0);
         let mut hit = RayHit::none();
@@ -266,6 +315,9 @@ impl Obvhs {
     }
 
     fn any(&self, ray: &Ray, c: &mut Counters) -> bool {
+        if !ray.is_traceable() {
+            return false;
+        }
         let wt = WatertightRay::new(ray.dir);
         let mut last = (usize::MAX, 0.0, 0.0);
         let oray = to_oray(ray);

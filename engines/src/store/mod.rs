@@ -2,19 +2,32 @@
 //! by streaming from its generator, never held, as three files in one directory.
 //!
 //! - `header.json`: format version, name, camera, background, lights, materials, object and
-//!   primitive counts, and the bounds of the prepared primitives. Small: no per-object data.
-//! - `bbox.bin`: 16-byte header (`RTBBOX\0\0`, u32 version, u32 record size = 32), then one
-//!   record per object in stream order: its bounding box (6 × f32: min x y z, max x y z, of
-//!   its prepared `f32` primitives) and the byte offset (u64) of its record in `geometry.bin`.
-//! - `geometry.bin`: 16-byte header (`RTGEOM\0\0`, u32 version, u32 0), then one variable-size
-//!   record per object, in the same order: u32 record bytes (this field included), u32
-//!   material index, the [`Surface`] (u8 kind, then f32s), u32 primitive count, and each
-//!   prepared primitive (u8 kind, then its f32s: sphere 4, cone 8, triangle 9).
+//!   primitive counts, the bounds of the prepared primitives, and the byte sizes of the two
+//!   binary files (`bbox_bytes`, `geometry_bytes`). Small: no per-object data.
+//! - `bbox.bin`: 16-byte header, then one 36-byte record per object in stream order: its
+//!   bounding box (6 × f32: min x y z, max x y z, of its prepared `f32` primitives), the byte
+//!   offset (u64) of its record in `geometry.bin`, and a CRC-32 (u32) of the object id (u64)
+//!   followed by the record's first 32 bytes.
+//! - `geometry.bin`: 16-byte header, then one variable-size record per object, in the same
+//!   order: u32 record bytes (this field and the checksum included), u32 material index, the
+//!   [`Surface`] (u8 kind, then f32s), u32 primitive count, each prepared primitive (u8 kind,
+//!   then its f32s: sphere 4, cone 8, triangle 9), and a CRC-32 (u32) of all the record's bytes
+//!   before it.
+//! - Each binary file's header: the magic (`RTBBOX\0\0`, `RTGEOM\0\0`), u32 version, and the
+//!   CRC-32 (u32) of `header.json`'s bytes, which ties the header to the files.
 //!
-//! All numbers little-endian. The object id is the record order (0-based), which is also the
-//! scene's object index: hits name the same object in-memory and from the store. The
-//! primitives are exactly what [`crate::geometry::prims_of`] makes (same triangulation), so the
-//! breadth-first engine tests the same `f32` triangles as every other engine.
+//! All numbers little-endian; CRC-32 is IEEE's (crate `crc32fast`). Reading checks what it can
+//! before trusting it: [`StoreHeader::read`] the header's checksum, the files' sizes against the
+//! header and the object count against the size of `bbox.bin`, and every value against the scene
+//! rules (`rtbench_scenes::validate`); each record read is checked against its checksum, and a
+//! record length is checked against the file before anything is allocated for it;
+//! [`StoreHeader::verify`] reads the whole store once and checks every record, that the records
+//! tile `geometry.bin` exactly and that counts and bounds agree with the header.
+//!
+//! The object id is the record order (0-based), which is also the scene's object index: hits
+//! name the same object in-memory and from the store. The primitives are exactly what
+//! [`crate::geometry::prims_of`] makes (same triangulation), so the breadth-first engine tests
+//! the same `f32` triangles as every other engine.
 
 mod io;
 mod read;
@@ -26,12 +39,15 @@ pub use read::{BboxReader, BboxRecord, GeometryReader, ObjectRecord, StoreHeader
 pub use surface::Surface;
 pub use write::StoreWriter;
 
-/// Format version written in all three files; readers refuse any other.
-pub const VERSION: u32 = 1;
+/// Format version written in all three files; readers refuse any other (2: checksums).
+pub const VERSION: u32 = 2;
 pub const BBOX_MAGIC: &[u8; 8] = b"RTBBOX\0\0";
 pub const GEOMETRY_MAGIC: &[u8; 8] = b"RTGEOM\0\0";
-/// Bytes of a bbox record: 6 × f32 + u64.
-pub const BBOX_RECORD: usize = 32;
+/// Bytes of a bbox record: 6 × f32 + u64 + u32 checksum.
+pub const BBOX_RECORD: usize = 36;
+/// Smallest geometry record: length, material, a surface kind byte, the primitive count and the
+/// checksum.
+pub const MIN_GEOMETRY_RECORD: usize = 17;
 /// Bytes of each file's header.
 pub const FILE_HEADER: u64 = 16;
 

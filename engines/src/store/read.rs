@@ -2,12 +2,14 @@
 //! file with forward-only seeks (seed 000 §4.2.2, "G": geometry is read only when needed).
 
 use super::io::IoFile;
+use super::write::bbox_checksum;
 use super::{
     Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE, GEOMETRY_MAGIC,
-    HEADER_FILE, VERSION,
+    HEADER_FILE, MIN_GEOMETRY_RECORD, VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
+use rtbench_scenes::validate;
 use rtbench_scenes::{Light, Material, View};
 use serde_json::Value;
 use std::io;
@@ -25,6 +27,9 @@ pub struct StoreHeader {
     pub view: View,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
+    /// Sizes of `bbox.bin` and `geometry.bin`, as recorded (and checked against the files).
+    pub bbox_bytes: u64,
+    pub geometry_bytes: u64,
 }
 
 fn bad(dir: &Path, what: impl std::fmt::Display) -> io::Error {
@@ -37,8 +42,8 @@ fn bad(dir: &Path, what: impl std::fmt::Display) -> io::Error {
 impl StoreHeader {
     pub fn read(dir: &Path) -> io::Result<StoreHeader> {
         let path = dir.join(HEADER_FILE);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+        let text = read_bounded(&path, MAX_HEADER_BYTES)?;
+        let crc = crc32fast::hash(text.as_bytes());
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(dir, e))?;
         if v["format"] != "rtbench-store" {
             return Err(bad(dir, "header.json has no \"format\": \"rtbench-store\""));
@@ -76,8 +81,14 @@ impl StoreHeader {
             angle: num(vw, "angle")?,
             hither: num(vw, "hither")?,
             resolution: [
-                res[0].as_u64().unwrap_or(512) as u32,
-                res[1].as_u64().unwrap_or(512) as u32,
+                res[0]
+                    .as_u64()
+                    .and_then(|r| u32::try_from(r).ok())
+                    .ok_or_else(|| bad(dir, "view.resolution"))?,
+                res[1]
+                    .as_u64()
+                    .and_then(|r| u32::try_from(r).ok())
+                    .ok_or_else(|| bad(dir, "view.resolution"))?,
             ],
         };
         let mut lights = Vec::new();
@@ -104,18 +115,173 @@ impl StoreHeader {
         }
         let b = d3(&v["bounds"][0])?.as_vec3();
         let c = d3(&v["bounds"][1])?.as_vec3();
-        Ok(StoreHeader {
+        let count = |k: &str| -> io::Result<u64> {
+            v[k].as_u64()
+                .ok_or_else(|| bad(dir, format!("'{k}' is not a whole number")))
+        };
+        let h = StoreHeader {
             dir: dir.to_path_buf(),
             name: v["name"].as_str().unwrap_or("").to_string(),
-            objects: num(&v, "objects")? as u64,
-            primitives: num(&v, "primitives")? as u64,
+            objects: count("objects")?,
+            primitives: count("primitives")?,
             bounds: [b, c],
             background: d3(&v["background"])?,
             view,
             lights,
             materials,
-        })
+            bbox_bytes: count("bbox_bytes")?,
+            geometry_bytes: count("geometry_bytes")?,
+        };
+        h.check(crc)?;
+        Ok(h)
     }
+
+    /// The header against the scene rules and against the files: their sizes, and the checksum of
+    /// header.json that each file's header carries.
+    fn check(&self, crc: u32) -> io::Result<()> {
+        let dir = &self.dir;
+        let rule = |r: Result<(), String>| r.map_err(|e| bad(dir, format!("header.json: {e}")));
+        rule(validate::check_view(&self.view))?;
+        rule(validate::check_background(self.background))?;
+        for l in &self.lights {
+            rule(validate::check_light(l))?;
+        }
+        for m in &self.materials {
+            rule(validate::check_material(m))?;
+        }
+        if self.objects > u32::MAX as u64 {
+            return Err(bad(
+                dir,
+                format!("{} objects (at most 2^32 − 1)", self.objects),
+            ));
+        }
+        if self.objects > 0 && self.materials.is_empty() {
+            return Err(bad(dir, "header.json: objects but no materials"));
+        }
+        let want_bbox = FILE_HEADER + self.objects * BBOX_RECORD as u64;
+        if self.bbox_bytes != want_bbox {
+            return Err(bad(
+                dir,
+                format!(
+                    "header.json: bbox_bytes {} for {} objects (expected {want_bbox})",
+                    self.bbox_bytes, self.objects
+                ),
+            ));
+        }
+        if self.objects > 0 && !(self.bounds[0].is_finite() && self.bounds[1].is_finite()) {
+            return Err(bad(dir, "header.json: bounds are not finite"));
+        }
+        for (name, want) in [
+            (BBOX_FILE, self.bbox_bytes),
+            (GEOMETRY_FILE, self.geometry_bytes),
+        ] {
+            let path = dir.join(name);
+            let mut f = std::fs::File::open(&path)
+                .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+            let size = f.metadata()?.len();
+            if size != want {
+                return Err(bad(
+                    dir,
+                    format!("{name} has {size} bytes, header.json says {want}"),
+                ));
+            }
+            let mut h = [0u8; FILE_HEADER as usize];
+            std::io::Read::read_exact(&mut f, &mut h)
+                .map_err(|_| bad(dir, format!("{name} is shorter than its header")))?;
+            if u32::from_le_bytes(h[12..16].try_into().unwrap()) != crc {
+                return Err(bad(
+                    dir,
+                    format!("{name} does not match header.json (checksum)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the whole store once (its own buffers, outside any engine's I/O counters) and checks
+    /// every record: its checksum and values, that the geometry records tile `geometry.bin` in
+    /// object order, that each box is its primitives' box, and that the object and primitive
+    /// counts and the bounds are the header's. Returns the bytes read.
+    pub fn verify(&self) -> io::Result<u64> {
+        let mut bbox = BboxReader::open(&self.dir, self.objects, 1 << 16)?;
+        let mut geometry = GeometryReader::open(&self.dir, 1 << 16)?;
+        let mut rec = ObjectRecord::default();
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let mut next = FILE_HEADER;
+        let mut prims = 0u64;
+        while let Some((id, b)) = bbox.next_record()? {
+            if b.offset != next {
+                return Err(bad(
+                    &self.dir,
+                    format!("bbox record {id}: offset {} (expected {next})", b.offset),
+                ));
+            }
+            geometry.read_at(b.offset, &mut rec)?;
+            next = geometry.file.position();
+            let (mut a, mut c) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            for p in &rec.prims {
+                let (pa, pc) = p.bounds();
+                a = a.min(pa);
+                c = c.max(pc);
+            }
+            if (a, c) != (b.lo, b.hi) {
+                return Err(bad(
+                    &self.dir,
+                    format!("bbox record {id} is not its primitives' box"),
+                ));
+            }
+            if (rec.material as usize) >= self.materials.len() {
+                return Err(bad(
+                    &self.dir,
+                    format!(
+                        "object {id} names material {} of {}",
+                        rec.material,
+                        self.materials.len()
+                    ),
+                ));
+            }
+            if !rec.prims.is_empty() {
+                lo = lo.min(a);
+                hi = hi.max(c);
+            }
+            prims += rec.prims.len() as u64;
+        }
+        if next != self.geometry_bytes {
+            return Err(bad(
+                &self.dir,
+                format!(
+                    "geometry records end at {next}, the file at {}",
+                    self.geometry_bytes
+                ),
+            ));
+        }
+        if prims != self.primitives || (prims > 0 && [lo, hi] != self.bounds) {
+            return Err(bad(
+                &self.dir,
+                "header.json's primitive count or bounds differ from the records",
+            ));
+        }
+        Ok(bbox.file.io.bytes_read + geometry.file.io.bytes_read)
+    }
+}
+
+/// Largest header.json read (it holds no per-object data: lights and materials only).
+const MAX_HEADER_BYTES: u64 = 64 << 20;
+
+/// A text file of at most `max` bytes, its size checked before reading.
+fn read_bounded(path: &Path, max: u64) -> io::Result<String> {
+    let shown = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+    let f = std::fs::File::open(path).map_err(shown)?;
+    let size = f.metadata().map_err(shown)?.len();
+    if size > max {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("{}: {size} bytes (at most {max})", path.display()),
+        ));
+    }
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut std::io::Read::take(f, max), &mut text).map_err(shown)?;
+    Ok(text)
 }
 
 fn check_file_header(f: &mut IoFile, magic: &[u8; 8], path: &Path) -> io::Result<()> {
@@ -173,6 +339,13 @@ impl BboxReader {
         }
         let mut b = [0u8; BBOX_RECORD];
         self.file.read_exact(&mut b)?;
+        let crc = u32::from_le_bytes(b[32..36].try_into().unwrap());
+        if bbox_checksum(self.next_id, &b[..32]) != crc {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("bbox record {}: checksum mismatch", self.next_id),
+            ));
+        }
         let f = |i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
         let id = self.next_id as u32;
         self.next_id += 1;
@@ -200,16 +373,20 @@ pub struct ObjectRecord {
 pub struct GeometryReader {
     pub file: IoFile,
     scratch: Vec<u8>,
+    /// The file's size: no record length past it is believed.
+    size: u64,
 }
 
 impl GeometryReader {
     pub fn open(dir: &Path, buffer: usize) -> io::Result<GeometryReader> {
         let path = dir.join(GEOMETRY_FILE);
+        let size = std::fs::metadata(&path)?.len();
         let mut file = IoFile::open(&path, buffer)?;
         check_file_header(&mut file, GEOMETRY_MAGIC, &path)?;
         Ok(GeometryReader {
             file,
             scratch: Vec::new(),
+            size,
         })
     }
 
@@ -229,16 +406,31 @@ impl GeometryReader {
         self.file.seek_to(offset)?;
         let mut len = [0u8; 4];
         self.file.read_exact(&mut len)?;
+        let len_bytes = len;
         let len = u32::from_le_bytes(len) as usize;
-        if len < 13 {
+        // Checked before anything is allocated for it: a corrupt length asked for gigabytes.
+        if len < MIN_GEOMETRY_RECORD || offset.saturating_add(len as u64) > self.size {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
-                "geometry record too short",
+                format!(
+                    "geometry record at {offset}: length {len} does not fit the file ({} bytes)",
+                    self.size
+                ),
             ));
         }
         self.scratch.resize(len - 4, 0);
         self.file.read_exact(&mut self.scratch)?;
-        decode_record(&self.scratch, out).ok_or_else(|| {
+        let (body, crc) = self.scratch.split_at(len - 8);
+        let mut h = crc32fast::Hasher::new();
+        h.update(&len_bytes);
+        h.update(body);
+        if h.finalize() != u32::from_le_bytes(crc.try_into().unwrap()) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("geometry record at {offset}: checksum mismatch"),
+            ));
+        }
+        decode_record(body, out).ok_or_else(|| {
             io::Error::new(
                 io::ErrorKind::InvalidData,
                 format!("geometry record at {offset} is malformed"),
@@ -308,5 +500,23 @@ fn decode_record(b: &[u8], out: &mut ObjectRecord) -> Option<()> {
             _ => return None,
         });
     }
-    c.0.is_empty().then_some(())
+    // The scene rules (rtbench_scenes::validate), on what was stored.
+    let max = validate::MAX_COORD as f32;
+    let point = |p: Vec3| p.is_finite() && p.abs().max_element() <= max;
+    let ok = out.prims.iter().all(|p| match *p {
+        Prim::Sphere { center, radius } => point(center) && radius > 0.0 && radius <= max,
+        Prim::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+        } => {
+            point(base)
+                && point(apex)
+                && (0.0..=max).contains(&base_radius)
+                && (0.0..=max).contains(&apex_radius)
+        }
+        Prim::Triangle(t) => t.iter().all(|&v| point(v)),
+    });
+    (ok && c.0.is_empty()).then_some(())
 }

@@ -98,3 +98,84 @@ fn refuses_what_is_not_a_store() {
     std::fs::write(dir.0.join(BBOX_FILE), b"RTGEOM\0\0\x01\0\0\0\0\0\0\0").unwrap();
     assert!(BboxReader::open(&dir.0, 0, 64).is_err());
 }
+
+/// A small store of `program` at `sf`, written into `dir`.
+fn write_store(dir: &TempDir, program: Program, sf: u32) {
+    let opts = Options {
+        size_factor: sf,
+        ..Options::standard(program)
+    };
+    let mut w = StoreWriter::create(&dir.0, "x").unwrap();
+    spd::generate(program, &opts, &mut w).unwrap();
+    w.finish().unwrap();
+}
+
+/// Opening and verifying, as the breadth-first engine does with `verify=full`.
+fn open_and_verify(dir: &std::path::Path) -> std::io::Result<u64> {
+    StoreHeader::read(dir)?.verify()
+}
+
+#[test]
+fn every_bit_flip_is_refused() {
+    let dir = TempDir::new("flips");
+    write_store(&dir, Program::Tree, 2);
+    assert!(open_and_verify(&dir.0).is_ok());
+    // A fixed pseudo-random sequence (xorshift), so that a failure reproduces.
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    for k in 0..300 {
+        let name = [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE][k % 3];
+        let path = dir.0.join(name);
+        let orig = std::fs::read(&path).unwrap();
+        let mut bytes = orig.clone();
+        let bit = (next() % (bytes.len() as u64 * 8)) as usize;
+        bytes[bit / 8] ^= 1 << (bit % 8);
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(
+            open_and_verify(&dir.0).is_err(),
+            "flip of bit {bit} of {name} accepted"
+        );
+        std::fs::write(&path, &orig).unwrap();
+    }
+}
+
+#[test]
+fn record_lengths_are_checked_before_allocating() {
+    let dir = TempDir::new("len");
+    write_store(&dir, Program::Tetra, 1);
+    let path = dir.0.join(GEOMETRY_FILE);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[16..20].copy_from_slice(&[0xf0, 0xff, 0xff, 0xff]);
+    std::fs::write(&path, &bytes).unwrap();
+    let mut geo = GeometryReader::open(&dir.0, 4096).unwrap();
+    let e = geo
+        .read_at(FILE_HEADER, &mut ObjectRecord::default())
+        .unwrap_err();
+    assert!(e.to_string().contains("does not fit the file"), "{e}");
+}
+
+#[test]
+fn a_header_that_disagrees_with_the_files_is_refused() {
+    let dir = TempDir::new("objects");
+    write_store(&dir, Program::Tetra, 1);
+    let path = dir.0.join(HEADER_FILE);
+    let text = std::fs::read_to_string(&path).unwrap();
+    // The case: "objects": 1, even with the checksum put right.
+    let edited = text.replace("\"objects\": 4", "\"objects\": 1");
+    assert_ne!(edited, text);
+    std::fs::write(&path, &edited).unwrap();
+    let crc = crc32fast::hash(edited.as_bytes()).to_le_bytes();
+    for name in [BBOX_FILE, GEOMETRY_FILE] {
+        let p = dir.0.join(name);
+        let mut b = std::fs::read(&p).unwrap();
+        b[12..16].copy_from_slice(&crc);
+        std::fs::write(&p, &b).unwrap();
+    }
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    assert!(e.contains("bbox_bytes"), "{e}");
+}

@@ -46,6 +46,14 @@ fn v3(out: &mut Vec<u8>, v: Vec3) {
     f32s(out, &v.to_array());
 }
 
+/// The checksum of bbox record `id` (its first 32 bytes, `rec`).
+pub(super) fn bbox_checksum(id: u64, rec: &[u8]) -> u32 {
+    let mut h = crc32fast::Hasher::new();
+    h.update(&id.to_le_bytes());
+    h.update(rec);
+    h.finalize()
+}
+
 /// The 16-byte header of a binary file of the store.
 fn file_header(magic: &[u8; 8], extra: u32) -> [u8; 16] {
     let mut h = [0u8; 16];
@@ -61,7 +69,8 @@ impl StoreWriter {
         std::fs::create_dir_all(dir)?;
         let mut bbox = IoFile::create(&dir.join(BBOX_FILE), WRITE_BUFFER)?;
         let mut geometry = IoFile::create(&dir.join(GEOMETRY_FILE), WRITE_BUFFER)?;
-        bbox.write_all(&file_header(BBOX_MAGIC, super::BBOX_RECORD as u32))?;
+        // The header's checksum goes in at `finish`, when header.json is written.
+        bbox.write_all(&file_header(BBOX_MAGIC, 0))?;
         geometry.write_all(&file_header(GEOMETRY_MAGIC, 0))?;
         Ok(StoreWriter {
             dir: dir.to_path_buf(),
@@ -114,14 +123,19 @@ impl StoreWriter {
         for p in &self.prims {
             encode_prim(r, p);
         }
-        let len = r.len() as u32;
+        let len = u32::try_from(r.len() + 4)
+            .map_err(|_| io::Error::other("an object's record passes 4 GiB"))?;
         r[..4].copy_from_slice(&len.to_le_bytes());
+        let crc = crc32fast::hash(r);
+        r.extend_from_slice(&crc.to_le_bytes());
         let offset = self.geometry.written();
         self.geometry.write_all(r)?;
         let mut b = Vec::with_capacity(super::BBOX_RECORD);
         v3(&mut b, lo);
         v3(&mut b, hi);
         b.extend_from_slice(&offset.to_le_bytes());
+        let crc = bbox_checksum(self.objects, &b);
+        b.extend_from_slice(&crc.to_le_bytes());
         self.bbox.write_all(&b)?;
         if !self.prims.is_empty() {
             self.lo = self.lo.min(lo);
@@ -137,6 +151,8 @@ impl StoreWriter {
         if let Some(e) = self.error {
             return Err(e);
         }
+        let bbox_bytes = self.bbox.written();
+        let geometry_bytes = self.geometry.written();
         let mut io = self.bbox.finish()?;
         io.add(&self.geometry.finish()?);
         let v = &self.view;
@@ -148,6 +164,8 @@ impl StoreWriter {
             "objects": self.objects,
             "primitives": self.prims_total,
             "bounds": [self.lo.to_array(), self.hi.to_array()],
+            "bbox_bytes": bbox_bytes,
+            "geometry_bytes": geometry_bytes,
             "background": d3(self.background),
             "view": {"from": d3(v.from), "at": d3(v.at), "up": d3(v.up), "angle": v.angle,
                      "hither": v.hither, "resolution": v.resolution},
@@ -161,6 +179,18 @@ impl StoreWriter {
         std::fs::write(self.dir.join(HEADER_FILE), &text)?;
         io.bytes_written += text.len() as u64;
         io.write_calls += 1;
+        // Tie the header to the files: its checksum in both files' headers.
+        let crc = crc32fast::hash(text.as_bytes()).to_le_bytes();
+        for name in [BBOX_FILE, GEOMETRY_FILE] {
+            use std::os::unix::fs::FileExt;
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(self.dir.join(name))?;
+            f.write_all_at(&crc, 12)?;
+            f.sync_data()?;
+            io.bytes_written += 4;
+            io.write_calls += 1;
+        }
         Ok(io)
     }
 }

@@ -11,11 +11,13 @@ use sha2::{Digest, Sha256};
 pub fn run(a: &RenderArgs) -> Result<()> {
     workload::check_size(a.size)?;
     let settings = workload::parse_settings(&a.set)?;
+    workload::check_json_settings(a.json, &settings)?;
     let store = std::path::Path::new(&a.scene.scene);
     if store.join(rtbench_engines::store::HEADER_FILE).is_file() {
         return run_store(a, store, settings);
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
+    workload::check_scene_fits(&src, a.scene.opts.force)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;

@@ -114,6 +114,10 @@ fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
                     "--threads '{}': expected counts ≥ 1 or 'all'",
                     p.threads
                 ))),
+                Ok(n) if n > workload::available_threads() => Err(input(format!(
+                    "--threads {n}: more than the {} this machine runs at once",
+                    workload::available_threads()
+                ))),
                 Ok(n) => Ok(Some(n)),
             },
         })
@@ -284,6 +288,13 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
         )));
     }
     let c = rtbench_reports::compare(&a.a, &a.b, a.threshold).map_err(|e| input(e.to_string()))?;
+    if c.matched == 0 {
+        return Err(input(format!(
+            "{} and {}: no run of A is in B, nothing compared",
+            a.a.display(),
+            a.b.display()
+        )));
+    }
     if a.json {
         print_json(&serde_json::to_value(&c).expect("comparison serialises"));
     } else {
@@ -292,6 +303,12 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
     if c.is_regression() {
         let names: Vec<String> = c.regressions.iter().map(|f| f.message.clone()).collect();
         return Err(Failure::Check(format!("regression: {}", names.join("; "))));
+    }
+    if c.missing_in_b() > 0 {
+        return Err(Failure::Check(format!(
+            "B lacks {} of A's runs (see the notes)",
+            c.missing_in_b()
+        )));
     }
     Ok(())
 }

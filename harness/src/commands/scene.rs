@@ -8,7 +8,6 @@ use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
 use serde_json::json;
-use std::io::Write;
 use std::path::Path;
 
 pub fn list(as_json: bool) -> Result<()> {
@@ -124,6 +123,10 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
     std::fs::rename(&tmp, out)
         .map_err(|e| cleanup(format!("{}: cannot rename into place: {e}", out.display())))?;
     let header = StoreHeader::read(out).map_err(|e| input(e.to_string()))?;
+    if header.objects == 0 {
+        let _ = std::fs::remove_dir_all(out);
+        return Err(input(format!("{}: the scene has no objects", src.label())));
+    }
     let secs = start.elapsed().as_secs_f64();
     let v = json!({
         "store": out.display().to_string(),
@@ -154,6 +157,9 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
 pub fn stats(src: &Source, as_json: bool) -> Result<()> {
     let mut c = CountingSink::default();
     src.stream(&mut c)?;
+    if c.counts.objects() == 0 {
+        return Err(input(format!("{}: the scene has no objects", src.label())));
+    }
     let bounds = c
         .bounds
         .map(|b| json!([[b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]]));
@@ -176,19 +182,16 @@ pub fn stats(src: &Source, as_json: bool) -> Result<()> {
         print_json(&v);
     } else {
         let k = &c.counts;
-        let mut o = std::io::stdout().lock();
-        let _ = writeln!(o, "scene      {}", src.label());
-        let _ = writeln!(o, "objects    {}", k.objects());
-        let _ = writeln!(
-            o,
+        println!("scene      {}", src.label());
+        println!("objects    {}", k.objects());
+        println!(
             "  spheres  {}\n  cones    {}\n  polygons {}\n  patches  {}",
             k.sphere, k.cone, k.polygon, k.patch
         );
-        let _ = writeln!(o, "triangles  {}", k.triangles);
-        let _ = writeln!(o, "lights     {}", c.lights);
+        println!("triangles  {}", k.triangles);
+        println!("lights     {}", c.lights);
         if let Some(b) = c.bounds {
-            let _ = writeln!(
-                o,
+            println!(
                 "bounds     [{} {} {}] .. [{} {} {}]",
                 b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
             );

@@ -42,6 +42,20 @@ pub fn prepare(src: &Source) -> Result<Prepared> {
     })
 }
 
+/// `--json` owns stdout: a setting that makes a library print there (Embree's `verbose`, which
+/// writes on stdout from C++) is refused with it.
+pub fn check_json_settings(json: bool, settings: &[(String, String)]) -> Result<()> {
+    if let Some((_, v)) = settings
+        .iter()
+        .find(|(k, v)| json && k == "verbose" && v != "0")
+    {
+        return Err(input(format!(
+            "--set verbose={v}: Embree prints on stdout, which --json owns (drop one of them)"
+        )));
+    }
+    Ok(())
+}
+
 /// Parses `--set key=value` arguments.
 pub fn parse_settings(set: &[String]) -> Result<Vec<(String, String)>> {
     set.iter()
@@ -63,10 +77,25 @@ pub fn build(
     Ok((e, t.elapsed().as_secs_f64()))
 }
 
-/// A rayon pool with `threads` threads (all cores when `None`).
+/// Threads this machine runs at once (`std::thread::available_parallelism`, 1 if unknown).
+pub fn available_threads() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+}
+
+/// A rayon pool with `threads` threads (all cores when `None`). More threads than the machine
+/// runs at once are refused: they measure nothing but the scheduler (100,000 made a load
+/// average of 800 on two cores before failing).
 pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     if threads == Some(0) {
         return Err(input("--threads must be at least 1"));
+    }
+    let most = available_threads();
+    if let Some(n) = threads.filter(|&n| n > most) {
+        return Err(input(format!(
+            "--threads {n}: more than the {most} this machine runs at once"
+        )));
     }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
@@ -74,9 +103,76 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .map_err(|e| input(format!("cannot start threads: {e}")))
 }
 
+/// Bytes the workload holds per pixel corner, at least: measured 80 (in-memory engines) to 210
+/// (breadth-first) at --size 2048 (corners, rays, hits, paths, shading records), rounded up.
+pub const BYTES_PER_CORNER: u64 = 256;
+
+/// Bytes an in-memory run holds per scene object, at least: measured 330 (embree, spheres) to
+/// 1,640 (bvh8, gears' polygons) at 0.1 to 1 million objects; the lower figure, rounded down.
+pub const BYTES_PER_OBJECT: u64 = 300;
+
+/// Memory this process can still have: the smaller of the machine's available memory
+/// (`MemAvailable`) and the address-space limit (`ulimit -v`). None when neither is known.
+pub fn memory_available() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+        let line = t.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok()
+    });
+    let mem = meminfo.map(|kb| kb.saturating_mul(1024));
+    let mut lim = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes only into `lim`, which we own.
+    let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) };
+    let limit = (rc == 0 && lim.rlim_cur != libc::RLIM_INFINITY).then_some(lim.rlim_cur);
+    match (mem, limit) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+fn gib(b: u64) -> String {
+    format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
+}
+
+/// `--size`: from 1 to 16384, and an image whose workload fits in the memory available.
 pub fn check_size(size: u32) -> Result<()> {
     if !(1..=16384).contains(&size) {
         return Err(input(format!("--size {size}: must be from 1 to 16384")));
+    }
+    let corners = (size as u64 + 1).pow(2);
+    let need = corners * BYTES_PER_CORNER;
+    if let Some(have) = memory_available().filter(|&have| need > have) {
+        return Err(input(format!(
+            "--size {size}: the workload needs at least {} ({BYTES_PER_CORNER} B per pixel \
+             corner), {} is available",
+            gib(need),
+            gib(have)
+        )));
+    }
+    Ok(())
+}
+
+/// A generated scene about to be held in memory fits in the memory available, by the estimate
+/// [`BYTES_PER_OBJECT`] (`--sf 40` of tree ran the machine out of memory); `force` skips this.
+pub fn check_scene_fits(src: &Source, force: bool) -> Result<()> {
+    let Source::Program(p, o) = src else {
+        return Ok(());
+    };
+    if force {
+        return Ok(());
+    }
+    let objects = p.object_count(o.size_factor).unwrap_or(u64::MAX);
+    let need = objects.saturating_mul(BYTES_PER_OBJECT);
+    if let Some(have) = memory_available().filter(|&have| need > have) {
+        return Err(input(format!(
+            "{}: {objects} objects need at least {} in memory, {} is available (--force to \
+             try anyway)",
+            src.label(),
+            gib(need),
+            gib(have)
+        )));
     }
     Ok(())
 }

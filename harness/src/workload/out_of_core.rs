@@ -324,9 +324,21 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
                     loaded = hit.object;
                 }
                 let (ray, path) = &group[k as usize];
-                let surface = record.surface.expect("decoded records have a surface");
+                let surface = record
+                    .surface
+                    .ok_or_else(|| io::Error::other("record without a surface"))?;
                 let p = ray.at(hit.t);
-                let m = &h.materials[record.material as usize];
+                let m = h.materials.get(record.material as usize).ok_or_else(|| {
+                    io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!(
+                            "object {} names material {} of {} in header.json",
+                            hit.object,
+                            record.material,
+                            h.materials.len()
+                        ),
+                    )
+                })?;
                 g.hits += 1;
                 term[k as usize] = shade_hit(
                     ray,

@@ -111,18 +111,24 @@ fn bounds(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     if !lo.is_finite() {
         return if log { (0.1, 10.0) } else { (0.0, 1.0) };
     }
+    // Padded, but never past the finite doubles (a figure of 1e308 made the axis infinite and
+    // its ticks endless).
     if log {
-        if hi / lo < 1.01 {
+        let (a, b) = if hi / lo < 1.01 {
             (lo / 2.0, hi * 2.0)
         } else {
             let pad = (hi / lo).powf(0.06);
             (lo / pad, hi * pad)
-        }
-    } else if hi - lo < 1e-12 * hi.abs().max(1.0) {
-        (lo - 1.0, hi + 1.0)
+        };
+        (a.max(f64::MIN_POSITIVE), b.min(f64::MAX))
     } else {
-        let pad = (hi - lo) * 0.06;
-        (lo - pad, hi + pad)
+        let (a, b) = if hi - lo < 1e-12 * hi.abs().max(1.0) {
+            (lo - 1.0, hi + 1.0)
+        } else {
+            let pad = (hi - lo) * 0.06;
+            (lo - pad, hi + pad)
+        };
+        (a.max(-f64::MAX / 4.0), b.min(f64::MAX / 4.0))
     }
 }
 

@@ -5,7 +5,17 @@
 /// first gives three to twelve), every few decades on a wide range, evenly spaced round numbers on a range
 /// too narrow for any of those; grid lines at 1…9 × 10^k.
 pub fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
-    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    // Decades of the finite positive doubles only: an infinite or zero end made the range of
+    // decades i32::MAX long (a report with a figure of 1e308 never ended).
+    let decade = |x: f64, round: fn(f64) -> f64| {
+        let d = round(x.log10());
+        if d.is_nan() {
+            0
+        } else {
+            d.clamp(-330.0, 310.0) as i32
+        }
+    };
+    let (k0, k1) = (decade(lo, f64::floor), decade(hi, f64::ceil));
     let within = |mults: &[f64], step: i32| -> Vec<f64> {
         (k0..=k1)
             .filter(|k| (k - k0) % step == 0)
@@ -74,5 +84,15 @@ mod tests {
         assert_eq!(wide.len(), 8, "every fourth decade: {wide:?}");
         assert!((wide[1] / wide[0] - 1e4).abs() < 1e-6);
         assert_eq!(linear_ticks(59.0, 62.5), [59.0, 60.0, 61.0, 62.0]);
+        // Extreme ends end, with few ticks.
+        for (lo, hi) in [
+            (1e-3, f64::INFINITY),
+            (0.0, 1e308),
+            (f64::NAN, 1.0),
+            (1e-300, 1e308),
+        ] {
+            let (bold, light) = log_ticks(lo, hi);
+            assert!(bold.len() <= 100 && light.len() <= 1000, "{lo} {hi}");
+        }
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::model::{Light, Material, ShapeRef, View};
 use crate::sink::Sink;
+use crate::validate;
 use glam::DVec3;
 use std::io::Read;
 use std::path::Path;
@@ -18,9 +19,32 @@ pub struct NffError {
     pub message: String,
 }
 
-/// Largest vertex count accepted for one polygon (guards against a corrupt count asking for
-/// gigabytes).
-const MAX_VERTICES: usize = 1 << 20;
+/// Largest vertex count accepted for one polygon. A corrupt count must not ask for gigabytes, and
+/// triangulating a concave polygon (ear clipping) is quadratic: 0.8 s for a 16,384-vertex star
+/// polygon, where 100,000 vertices took 18.9 s. The SPD's largest polygons have 144 vertices.
+pub const MAX_VERTICES: usize = 1 << 14;
+
+/// A token as errors show it: at most 40 characters (then `…`), control characters escaped, so
+/// that one error stays one short line whatever the input holds.
+pub fn shown(t: &str) -> String {
+    shown_upto(t, 40)
+}
+
+/// [`shown`] with room for `max` characters (file names).
+pub fn shown_upto(t: &str, max: usize) -> String {
+    let mut s = String::new();
+    for c in t.chars().take(max) {
+        if c.is_control() {
+            s.extend(c.escape_default());
+        } else {
+            s.push(c);
+        }
+    }
+    if t.chars().nth(max).is_some() {
+        s.push('…');
+    }
+    s
+}
 
 struct Tokens<'a> {
     file: &'a str,
@@ -86,9 +110,9 @@ impl<'a> Tokens<'a> {
             .ok_or_else(|| self.err(format!("unexpected end of file: expected {what}")))?;
         let x: f64 = t
             .parse()
-            .map_err(|_| self.err(format!("expected a number ({what}), found '{t}'")))?;
+            .map_err(|_| self.err(format!("expected a number ({what}), found '{}'", shown(t))))?;
         if !x.is_finite() {
-            return Err(self.err(format!("{what} is not finite: '{t}'")));
+            return Err(self.err(format!("{what} is not finite: '{}'", shown(t))));
         }
         Ok(x)
     }
@@ -104,7 +128,10 @@ impl<'a> Tokens<'a> {
     fn keyword(&mut self, want: &str) -> Result<(), NffError> {
         match self.next() {
             Some(t) if t == want => Ok(()),
-            Some(t) => Err(self.err(format!("expected '{want}' in the view block, found '{t}'"))),
+            Some(t) => Err(self.err(format!(
+                "expected '{want}' in the view block, found '{}'",
+                shown(t)
+            ))),
             None => Err(self.err(format!("unexpected end of file: expected '{want}'"))),
         }
     }
@@ -115,12 +142,19 @@ impl<'a> Tokens<'a> {
             .ok_or_else(|| self.err(format!("unexpected end of file: expected {what}")))?;
         let n: usize = t
             .parse()
-            .map_err(|_| self.err(format!("expected a vertex count, found '{t}'")))?;
+            .map_err(|_| self.err(format!("expected a vertex count, found '{}'", shown(t))))?;
         if !(3..=MAX_VERTICES).contains(&n) {
             return Err(self.err(format!("{what} {n} out of range (3 to {MAX_VERTICES})")));
         }
         Ok(n)
     }
+}
+
+/// Checks a primitive (crate::validate) and passes it on.
+fn shape(t: &Tokens<'_>, sink: &mut dyn Sink, s: ShapeRef<'_>) -> Result<(), NffError> {
+    validate::check_shape(s).map_err(|e| t.err(e))?;
+    sink.shape(s);
+    Ok(())
 }
 
 /// Reads NFF text into `sink`. `file` names the input in errors.
@@ -161,20 +195,20 @@ pub fn read_nff(text: &str, file: &str, sink: &mut dyn Sink) -> Result<(), NffEr
                         "resolution must be whole numbers from 1 to 1e6, got {rx} {ry}"
                     )));
                 }
-                if (at - from).length_squared() == 0.0 {
-                    return Err(t.err("view 'from' and 'at' are the same point".into()));
-                }
-                sink.view(&View {
+                let view = View {
                     from,
                     at,
                     up,
                     angle,
                     hither,
                     resolution: [rx as u32, ry as u32],
-                });
+                };
+                validate::check_view(&view).map_err(|e| t.err(e))?;
+                sink.view(&view);
             }
             "b" => {
                 let c = t.vec3("background colour")?;
+                validate::check_background(c).map_err(|e| t.err(e))?;
                 sink.background(c);
             }
             "l" => {
@@ -184,7 +218,9 @@ pub fn read_nff(text: &str, file: &str, sink: &mut dyn Sink) -> Result<(), NffEr
                 } else {
                     None
                 };
-                sink.light(&Light { position, color });
+                let light = Light { position, color };
+                validate::check_light(&light).map_err(|e| t.err(e))?;
+                sink.light(&light);
             }
             "f" => {
                 let color = t.vec3("fill colour")?;
@@ -193,31 +229,37 @@ pub fn read_nff(text: &str, file: &str, sink: &mut dyn Sink) -> Result<(), NffEr
                 let shine = t.number("Shine")?;
                 let tr = t.number("T")?;
                 let ior = t.number("index of refraction")?;
-                sink.material(&Material {
+                let material = Material {
                     color,
                     kd,
                     ks,
                     shine,
                     t: tr,
                     ior,
-                });
+                };
+                validate::check_material(&material).map_err(|e| t.err(e))?;
+                sink.material(&material);
             }
             "s" => {
                 let center = t.vec3("sphere centre")?;
                 let radius = t.number("sphere radius")?;
-                sink.shape(ShapeRef::Sphere { center, radius });
+                shape(&t, sink, ShapeRef::Sphere { center, radius })?;
             }
             "c" => {
                 let base = t.vec3("cone base")?;
                 let base_radius = t.number("cone base radius")?;
                 let apex = t.vec3("cone apex")?;
                 let apex_radius = t.number("cone apex radius")?;
-                sink.shape(ShapeRef::Cone {
-                    base,
-                    base_radius,
-                    apex,
-                    apex_radius,
-                });
+                shape(
+                    &t,
+                    sink,
+                    ShapeRef::Cone {
+                        base,
+                        base_radius,
+                        apex,
+                        apex_radius,
+                    },
+                )?;
             }
             "p" => {
                 let n = t.count("polygon vertex count")?;
@@ -225,7 +267,7 @@ pub fn read_nff(text: &str, file: &str, sink: &mut dyn Sink) -> Result<(), NffEr
                 for _ in 0..n {
                     verts.push(t.vec3("polygon vertex")?);
                 }
-                sink.shape(ShapeRef::Polygon(&verts));
+                shape(&t, sink, ShapeRef::Polygon(&verts))?;
             }
             "pp" => {
                 let n = t.count("patch vertex count")?;
@@ -235,14 +277,17 @@ pub fn read_nff(text: &str, file: &str, sink: &mut dyn Sink) -> Result<(), NffEr
                     verts.push(t.vec3("patch vertex")?);
                     norms.push(t.vec3("patch normal")?);
                 }
-                sink.shape(ShapeRef::Patch {
-                    vertices: &verts,
-                    normals: &norms,
-                });
+                shape(
+                    &t,
+                    sink,
+                    ShapeRef::Patch {
+                        vertices: &verts,
+                        normals: &norms,
+                    },
+                )?;
             }
             other => {
-                let shown: String = other.chars().take(40).collect();
-                return Err(t.err(format!("unknown directive '{shown}'")));
+                return Err(t.err(format!("unknown directive '{}'", shown(other))));
             }
         }
     }

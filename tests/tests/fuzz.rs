@@ -1,0 +1,44 @@
+//! The fuzzer over the NFF, store and results readers at small scale (a few seconds); the large
+//! run is `cargo run --release -p rtbench-tests --example fuzz`.
+
+use rtbench_tests::fuzz::{corpus_dir, run, Target};
+
+#[test]
+fn mutated_inputs_never_panic_nor_hang() {
+    // One test for the three readers: the driver swaps the process's panic hook while it runs.
+    for (t, n) in [
+        (Target::Nff, 5_000),
+        (Target::Store, 400),
+        (Target::Results, 800),
+    ] {
+        let o = run(t, n, 14, &corpus_dir());
+        assert_eq!(o.inputs, n);
+        if let Some((input, msg)) = &o.first_panic {
+            panic!(
+                "{}: {} of {n} inputs panicked; first: {msg} on {:?}",
+                t.name(),
+                o.panics,
+                String::from_utf8_lossy(input)
+            );
+        }
+        assert_eq!(
+            o.corrupt_accepted,
+            0,
+            "{}: a changed store was read as good",
+            t.name()
+        );
+        // Both answers occur: the mutations reach past the first check.
+        assert!(
+            o.accepted > 0 && o.accepted < n,
+            "{}: {} accepted",
+            t.name(),
+            o.accepted
+        );
+        assert!(
+            o.slowest.as_secs_f64() < 10.0,
+            "{}: {:?}",
+            t.name(),
+            o.slowest
+        );
+    }
+}
