@@ -168,3 +168,35 @@ fn unknown_engines_are_refused() {
         "{err}"
     );
 }
+
+/// Issue 14's reproducer: options that leave nothing to run, or name what does not exist, are refused
+/// before anything is measured (they used to give an empty table and exit 0).
+#[test]
+fn options_that_leave_nothing_to_run_are_refused() {
+    for (args, needle) in [
+        (
+            &["nakamaru-3.2", "--quick", "--max-sf", "0"][..],
+            "leaves no size factor to run",
+        ),
+        (&["nakamaru-3.2", "--max-sf", "bogus=3"][..], "does not run"),
+        (
+            &["nakamaru-3.2", "--engines", "bogus"][..],
+            "option 'engines' does not apply",
+        ),
+        (
+            &["kimura-3.3", "--engines", "bogus"][..],
+            "option 'engines' does not apply",
+        ),
+        (&["spd-stats", "--threads", "0"][..], "threads '0'"),
+        (&["yamauchi-static-lb", "--size", "0"][..], "size '0'"),
+    ] {
+        let out = rtbench(&[&["reproduce"][..], args, &["--out", "/nonexistent/x"][..]].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(needle) && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}

@@ -435,13 +435,37 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let (disks, fault_ms) = disks(ctx.id, ctx.params.raw(FAULT_MS.key))?;
     let memory = p.memory_mb << 20;
     let frames = memory / PAGE;
+    if let Some(c) = caps.iter().find(|c| {
+        c.0.as_ref()
+            .is_some_and(|name| !p.sf_ranges.iter().any(|(s, _)| s == name))
+    }) {
+        let known: Vec<&str> = p.sf_ranges.iter().map(|(s, _)| s.as_str()).collect();
+        return Err(input(format!(
+            "{}: max-sf names scene '{}', which this table does not run (it runs {})",
+            ctx.id,
+            c.0.as_deref().unwrap_or(""),
+            known.join(", ")
+        )));
+    }
+    let planned: Vec<(&String, u32, u32)> = p
+        .sf_ranges
+        .iter()
+        .map(|(scene, range)| {
+            let (lo, hi) = sf_range(scene, *range, &caps, ctx.quick);
+            (scene, lo, hi)
+        })
+        .filter(|(_, lo, hi)| lo <= hi)
+        .collect();
+    if planned.is_empty() {
+        return Err(input(format!(
+            "{}: max-sf '{}' leaves no size factor to run",
+            ctx.id,
+            max_sf.as_deref().unwrap_or("")
+        )));
+    }
     let mut measured = Vec::new();
     let mut svgs = Vec::new();
-    for (scene, range) in &p.sf_ranges {
-        let (lo, hi) = sf_range(scene, *range, &caps, ctx.quick);
-        if lo > hi {
-            continue;
-        }
+    for (scene, lo, hi) in planned {
         let pts = measure_scene(scene, lo, hi, frames)?;
         let s = analyse(&p, scene, lo, hi, &pts, &disks);
         if pts.len() >= 2 {
