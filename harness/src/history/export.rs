@@ -90,7 +90,13 @@ mod tests {
         };
         let v = bmf(&[m]);
         assert_eq!(v["kernels/sphere"]["criterion_ns"]["value"], json!(2.0));
-        assert_eq!(v["kernels/sphere"]["criterion_ns"]["lower_value"], json!(1.0));
-        assert_eq!(v["kernels/sphere"]["criterion_ns"]["upper_value"], json!(3.0));
+        assert_eq!(
+            v["kernels/sphere"]["criterion_ns"]["lower_value"],
+            json!(1.0)
+        );
+        assert_eq!(
+            v["kernels/sphere"]["criterion_ns"]["upper_value"],
+            json!(3.0)
+        );
     }
 }

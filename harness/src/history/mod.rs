@@ -129,9 +129,7 @@ pub struct History {
 
 fn db_err(path: &str, e: rusqlite::Error) -> crate::error::Failure {
     let msg = match &e {
-        rusqlite::Error::SqliteFailure(f, m)
-            if f.code == rusqlite::ErrorCode::NotADatabase =>
-        {
+        rusqlite::Error::SqliteFailure(f, m) if f.code == rusqlite::ErrorCode::NotADatabase => {
             m.clone().unwrap_or_else(|| "file is not a database".into())
         }
         _ => e.to_string(),
@@ -310,7 +308,9 @@ impl History {
     /// The environment JSON of a night.
     pub fn env_json(&self, id: i64) -> Result<Option<String>> {
         self.conn
-            .query_row("SELECT env_json FROM runs WHERE id = ?1", [id], |r| r.get(0))
+            .query_row("SELECT env_json FROM runs WHERE id = ?1", [id], |r| {
+                r.get(0)
+            })
             .optional()
             .map_err(|e| self.err(e))
     }
@@ -445,7 +445,11 @@ mod tests {
         assert!(e.starts_with(&p.display().to_string()) && e.lines().count() == 1);
 
         let q = tmp("junk");
-        std::fs::write(&q, "this is not a database, only some text long enough\n".repeat(40)).unwrap();
+        std::fs::write(
+            &q,
+            "this is not a database, only some text long enough\n".repeat(40),
+        )
+        .unwrap();
         let e = History::open(&q, false).err().unwrap().to_string();
         assert!(e.contains("not a database"), "{e}");
         assert_eq!(e.lines().count(), 1);

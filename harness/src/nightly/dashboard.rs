@@ -30,7 +30,13 @@ fn esc(s: &str) -> String {
 
 /// One chart per group: each metric a series over the nights (x = night id), each change point a
 /// vertical line in the series' colour.
-fn chart(stem: &str, title: &str, y_label: &str, y_log: bool, group: &[(String, Vec<(f64, f64)>)]) -> Chart {
+fn chart(
+    stem: &str,
+    title: &str,
+    y_label: &str,
+    y_log: bool,
+    group: &[(String, Vec<(f64, f64)>)],
+) -> Chart {
     let mut series = Vec::new();
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for (_, pts) in group {
@@ -44,7 +50,14 @@ fn chart(stem: &str, title: &str, y_label: &str, y_log: bool, group: &[(String, 
         series.push(Series {
             name: name.clone(),
             color,
-            points: pts.iter().map(|&(x, y)| Point { x, y, y_range: None }).collect(),
+            points: pts
+                .iter()
+                .map(|&(x, y)| Point {
+                    x,
+                    y,
+                    y_range: None,
+                })
+                .collect(),
         });
         let ys: Vec<f64> = pts.iter().map(|p| p.1).collect();
         for cp in detect::change_points(&ys, 0.01, 3) {
@@ -53,8 +66,16 @@ fn chart(stem: &str, title: &str, y_label: &str, y_log: bool, group: &[(String, 
                 name: format!("change point ({name})"),
                 color,
                 points: vec![
-                    Point { x, y: lo, y_range: None },
-                    Point { x, y: hi, y_range: None },
+                    Point {
+                        x,
+                        y: lo,
+                        y_range: None,
+                    },
+                    Point {
+                        x,
+                        y: hi,
+                        y_range: None,
+                    },
                 ],
             });
         }
@@ -96,7 +117,10 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         let ms = h.metrics(r.id)?;
         for m in &ms {
             if m.gated && m.kind != "counter" || m.kind == "criterion" {
-                trend.entry(m.name.clone()).or_default().push((r.id as f64, m.value));
+                trend
+                    .entry(m.name.clone())
+                    .or_default()
+                    .push((r.id as f64, m.value));
                 kinds.insert(m.name.clone(), m.kind.clone());
             }
         }
@@ -134,7 +158,9 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
                 esc(&f.name),
                 f.baseline.map(fmt_value).unwrap_or_default(),
                 f.value.map(fmt_value).unwrap_or_default(),
-                f.change_pct.map(|c| format!("{c:+.2}%")).unwrap_or_default()
+                f.change_pct
+                    .map(|c| format!("{c:+.2}%"))
+                    .unwrap_or_default()
             ));
         }
         body.push_str("</table>\n");
@@ -156,7 +182,10 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
             Some("criterion") => (2, "criterion kernels, ns per call".to_string()),
             _ => (3, "other".to_string()),
         };
-        groups.entry(key).or_default().push((subj.to_string(), pts.clone()));
+        groups
+            .entry(key)
+            .or_default()
+            .push((subj.to_string(), pts.clone()));
     }
     body.push_str("<h2>Trends</h2>\n<p>One point per night; a vertical line in a series' colour marks a change point (E-divisive, p ≤ 0.01).</p>\n");
     for (i, ((kind, title), series)) in groups.iter().enumerate() {
@@ -201,5 +230,7 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
     let html = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rtbench nightly</title>\n<style>\nbody{{font-family:sans-serif;margin:2em;max-width:1400px}}\ntable{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:left}}\ntr.regression,tr.failed{{background:#fdd}}tr.improvement{{background:#dfd}}p.ok{{color:#060}}\nfigure{{display:inline-block;margin:0.5em}}svg{{max-width:100%;height:auto}}\n</style></head><body>\n{body}</body></html>\n"
     );
-    crate::output::write_atomic(&dir.join("index.html"), |w| std::io::Write::write_all(w, html.as_bytes()))
+    crate::output::write_atomic(&dir.join("index.html"), |w| {
+        std::io::Write::write_all(w, html.as_bytes())
+    })
 }

@@ -67,7 +67,14 @@ fn subject(r: &RunRecord) -> String {
     format!("{label} {}@{}", r.scene.name, r.threads)
 }
 
-fn metric(name: String, kind: &str, unit: &str, value: f64, gated: bool, samples: Vec<f64>) -> Metric {
+fn metric(
+    name: String,
+    kind: &str,
+    unit: &str,
+    value: f64,
+    gated: bool,
+    samples: Vec<f64>,
+) -> Metric {
     Metric {
         name,
         kind: kind.into(),
@@ -85,7 +92,14 @@ pub fn record_metrics(s: &Suite, records: &[RunRecord]) -> Vec<Metric> {
     for r in records.iter().filter(|r| r.ok()) {
         let subj = subject(r);
         let tr = r.time_s.trace_for_compare();
-        out.push(metric(format!("{subj}/trace_cpu_s"), "time", "s", tr.median, false, tr.samples.clone()));
+        out.push(metric(
+            format!("{subj}/trace_cpu_s"),
+            "time",
+            "s",
+            tr.median,
+            false,
+            tr.samples.clone(),
+        ));
         out.push(metric(
             format!("{subj}/build_s"),
             "time",
@@ -124,9 +138,23 @@ pub fn record_metrics(s: &Suite, records: &[RunRecord]) -> Vec<Metric> {
             }
         }
         let gate = s.gates("counters");
-        out.push(metric(format!("{subj}/counter.rays_total"), "counter", "count", r.rays_total as f64, gate, vec![]));
+        out.push(metric(
+            format!("{subj}/counter.rays_total"),
+            "counter",
+            "count",
+            r.rays_total as f64,
+            gate,
+            vec![],
+        ));
         for (k, v) in &r.counters {
-            out.push(metric(format!("{subj}/counter.{k}"), "counter", "count", *v as f64, gate, vec![]));
+            out.push(metric(
+                format!("{subj}/counter.{k}"),
+                "counter",
+                "count",
+                *v as f64,
+                gate,
+                vec![],
+            ));
         }
     }
     out
@@ -140,11 +168,22 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
         .map(|n| n.iter().map(|m| (m.name.as_str(), m)).collect())
         .collect();
     let time_like = |m: &Metric| m.kind == "time_ratio" || m.kind == "criterion";
-    let gated_times = tonight.iter().filter(|m| m.gated && time_like(m)).count().max(1);
+    let gated_times = tonight
+        .iter()
+        .filter(|m| m.gated && time_like(m))
+        .count()
+        .max(1);
     let alpha = s.false_alarm_budget / gated_times as f64;
-    let tol = s.instructions.as_ref().map(|i| i.tolerance_pct).unwrap_or(0.1);
+    let tol = s
+        .instructions
+        .as_ref()
+        .map(|i| i.tolerance_pct)
+        .unwrap_or(0.1);
     for m in tonight {
-        let history: Vec<&Metric> = lookup.iter().filter_map(|n| n.get(m.name.as_str()).copied()).collect();
+        let history: Vec<&Metric> = lookup
+            .iter()
+            .filter_map(|n| n.get(m.name.as_str()).copied())
+            .collect();
         let verdict = |dir: i32| match (dir, m.gated) {
             (1, true) => "regression",
             (-1, true) => "improvement",
@@ -187,8 +226,10 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                 }
             }
             "time_ratio" | "criterion" => {
-                let mut nights: Vec<(f64, Vec<f64>)> =
-                    history.iter().map(|h| (h.value, h.samples.clone())).collect();
+                let mut nights: Vec<(f64, Vec<f64>)> = history
+                    .iter()
+                    .map(|h| (h.value, h.samples.clone()))
+                    .collect();
                 // Start the baseline after the latest change point within it (if ≥ 3 nights remain).
                 let values: Vec<f64> = nights.iter().map(|n| n.0).collect();
                 if let Some(&cp) = detect::change_points(&values, 0.01, 3).last() {
@@ -196,7 +237,8 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                         nights.drain(..cp);
                     }
                 }
-                let Some(v) = detect::time_verdict(m.value, &m.samples, &nights, alpha, s.min_change_pct)
+                let Some(v) =
+                    detect::time_verdict(m.value, &m.samples, &nights, alpha, s.min_change_pct)
                 else {
                     continue;
                 };
@@ -272,7 +314,10 @@ pub fn summary_markdown(
         s.push_str(&format!("- **{}** {}\n", f.verdict, f.message));
     }
     s.push_str("\n## Improvements\n\n");
-    let good: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "improvement").collect();
+    let good: Vec<&Finding> = findings
+        .iter()
+        .filter(|f| f.verdict == "improvement")
+        .collect();
     if good.is_empty() {
         s.push_str("None.\n");
     }
@@ -295,13 +340,22 @@ pub fn summary_markdown(
             "| {} | {} | {} | {} | {} |\n",
             m.name,
             crate::nightly::dashboard::fmt_value(m.value),
-            f.and_then(|f| f.baseline).map(crate::nightly::dashboard::fmt_value).unwrap_or_default(),
-            f.and_then(|f| f.change_pct).map(|c| format!("{c:+.2}%")).unwrap_or_default(),
+            f.and_then(|f| f.baseline)
+                .map(crate::nightly::dashboard::fmt_value)
+                .unwrap_or_default(),
+            f.and_then(|f| f.change_pct)
+                .map(|c| format!("{c:+.2}%"))
+                .unwrap_or_default(),
             f.map(|f| f.verdict.as_str()).unwrap_or("ok"),
         ));
     }
-    let changed = findings.iter().filter(|f| f.name.contains("/counter.")).count();
-    s.push_str(&format!("\n{counters} exact counters, {changed} changed.\n"));
+    let changed = findings
+        .iter()
+        .filter(|f| f.name.contains("/counter."))
+        .count();
+    s.push_str(&format!(
+        "\n{counters} exact counters, {changed} changed.\n"
+    ));
     s
 }
 
@@ -353,7 +407,11 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
             baseline: None,
             value: None,
             change_pct: None,
-            message: format!("{}: run failed: {}", r.key, r.reason.as_deref().unwrap_or("")),
+            message: format!(
+                "{}: run failed: {}",
+                r.key,
+                r.reason.as_deref().unwrap_or("")
+            ),
         })
         .collect();
     let scratch = match &a.out {
@@ -367,9 +425,25 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
                 let subj = format!("{} {}{}", v.label(), p.name(), ins.sf);
                 match tools::instructions(v, p, ins.sf, ins.size, &scratch) {
                     Ok((ir, wall)) => {
-                        eprintln!("nightly: instructions {subj}: {ir} ({wall:.1} s under valgrind)");
-                        metrics.push(metric(format!("{subj}/instructions"), "instructions", "Ir", ir as f64, suite.gates("instructions"), vec![]));
-                        metrics.push(metric(format!("{subj}/valgrind_s"), "time", "s", wall, false, vec![wall]));
+                        eprintln!(
+                            "nightly: instructions {subj}: {ir} ({wall:.1} s under valgrind)"
+                        );
+                        metrics.push(metric(
+                            format!("{subj}/instructions"),
+                            "instructions",
+                            "Ir",
+                            ir as f64,
+                            suite.gates("instructions"),
+                            vec![],
+                        ));
+                        metrics.push(metric(
+                            format!("{subj}/valgrind_s"),
+                            "time",
+                            "s",
+                            wall,
+                            false,
+                            vec![wall],
+                        ));
                     }
                     Err(e) => findings.push(Finding {
                         name: format!("{subj}/instructions"),
@@ -382,13 +456,20 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
                 }
             }
         }
-        eprintln!("nightly: instruction counts took {}", fmt_secs(t.elapsed().as_secs_f64()));
+        eprintln!(
+            "nightly: instruction counts took {}",
+            fmt_secs(t.elapsed().as_secs_f64())
+        );
     }
     if let Some(c) = suite.criterion.as_ref().filter(|_| !a.skip_criterion) {
         let home = scratch.join(format!("criterion-{}", std::process::id()));
         match tools::criterion(c, &home, suite.gates("criterion")) {
             Ok((m, wall)) => {
-                eprintln!("nightly: criterion: {} benchmarks in {}", m.len(), fmt_secs(wall));
+                eprintln!(
+                    "nightly: criterion: {} benchmarks in {}",
+                    m.len(),
+                    fmt_secs(wall)
+                );
                 metrics.extend(m);
             }
             Err(e) => findings.push(Finding {
@@ -405,7 +486,12 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         }
     }
     let prev = history.runs(Some(&fp), Some(&suite.name))?;
-    let window: Vec<_> = prev.iter().rev().take(suite.baseline_nights).rev().collect();
+    let window: Vec<_> = prev
+        .iter()
+        .rev()
+        .take(suite.baseline_nights)
+        .rev()
+        .collect();
     let mut baseline = Vec::new();
     for r in &window {
         baseline.push(history.metrics(r.id)?);
@@ -426,17 +512,33 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         metrics: metrics.clone(),
         findings: findings.clone(),
     };
-    let md = summary_markdown(&suite.name, &env.git_commit, wall_s, window.len(), &metrics, &findings);
+    let md = summary_markdown(
+        &suite.name,
+        &env.git_commit,
+        wall_s,
+        window.len(),
+        &metrics,
+        &findings,
+    );
     if a.no_record {
-        eprintln!("nightly: --no-record: the night is not written to {}", a.db.display());
+        eprintln!(
+            "nightly: --no-record: the night is not written to {}",
+            a.db.display()
+        );
     } else {
         let id = history.append(&night)?;
         eprintln!("nightly: night {id} written to {}", a.db.display());
     }
     if let Some(d) = &a.out {
-        crate::output::write_atomic(&d.join("nightly.md"), |w| std::io::Write::write_all(w, md.as_bytes()))?;
+        crate::output::write_atomic(&d.join("nightly.md"), |w| {
+            std::io::Write::write_all(w, md.as_bytes())
+        })?;
         dashboard::write(&history, &d.join("dashboard"))?;
-        eprintln!("nightly: summary {}, dashboard {}", d.join("nightly.md").display(), d.join("dashboard/index.html").display());
+        eprintln!(
+            "nightly: summary {}, dashboard {}",
+            d.join("nightly.md").display(),
+            d.join("dashboard/index.html").display()
+        );
     }
     if a.json {
         crate::output::print_json(&serde_json::json!({
@@ -450,9 +552,16 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
     } else {
         print!("{md}");
     }
-    let bad: Vec<String> = findings.iter().filter(|f| is_bad(f)).map(|f| f.message.clone()).collect();
+    let bad: Vec<String> = findings
+        .iter()
+        .filter(|f| is_bad(f))
+        .map(|f| f.message.clone())
+        .collect();
     if !bad.is_empty() {
-        return Err(Failure::Check(format!("nightly regression: {}", bad.join("; "))));
+        return Err(Failure::Check(format!(
+            "nightly regression: {}",
+            bad.join("; ")
+        )));
     }
     Ok(())
 }
@@ -490,7 +599,9 @@ pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
         H::Show { db, run, json } => {
             let h = History::open(db, false)?;
             let id = resolve_run(&h, run.as_deref(), db)?;
-            let row = h.run(id)?.ok_or_else(|| input(format!("{}: no night {id}", db.display())))?;
+            let row = h
+                .run(id)?
+                .ok_or_else(|| input(format!("{}: no night {id}", db.display())))?;
             let metrics = h.metrics(id)?;
             let findings = h.findings(id)?;
             if *json {
@@ -504,7 +615,14 @@ pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
             } else {
                 print!(
                     "{}",
-                    summary_markdown(&row.suite, &row.git_commit, row.wall_s, 0, &metrics, &findings)
+                    summary_markdown(
+                        &row.suite,
+                        &row.git_commit,
+                        row.wall_s,
+                        0,
+                        &metrics,
+                        &findings
+                    )
                 );
             }
             Ok(())

@@ -164,7 +164,11 @@ fn variant(file: &str, entry: &str) -> Result<Variant> {
         let (k, v) = kv
             .split_once('=')
             .filter(|(k, _)| !k.trim().is_empty())
-            .ok_or_else(|| input(format!("{file}: variant '{entry}': expected engine:key=value")))?;
+            .ok_or_else(|| {
+                input(format!(
+                    "{file}: variant '{entry}': expected engine:key=value"
+                ))
+            })?;
         settings.push((k.trim().to_string(), v.trim().to_string()));
     }
     Ok(Variant {
@@ -215,7 +219,10 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         }
         variants.push(v);
     }
-    if !variants.iter().any(|v| v.engine == "embree" && v.settings.is_empty()) {
+    if !variants
+        .iter()
+        .any(|v| v.engine == "embree" && v.settings.is_empty())
+    {
         return Err(input(format!(
             "{file}: engines must hold 'embree', the yardstick of the time ratios"
         )));
@@ -257,7 +264,11 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
     }
     let size = raw.size.unwrap_or(128);
     crate::workload::check_size(size).map_err(|e| input(format!("{file}: {e}")))?;
-    let budget = positive(file, "false_alarm_budget", raw.false_alarm_budget.unwrap_or(0.03))?;
+    let budget = positive(
+        file,
+        "false_alarm_budget",
+        raw.false_alarm_budget.unwrap_or(0.03),
+    )?;
     if budget >= 1.0 {
         return Err(input(format!(
             "{file}: false_alarm_budget = {budget}: a probability per night, below 1"
@@ -376,9 +387,15 @@ gate = ["counters", "time_ratio"]
     #[test]
     fn bad_suites_name_the_file_and_the_problem_in_one_line() {
         let cases = [
-            (GOOD.replace("\"grid\"", "\"gridd\""), "unknown engine 'gridd'"),
+            (
+                GOOD.replace("\"grid\"", "\"gridd\""),
+                "unknown engine 'gridd'",
+            ),
             (GOOD.replace("tetra", "tetraa"), "unknown scene 'tetraa'"),
-            (GOOD.replace("\"counters\"", "\"speed\""), "unknown metric 'speed'"),
+            (
+                GOOD.replace("\"counters\"", "\"speed\""),
+                "unknown metric 'speed'",
+            ),
             (format!("{GOOD}colour = 3\n"), "unknown field `colour`"),
             (GOOD.replace("\"embree\", ", ""), "must hold 'embree'"),
             (format!("{GOOD}repeats = 1\n"), "repeats = 1"),

@@ -46,7 +46,11 @@ pub fn instructions(
     let wall = t.elapsed().as_secs_f64();
     if !o.status.success() {
         let err = String::from_utf8_lossy(&o.stderr);
-        let last = err.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let last = err
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
         return Err(format!("valgrind failed: {}", last.trim()));
     }
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
@@ -83,7 +87,11 @@ pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>
     let wall = t.elapsed().as_secs_f64();
     if !o.status.success() {
         let err = String::from_utf8_lossy(&o.stderr);
-        let last = err.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let last = err
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
         return Err(format!("cargo bench failed: {}", last.trim()));
     }
     let mut out = Vec::new();
@@ -135,7 +143,10 @@ pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>
         }
     }
     if out.is_empty() {
-        return Err(format!("cargo bench left no estimates in {}", home.display()));
+        return Err(format!(
+            "cargo bench left no estimates in {}",
+            home.display()
+        ));
     }
     out.sort_by(|a, b| a.name.cmp(&b.name));
     Ok((out, wall))
