@@ -104,6 +104,11 @@ pub enum HistoryCommand {
         #[arg(long)]
         run: Option<String>,
     },
+    /// `PRAGMA integrity_check` of the history, and its nights (exit 1 when not whole).
+    Check {
+        #[arg(long)]
+        db: PathBuf,
+    },
     /// The static HTML dashboard (DIR/index.html) of the history.
     Dashboard {
         #[arg(long)]

@@ -359,6 +359,27 @@ pub fn summary_markdown(
     s
 }
 
+/// One job's record over the rounds: the samples of every round, the counters of the first.
+fn merge(mut a: RunRecord, b: &RunRecord) -> RunRecord {
+    use rtbench_reports::Spread;
+    let cat = |x: &Spread, y: &Spread| {
+        let mut v = x.samples.clone();
+        v.extend(&y.samples);
+        Spread::of(&v)
+    };
+    let t = &mut a.time_s;
+    t.build = cat(&t.build, &b.time_s.build);
+    t.trace = cat(&t.trace, &b.time_s.trace);
+    t.intersect = cat(&t.intersect, &b.time_s.intersect);
+    t.shade = cat(&t.shade, &b.time_s.shade);
+    t.trace_cpu = cat(&t.trace_cpu, &b.time_s.trace_cpu);
+    a.repeats += b.repeats;
+    a.mrays_per_s = a.rays_total as f64 / a.time_s.trace.median.max(1e-12) / 1e6;
+    a.wall_s += b.wall_s;
+    a.peak_rss_bytes = a.peak_rss_bytes.max(b.peak_rss_bytes);
+    a
+}
+
 /// `rtbench nightly`.
 pub fn run(a: &NightlyArgs) -> Result<()> {
     let suite = suite::load(&a.suite)?;
@@ -373,29 +394,43 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         None => None,
     };
     let jobs = jobs(&suite);
+    // Rounds: every job once per round, one timed repeat each, so that an engine's i-th sample
+    // and Embree's i-th sample are minutes apart at most and a burst of load on a shared machine
+    // touches one sample of many metrics rather than every sample of one.
     let common = Common {
-        repeats: suite.repeats,
+        repeats: 1,
         size: suite.size,
         check: false,
         max_seconds: suite.max_seconds,
         max_memory: None,
     };
     eprintln!(
-        "nightly: suite '{}': {} runs × {} repeats, machine {}",
+        "nightly: suite '{}': {} runs × {} rounds, machine {}",
         suite.name,
         jobs.len(),
         suite.repeats,
         &fp[..12]
     );
-    let mut progress = plan::Progress::new(jobs.len());
-    let mut records = Vec::new();
-    for job in &jobs {
-        let rec = plan::run_child(job, &common);
-        progress.finish(job, &rec, false);
-        if let Some(r) = results.as_mut() {
+    let mut progress = plan::Progress::new(jobs.len() * suite.repeats as usize);
+    let mut merged: Vec<Option<RunRecord>> = vec![None; jobs.len()];
+    for _ in 0..suite.repeats {
+        for (job, slot) in jobs.iter().zip(merged.iter_mut()) {
+            if slot.as_ref().is_some_and(|r| !r.ok()) {
+                continue;
+            }
+            let rec = plan::run_child(job, &common);
+            progress.finish(job, &rec, false);
+            *slot = Some(match slot.take() {
+                Some(prev) if rec.ok() => merge(prev, &rec),
+                _ => rec,
+            });
+        }
+    }
+    let records: Vec<RunRecord> = merged.into_iter().flatten().collect();
+    if let Some(r) = results.as_mut() {
+        for rec in &records {
             r.put(rec.clone())?;
         }
-        records.push(rec);
     }
     let mut metrics = record_metrics(&suite, &records);
     let mut findings: Vec<Finding> = records
@@ -636,6 +671,24 @@ pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
                     crate::output::print_json(&crate::history::export::bmf(&h.metrics(id)?));
                 }
                 f => return Err(input(format!("--format '{f}': expected csv or bmf"))),
+            }
+            Ok(())
+        }
+        H::Check { db } => {
+            let h = History::open(db, false)?;
+            let verdict = h.integrity()?;
+            let runs = h.runs(None, None)?;
+            let samples: usize = runs.iter().map(|r| r.metrics as usize).sum();
+            println!(
+                "{}: integrity_check {verdict}; {} nights, {samples} metrics",
+                db.display(),
+                runs.len()
+            );
+            if verdict != "ok" {
+                return Err(Failure::Check(format!(
+                    "{}: integrity_check: {verdict}",
+                    db.display()
+                )));
             }
             Ok(())
         }

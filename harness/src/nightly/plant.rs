@@ -7,7 +7,8 @@
 //!   extra work, the results and counters unchanged;
 //! - `RTBENCH_PLANT=counter:ENGINE:SCENE`: one extra primitive test counted per call, no extra work.
 //!
-//! SCENE is the SPD program's name (`balls`); `*` matches every scene.
+//! SCENE is the SPD program's name (`balls`); `*` matches every scene. Several plants are separated
+//! by `;` (the first that matches an engine and scene applies).
 
 use rtbench_engines::{Counters, Engine, Hit, Ray};
 use std::collections::BTreeMap;
@@ -25,6 +26,11 @@ pub fn from_env(engine: &str, program: Option<&str>) -> Option<Plant> {
 }
 
 fn parse(spec: &str, engine: &str, program: Option<&str>) -> Option<Plant> {
+    spec.split(';')
+        .find_map(|one| parse_one(one.trim(), engine, program))
+}
+
+fn parse_one(spec: &str, engine: &str, program: Option<&str>) -> Option<Plant> {
     let parts: Vec<&str> = spec.split(':').collect();
     let matches = |e: &str, s: &str| e == engine && (s == "*" || Some(s) == program);
     match parts.as_slice() {
@@ -131,5 +137,8 @@ mod tests {
             Some(Plant::Counter)
         );
         assert_eq!(parse("work:grid:balls:x", "grid", Some("balls")), None);
+        let two = "work:bvh4:gears:0.06;counter:grid:tetra";
+        assert_eq!(parse(two, "bvh4", Some("gears")), Some(Plant::Work(0.06)));
+        assert_eq!(parse(two, "grid", Some("tetra")), Some(Plant::Counter));
     }
 }
