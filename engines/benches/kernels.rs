@@ -123,6 +123,7 @@ fn primitives(c: &mut Criterion) {
 /// A node of N children: boxes in a row along x, some crossed by the rays, some not.
 fn node<const N: usize>() -> WideNode<N> {
     let mut planes = [[0.0f32; N]; PLANES];
+    #[allow(clippy::needless_range_loop)] // i indexes the lanes of all six planes
     for i in 0..N {
         let x0 = -1.2 + 2.4 * i as f32 / N as f32;
         let lo = [x0, -0.5 + 0.1 * i as f32, -0.2];

@@ -28,15 +28,12 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// A named series of (night id, value).
+type Trend = (String, Vec<(f64, f64)>);
+
 /// One chart per group: each metric a series over the nights (x = night id), each change point a
 /// vertical line in the series' colour.
-fn chart(
-    stem: &str,
-    title: &str,
-    y_label: &str,
-    y_log: bool,
-    group: &[(String, Vec<(f64, f64)>)],
-) -> Chart {
+fn chart(stem: &str, title: &str, y_label: &str, y_log: bool, group: &[Trend]) -> Chart {
     let mut series = Vec::new();
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for (_, pts) in group {
@@ -80,6 +77,16 @@ fn chart(
             });
         }
     }
+    // Explicit x ticks (night ids, at most 12): the reports crate chooses ticks on a log scale
+    // otherwise, which a range starting at 0 does not have.
+    let mut xs: Vec<f64> = group
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| q.0))
+        .collect();
+    xs.sort_by(|a, b| a.total_cmp(b));
+    xs.dedup();
+    let step = xs.len().div_ceil(12).max(1);
+    let x_ticks: Vec<f64> = xs.iter().copied().step_by(step).collect();
     Chart {
         stem: stem.to_string(),
         title: title.to_string(),
@@ -89,7 +96,7 @@ fn chart(
             y_label: y_label.into(),
             x_log: false,
             y_log,
-            x_ticks: Vec::new(),
+            x_ticks,
             lines: true,
             legend: LegendAt::UpperLeft,
             series,
@@ -166,7 +173,7 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         body.push_str("</table>\n");
     }
     // Groups: time ratios by scene, instruction counts, criterion kernels.
-    let mut groups: BTreeMap<(u8, String), Vec<(String, Vec<(f64, f64)>)>> = BTreeMap::new();
+    let mut groups: BTreeMap<(u8, String), Vec<Trend>> = BTreeMap::new();
     for (name, pts) in &trend {
         let (subj, _) = name.rsplit_once('/').unwrap_or((name, ""));
         let key = match kinds.get(name).map(String::as_str) {
@@ -192,11 +199,12 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         // Keep each chart legible: at most 8 series.
         for (j, part) in series.chunks(8).enumerate() {
             let stem = format!("trend-{i}-{j}");
+            // Log y for all: every trend is positive, and equal ratios read as equal steps.
             let (ylab, ylog) = match kind {
-                0 => ("ratio to Embree", false),
+                0 => ("ratio to Embree", true),
                 1 => ("instructions", true),
                 2 => ("ns", true),
-                _ => ("value", false),
+                _ => ("value", true),
             };
             let c = chart(&stem, title, ylab, ylog, part);
             let svg = plot::svg(&c).map_err(|e| input(format!("plot {stem}: {e}")))?;
