@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# rtbench's tests, from a fresh clone: set up (libclang, Embree), then the whole workspace's tests.
+# rtbench's tests, from a fresh clone: set up (libclang, Embree; Chromium, for the test that loads the nightly
+# dashboard headless), then the whole workspace's tests.
 # Usage: bash scripts/test.sh [extra cargo test arguments]
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -7,4 +8,10 @@ cd "$ROOT"
 [ -x "$HOME/.cargo/bin/cargo" ] && export PATH="$HOME/.cargo/bin:$PATH"
 command -v cargo >/dev/null || { echo "test.sh: error: cargo not found (install Rust with rustup)" >&2; exit 1; }
 bash scripts/setup.sh
+if ! command -v chromium >/dev/null; then
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    echo "test.sh: installing chromium with apt-get (the nightly dashboard's test loads it headless)"
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq >/dev/null
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium >/dev/null
+fi
 cargo test --workspace "$@"

@@ -44,6 +44,78 @@ pub enum Command {
     /// One measured run, printed as one JSON line (the child process of run and sweep).
     #[command(hide = true)]
     RunOne(RunOneArgs),
+    /// Run a nightly suite, store every sample in the history, exit 1 on a detected regression.
+    Nightly(NightlyArgs),
+    /// The nightly history: list, show, export (CSV, Bencher Metric Format), dashboard.
+    #[command(subcommand)]
+    History(HistoryCommand),
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct NightlyArgs {
+    /// The suite file (TOML; the default suite is suites/nightly.toml).
+    #[arg(long)]
+    pub suite: PathBuf,
+    /// The history (SQLite; created if missing).
+    #[arg(long)]
+    pub db: PathBuf,
+    /// Also write the runs (results.jsonl), the Markdown summary (nightly.md) and the dashboard here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// A note stored with the night.
+    #[arg(long)]
+    pub note: Option<String>,
+    /// Compare, but do not write the night to the history.
+    #[arg(long)]
+    pub no_record: bool,
+    /// Skip the suite's criterion benchmarks this time.
+    #[arg(long)]
+    pub skip_criterion: bool,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum HistoryCommand {
+    /// Every night of the history.
+    List {
+        #[arg(long)]
+        db: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+    /// One night (default: the latest): its findings and gated metrics.
+    Show {
+        #[arg(long)]
+        db: PathBuf,
+        /// A night's id, or `latest`.
+        #[arg(long)]
+        run: Option<String>,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Every metric of every night as CSV, or one night (default: the latest) as Bencher Metric Format JSON.
+    Export {
+        #[arg(long)]
+        db: PathBuf,
+        /// `csv` or `bmf`.
+        #[arg(long, default_value = "csv")]
+        format: String,
+        #[arg(long)]
+        run: Option<String>,
+    },
+    /// `PRAGMA integrity_check` of the history, and its nights (exit 1 when not whole).
+    Check {
+        #[arg(long)]
+        db: PathBuf,
+    },
+    /// The static HTML dashboard (DIR/index.html) of the history.
+    Dashboard {
+        #[arg(long)]
+        db: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 /// What run and sweep share.

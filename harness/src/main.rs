@@ -21,6 +21,8 @@ macro_rules! print {
 mod cli;
 mod commands;
 mod error;
+mod history;
+mod nightly;
 mod output;
 mod reproduce;
 mod runs;
@@ -62,6 +64,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),
         Command::Report(a) => commands::runs::report(&a),
         Command::Compare(a) => commands::runs::compare(&a),
+        Command::Nightly(a) => nightly::run(&a),
+        Command::History(c) => nightly::history_cmd(&c),
         Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),
         Command::Reproduce(a) => {
             let out = a

@@ -259,3 +259,15 @@ pub fn cells_along(grid: &Grid, ray: &Ray) -> Vec<[u32; 3]> {
     });
     out
 }
+
+/// How many cells the DDA walk of `ray` steps through in `grid` (the walk alone: no primitive
+/// test). For the criterion benchmark of one DDA step (engines/benches/kernels.rs).
+#[doc(hidden)]
+pub fn dda_cells(grid: &Grid, ray: &Ray) -> usize {
+    let mut n = 0;
+    grid.walk(ray, |_, _, _| {
+        n += 1;
+        false
+    });
+    n
+}

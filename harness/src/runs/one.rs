@@ -44,6 +44,21 @@ fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String, u64> {
     m
 }
 
+/// The engine with the regression `RTBENCH_PLANT` plants, if any (crate::nightly::plant).
+fn plant(
+    engine: Box<dyn rtbench_engines::Engine>,
+    spec: &OneSpec,
+) -> Box<dyn rtbench_engines::Engine> {
+    let program = match &spec.source {
+        Source::Program(p, _) => Some(p.name()),
+        Source::File(_) => None,
+    };
+    match crate::nightly::plant::from_env(&spec.engine, program) {
+        Some(p) => Box::new(crate::nightly::plant::Planted::new(engine, p)),
+        None => engine,
+    }
+}
+
 pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     let start = Instant::now();
     workload::check_size(spec.size)?;
@@ -57,11 +72,13 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     // (cold caches, page faults on first touch), which would widen every spread.
     {
         let (engine, _) = workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
+        let engine = plant(engine, spec);
         pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
     }
     for _ in 0..spec.repeats.max(1) {
         let (engine, build_s) =
             workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
+        let engine = plant(engine, spec);
         let r = pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
         if let Some(f) = engine.failure() {
             return Err(crate::error::input(f));

@@ -1,0 +1,385 @@
+//! Detection for a shared, noisy machine.
+//!
+//! - Exact counters: any change against the last night of the same fingerprint is a finding.
+//! - Instruction counts: a change past the suite's small tolerance.
+//! - Times (trace CPU time over Embree's in the same night, per repeat; criterion estimates):
+//!   tonight's median is compared with the nights of the baseline by a one-sided prediction
+//!   interval on the log scale, `(ln v − mean) / (s·√(1 + 1/K)) > t(1 − α; K − 1)`, where `mean`
+//!   and `s` are the mean and standard deviation of the K baseline nights' log medians: the
+//!   history's own night-to-night spread, whatever the machine's load did to it. α is the suite's
+//!   false-alarm budget per night split over the gated time metrics (Bonferroni), so at most
+//!   `budget` nights in expectation carry a false alarm. Two confirmations must also hold: the
+//!   change exceeds `min_change_pct`, and a Mann–Whitney rank test of tonight's repeats against
+//!   the baseline's repeats says "greater" at p < 0.05 (one outlying repeat does not make a median
+//!   move alone). Both can only remove alarms, so the budget still bounds the false-alarm rate.
+//! - The baseline is the last `baseline_nights` nights of the same fingerprint, cut at the latest
+//!   change point found in them by E-divisive (energy statistic, permutation test, as Hunter
+//!   does): after a real, accepted change the baseline is the nights since.
+
+/// The standard normal quantile (Acklam's rational approximation; within 1e-4 of the tables).
+pub fn normal_quantile(p: f64) -> f64 {
+    const A: [f64; 6] = [
+        -3.969683028665376e1,
+        2.209460984245205e2,
+        -2.759285104469687e2,
+        1.383_577_518_672_69e2,
+        -3.066479806614716e1,
+        2.506628277459239,
+    ];
+    const B: [f64; 5] = [
+        -5.447609879822406e1,
+        1.615858368580409e2,
+        -1.556989798598866e2,
+        6.680131188771972e1,
+        -1.328068155288572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784894002430293e-3,
+        -3.223964580411365e-1,
+        -2.400758277161838,
+        -2.549671010739319,
+        4.374664141464968,
+        2.938163982698783,
+    ];
+    const D: [f64; 4] = [
+        7.784695709041462e-3,
+        3.224671290700398e-1,
+        2.445134137142996,
+        3.754408661907416,
+    ];
+    let p = p.clamp(1e-300, 1.0 - 1e-16);
+    let lo = 0.02425;
+    if p < lo {
+        let q = (-2.0 * p.ln()).sqrt();
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    } else if p <= 1.0 - lo {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    } else {
+        -normal_quantile(1.0 - p)
+    }
+}
+
+/// Student's t quantile with `nu` degrees of freedom (Hill's 1970 expansion around the normal
+/// quantile; within 1% of the tables for nu ≥ 2 at the tails used here).
+pub fn t_quantile(p: f64, nu: f64) -> f64 {
+    let z = normal_quantile(p);
+    let g1 = (z.powi(3) + z) / 4.0;
+    let g2 = (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / 96.0;
+    let g3 = (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / 384.0;
+    let g4 = (79.0 * z.powi(9) + 776.0 * z.powi(7) + 1482.0 * z.powi(5)
+        - 1920.0 * z.powi(3)
+        - 945.0 * z)
+        / 92160.0;
+    z + g1 / nu + g2 / nu.powi(2) + g3 / nu.powi(3) + g4 / nu.powi(4)
+}
+
+/// One-sided Mann–Whitney p-value that `x` tends to be greater than `y` (normal approximation
+/// with tie and continuity corrections). 1 when either side is empty.
+pub fn mann_whitney_greater(x: &[f64], y: &[f64]) -> f64 {
+    let (n1, n2) = (x.len() as f64, y.len() as f64);
+    if x.is_empty() || y.is_empty() {
+        return 1.0;
+    }
+    let mut all: Vec<(f64, bool)> = x
+        .iter()
+        .map(|&v| (v, true))
+        .chain(y.iter().map(|&v| (v, false)))
+        .collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let n = all.len();
+    let mut rank_x = 0.0;
+    let mut ties = 0.0;
+    let mut i = 0;
+    while i < n {
+        let mut j = i;
+        while j + 1 < n && all[j + 1].0 == all[i].0 {
+            j += 1;
+        }
+        let r = (i + j) as f64 / 2.0 + 1.0;
+        let t = (j - i + 1) as f64;
+        ties += t * t * t - t;
+        for a in &all[i..=j] {
+            if a.1 {
+                rank_x += r;
+            }
+        }
+        i = j + 1;
+    }
+    let u = rank_x - n1 * (n1 + 1.0) / 2.0;
+    let mean = n1 * n2 / 2.0;
+    let nn = n1 + n2;
+    let var = n1 * n2 / 12.0 * ((nn + 1.0) - ties / (nn * (nn - 1.0)));
+    if var <= 0.0 {
+        return if u > mean { 0.0 } else { 1.0 };
+    }
+    let z = (u - mean - 0.5) / var.sqrt();
+    1.0 - normal_cdf(z)
+}
+
+pub fn normal_cdf(z: f64) -> f64 {
+    0.5 * erfc(-z / std::f64::consts::SQRT_2)
+}
+
+/// Complementary error function (Numerical Recipes' erfcc, relative error < 1.2e-7).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+pub fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(|a, b| a.total_cmp(b));
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        (s[n / 2 - 1] + s[n / 2]) / 2.0
+    }
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0).max(1.0);
+    (m, var.sqrt())
+}
+
+/// The energy statistic of splitting `x` at `tau` (Matteson & James' E-divisive, α = 1).
+fn energy(x: &[f64], tau: usize) -> f64 {
+    let (a, b) = x.split_at(tau);
+    let (n, m) = (a.len() as f64, b.len() as f64);
+    let mut between = 0.0;
+    for p in a {
+        for q in b {
+            between += (p - q).abs();
+        }
+    }
+    let within = |s: &[f64]| {
+        let mut w = 0.0;
+        for i in 0..s.len() {
+            for j in i + 1..s.len() {
+                w += (s[i] - s[j]).abs();
+            }
+        }
+        let k = s.len() as f64;
+        if k < 2.0 {
+            0.0
+        } else {
+            w / (k * (k - 1.0) / 2.0)
+        }
+    };
+    let e = 2.0 * between / (n * m) - within(a) - within(b);
+    e * n * m / (n + m)
+}
+
+/// xorshift64*: a small deterministic generator for the permutations.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+}
+
+fn best_split(x: &[f64], min_seg: usize) -> Option<(usize, f64)> {
+    (min_seg..=x.len().saturating_sub(min_seg))
+        .map(|t| (t, energy(x, t)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Change points of a series (indices where a new segment starts), by E-divisive: binary
+/// segmentation on the energy statistic, each split kept when a permutation test (199
+/// permutations) gives p ≤ `alpha`. Segments have at least `min_seg` points.
+pub fn change_points(x: &[f64], alpha: f64, min_seg: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut todo = vec![(0usize, x.len())];
+    while let Some((lo, hi)) = todo.pop() {
+        let seg = &x[lo..hi];
+        if seg.len() < 2 * min_seg {
+            continue;
+        }
+        let Some((tau, stat)) = best_split(seg, min_seg) else {
+            continue;
+        };
+        let perms = 199;
+        let mut above = 0;
+        let mut y = seg.to_vec();
+        for _ in 0..perms {
+            for i in (1..y.len()).rev() {
+                let j = (rng.next() % (i as u64 + 1)) as usize;
+                y.swap(i, j);
+            }
+            if best_split(&y, min_seg).is_some_and(|(_, s)| s >= stat) {
+                above += 1;
+            }
+        }
+        let p = (above + 1) as f64 / (perms + 1) as f64;
+        if p <= alpha {
+            out.push(lo + tau);
+            todo.push((lo, lo + tau));
+            todo.push((lo + tau, hi));
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
+/// The verdict on one time-like metric (lower is better).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeVerdict {
+    /// +1 regression, −1 improvement, 0 neither.
+    pub direction: i32,
+    /// Tonight against the baseline's centre, percent.
+    pub change_pct: f64,
+    /// The baseline's centre (geometric mean of its nights).
+    pub baseline: f64,
+    /// How many prediction-interval widths tonight lies out, and the threshold.
+    pub score: f64,
+    pub threshold: f64,
+    pub mw_p: f64,
+}
+
+/// Tonight's value and samples against the baseline nights' values and samples. `None` when the
+/// baseline has fewer than 3 nights. `alpha` is this metric's share of the false-alarm budget.
+pub fn time_verdict(
+    tonight: f64,
+    tonight_samples: &[f64],
+    nights: &[(f64, Vec<f64>)],
+    alpha: f64,
+    min_change_pct: f64,
+) -> Option<TimeVerdict> {
+    let logs: Vec<f64> = nights
+        .iter()
+        .map(|(v, _)| *v)
+        .filter(|v| *v > 0.0)
+        .map(f64::ln)
+        .collect();
+    if logs.len() < 3 || tonight <= 0.0 {
+        return None;
+    }
+    let k = logs.len() as f64;
+    let (m, sd) = mean_sd(&logs);
+    // A floor on the spread: the repeats' own noise (a night's median of n repeats moves by
+    // about σ/√n even on a quiet machine), so a baseline of lucky identical nights does not make
+    // every tiny wobble significant.
+    let within = {
+        let rel: Vec<f64> = nights
+            .iter()
+            .map(|(v, s)| {
+                if s.len() < 2 || *v <= 0.0 {
+                    0.0
+                } else {
+                    let mad = median(&s.iter().map(|x| (x - v).abs()).collect::<Vec<_>>());
+                    1.4826 * mad / v / (s.len() as f64).sqrt()
+                }
+            })
+            .collect();
+        median(&rel)
+    };
+    let s = sd.max(within).max(1e-6) * (1.0 + 1.0 / k).sqrt();
+    let d = tonight.ln() - m;
+    let threshold = t_quantile(1.0 - alpha, k - 1.0);
+    let score = d / s;
+    let change_pct = (d.exp() - 1.0) * 100.0;
+    let pooled: Vec<f64> = nights.iter().flat_map(|(_, s)| s.iter().copied()).collect();
+    let (mw_up, mw_down) = (
+        mann_whitney_greater(tonight_samples, &pooled),
+        mann_whitney_greater(&pooled, tonight_samples),
+    );
+    let big = change_pct.abs() >= min_change_pct;
+    let direction = if score > threshold && big && mw_up < 0.05 {
+        1
+    } else if score < -threshold && big && mw_down < 0.05 {
+        -1
+    } else {
+        0
+    };
+    Some(TimeVerdict {
+        direction,
+        change_pct,
+        baseline: m.exp(),
+        score,
+        threshold,
+        mw_p: if d >= 0.0 { mw_up } else { mw_down },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_match_the_tables() {
+        assert!((normal_quantile(0.975) - 1.959964).abs() < 1e-5);
+        assert!(
+            (normal_quantile(0.001) + 3.090232).abs() < 1e-4,
+            "{}",
+            normal_quantile(0.001)
+        );
+        // t(0.995; 9) = 3.2498, t(0.999; 4) = 7.1732 (tables)
+        assert!((t_quantile(0.995, 9.0) - 3.2498).abs() < 0.02);
+        assert!((t_quantile(0.99, 4.0) - 3.7469).abs() < 0.05);
+        assert!((normal_cdf(1.959964) - 0.975).abs() < 1e-6);
+    }
+
+    #[test]
+    fn mann_whitney_sees_a_shift_and_not_its_absence() {
+        let y: Vec<f64> = (0..20).map(|i| 1.0 + 0.01 * i as f64).collect();
+        let x: Vec<f64> = y.iter().map(|v| v + 0.5).collect();
+        assert!(mann_whitney_greater(&x, &y) < 1e-4);
+        assert!(mann_whitney_greater(&y, &x) > 0.99);
+        assert!(mann_whitney_greater(&y, &y) > 0.3);
+    }
+
+    #[test]
+    fn e_divisive_finds_a_step_and_nothing_in_flat_noise() {
+        let mut r = Rng(42);
+        let mut noise = || (r.next() % 1000) as f64 / 1000.0 * 0.02;
+        let flat: Vec<f64> = (0..30).map(|_| 1.0 + noise()).collect();
+        assert!(change_points(&flat, 0.01, 4).is_empty());
+        let step: Vec<f64> = (0..30)
+            .map(|i| if i < 18 { 1.0 } else { 1.1 } + noise())
+            .collect();
+        assert_eq!(change_points(&step, 0.01, 4), vec![18]);
+    }
+
+    #[test]
+    fn a_slowdown_past_the_spread_is_a_regression_and_noise_is_not() {
+        let nights: Vec<(f64, Vec<f64>)> = [1.00, 1.01, 0.99, 1.005, 0.995, 1.0]
+            .iter()
+            .map(|&v| (v, vec![v * 0.99, v, v * 1.01]))
+            .collect();
+        let slow = time_verdict(1.08, &[1.07, 1.08, 1.09], &nights, 0.001, 1.0).unwrap();
+        assert_eq!(slow.direction, 1, "{slow:?}");
+        let same = time_verdict(1.005, &[0.995, 1.005, 1.01], &nights, 0.001, 1.0).unwrap();
+        assert_eq!(same.direction, 0, "{same:?}");
+        let fast = time_verdict(0.9, &[0.89, 0.9, 0.91], &nights, 0.001, 1.0).unwrap();
+        assert_eq!(fast.direction, -1, "{fast:?}");
+        assert!(time_verdict(1.0, &[1.0], &nights[..2], 0.001, 1.0).is_none());
+    }
+}

@@ -1,0 +1,715 @@
+//! `rtbench nightly --suite FILE --db FILE.sqlite [--out DIR]`: runs a suite (each engine × scene
+//! in its own child process, as `rtbench run` does), measures instruction counts under valgrind and
+//! the criterion kernels if the suite asks, compares the night with the history's baseline for the
+//! same machine fingerprint (`detect.rs`), writes the whole night to the history in one
+//! transaction, and exits 1 only when a gated metric regressed, naming it.
+
+pub mod dashboard;
+pub mod detect;
+pub mod plant;
+pub mod suite;
+mod tools;
+
+use crate::cli::NightlyArgs;
+use crate::error::{input, Failure, Result};
+use crate::history::{Finding, History, Metric, Night};
+use crate::runs::plan::{self, Common, Job, ResultsDir};
+use rtbench_reports::{Environment, RunRecord};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::time::Instant;
+use suite::Suite;
+
+/// The machine's fingerprint: what must match for two nights' times to be comparable (CPU model
+/// and flags, cores, memory, OS, rustc, Embree version). Not the commit, not the host name.
+pub fn fingerprint(env: &Environment) -> String {
+    let key = serde_json::json!([
+        env.cpu_model,
+        env.cpu_flags,
+        env.cores_logical,
+        env.cores_physical,
+        env.memory_bytes,
+        env.os,
+        env.rustc,
+        env.embree_version,
+    ]);
+    crate::commands::render::hex(&Sha256::digest(key.to_string().as_bytes()))
+}
+
+/// The jobs of a suite, Embree first within each (scene, SF, threads).
+fn jobs(s: &Suite) -> Vec<Job> {
+    let mut out = Vec::new();
+    for p in &s.scenes {
+        for &sf in &s.sf {
+            for &threads in &s.threads {
+                for v in &s.variants {
+                    out.push(Job {
+                        engine: v.engine.clone(),
+                        settings: v.settings.clone(),
+                        program: p.name().to_string(),
+                        sf,
+                        tessellate: None,
+                        threads,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+fn subject(r: &RunRecord) -> String {
+    let mut label = r.engine.clone();
+    if !r.settings.is_empty() {
+        let s: Vec<String> = r.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        label = format!("{label}[{}]", s.join(","));
+    }
+    format!("{label} {}@{}", r.scene.name, r.threads)
+}
+
+fn metric(
+    name: String,
+    kind: &str,
+    unit: &str,
+    value: f64,
+    gated: bool,
+    samples: Vec<f64>,
+) -> Metric {
+    Metric {
+        name,
+        kind: kind.into(),
+        unit: unit.into(),
+        value,
+        gated,
+        samples,
+    }
+}
+
+/// A night's metrics from its run records: trace CPU time and build time (every repeat; not
+/// gated), trace CPU time over Embree's (one ratio per repeat), every exact counter, rays.
+pub fn record_metrics(s: &Suite, records: &[RunRecord]) -> Vec<Metric> {
+    let mut out = Vec::new();
+    for r in records.iter().filter(|r| r.ok()) {
+        let subj = subject(r);
+        let tr = r.time_s.trace_for_compare();
+        out.push(metric(
+            format!("{subj}/trace_cpu_s"),
+            "time",
+            "s",
+            tr.median,
+            false,
+            tr.samples.clone(),
+        ));
+        out.push(metric(
+            format!("{subj}/build_s"),
+            "time",
+            "s",
+            r.time_s.build.median,
+            false,
+            r.time_s.build.samples.clone(),
+        ));
+        if r.engine != "embree" {
+            let yard = records.iter().find(|y| {
+                y.ok()
+                    && y.engine == "embree"
+                    && y.settings.is_empty()
+                    && y.scene.name == r.scene.name
+                    && y.threads == r.threads
+            });
+            if let Some(y) = yard {
+                let ys = &y.time_s.trace_for_compare().samples;
+                let ratios: Vec<f64> = tr
+                    .samples
+                    .iter()
+                    .zip(ys)
+                    .filter(|(_, b)| **b > 0.0)
+                    .map(|(a, b)| a / b)
+                    .collect();
+                if !ratios.is_empty() {
+                    out.push(metric(
+                        format!("{subj}/time_ratio"),
+                        "time_ratio",
+                        "ratio",
+                        detect::median(&ratios),
+                        s.gates("time_ratio"),
+                        ratios,
+                    ));
+                }
+            }
+        }
+        let gate = s.gates("counters");
+        out.push(metric(
+            format!("{subj}/counter.rays_total"),
+            "counter",
+            "count",
+            r.rays_total as f64,
+            gate,
+            vec![],
+        ));
+        for (k, v) in &r.counters {
+            out.push(metric(
+                format!("{subj}/counter.{k}"),
+                "counter",
+                "count",
+                *v as f64,
+                gate,
+                vec![],
+            ));
+        }
+    }
+    out
+}
+
+/// Tonight's metrics against the baseline nights (oldest first): the findings.
+pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let lookup: Vec<BTreeMap<&str, &Metric>> = baseline
+        .iter()
+        .map(|n| n.iter().map(|m| (m.name.as_str(), m)).collect())
+        .collect();
+    let time_like = |m: &Metric| m.kind == "time_ratio" || m.kind == "criterion";
+    let gated_times = tonight
+        .iter()
+        .filter(|m| m.gated && time_like(m))
+        .count()
+        .max(1);
+    let alpha = s.false_alarm_budget / gated_times as f64;
+    let tol = s
+        .instructions
+        .as_ref()
+        .map(|i| i.tolerance_pct)
+        .unwrap_or(0.1);
+    for m in tonight {
+        let history: Vec<&Metric> = lookup
+            .iter()
+            .filter_map(|n| n.get(m.name.as_str()).copied())
+            .collect();
+        let verdict = |dir: i32| match (dir, m.gated) {
+            (1, true) => "regression",
+            (-1, true) => "improvement",
+            _ => "change",
+        };
+        match m.kind.as_str() {
+            "counter" => {
+                let Some(last) = history.last() else { continue };
+                if last.value != m.value {
+                    let pct = (m.value - last.value) / last.value.abs().max(1.0) * 100.0;
+                    out.push(Finding {
+                        name: m.name.clone(),
+                        verdict: if m.gated { "regression" } else { "change" }.into(),
+                        baseline: Some(last.value),
+                        value: Some(m.value),
+                        change_pct: Some(pct),
+                        message: format!(
+                            "{}: exact counter changed {} → {} ({pct:+.4}%)",
+                            m.name, last.value, m.value
+                        ),
+                    });
+                }
+            }
+            "instructions" => {
+                let Some(last) = history.last() else { continue };
+                let pct = (m.value - last.value) / last.value.max(1.0) * 100.0;
+                if pct.abs() > tol {
+                    let dir = if pct > 0.0 { 1 } else { -1 };
+                    out.push(Finding {
+                        name: m.name.clone(),
+                        verdict: verdict(dir).into(),
+                        baseline: Some(last.value),
+                        value: Some(m.value),
+                        change_pct: Some(pct),
+                        message: format!(
+                            "{}: instructions {:.0} → {:.0} ({pct:+.3}%, tolerance ±{tol}%)",
+                            m.name, last.value, m.value
+                        ),
+                    });
+                }
+            }
+            "time_ratio" | "criterion" => {
+                let mut nights: Vec<(f64, Vec<f64>)> = history
+                    .iter()
+                    .map(|h| (h.value, h.samples.clone()))
+                    .collect();
+                // Start the baseline after the latest change point within it (if ≥ 3 nights remain).
+                let values: Vec<f64> = nights.iter().map(|n| n.0).collect();
+                if let Some(&cp) = detect::change_points(&values, 0.01, 3).last() {
+                    if nights.len() - cp >= 3 {
+                        nights.drain(..cp);
+                    }
+                }
+                let Some(v) =
+                    detect::time_verdict(m.value, &m.samples, &nights, alpha, s.min_change_pct)
+                else {
+                    continue;
+                };
+                if v.direction != 0 {
+                    out.push(Finding {
+                        name: m.name.clone(),
+                        verdict: verdict(v.direction).into(),
+                        baseline: Some(v.baseline),
+                        value: Some(m.value),
+                        change_pct: Some(v.change_pct),
+                        message: format!(
+                            "{}: {:.4} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3})",
+                            m.name,
+                            m.value,
+                            v.baseline,
+                            nights.len(),
+                            v.change_pct,
+                            v.score,
+                            v.threshold,
+                            alpha,
+                            v.mw_p
+                        ),
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+fn fmt_secs(s: f64) -> String {
+    if s >= 60.0 {
+        format!("{}m{:02}s", (s / 60.0) as u64, (s % 60.0) as u64)
+    } else {
+        format!("{s:.1}s")
+    }
+}
+
+fn is_bad(f: &Finding) -> bool {
+    f.verdict == "regression" || f.verdict == "failed"
+}
+
+/// The Markdown summary for a CI job page: regressions first, then improvements, then the table.
+pub fn summary_markdown(
+    suite: &str,
+    commit: &str,
+    wall_s: f64,
+    baseline_nights: usize,
+    metrics: &[Metric],
+    findings: &[Finding],
+) -> String {
+    let mut s = String::new();
+    let gated = metrics.iter().filter(|m| m.gated).count();
+    let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
+    s.push_str(&format!(
+        "# Nightly `{suite}` at `{}`: {}\n\n{} metrics ({gated} gated), {} baseline nights of this machine, {}.\n\n",
+        &commit[..commit.len().min(12)],
+        if bad.is_empty() {
+            "no regression".to_string()
+        } else {
+            format!("{} regression(s)", bad.len())
+        },
+        metrics.len(),
+        baseline_nights,
+        fmt_secs(wall_s)
+    ));
+    s.push_str("## Regressions\n\n");
+    if bad.is_empty() {
+        s.push_str("None.\n");
+    }
+    for f in &bad {
+        s.push_str(&format!("- **{}** {}\n", f.verdict, f.message));
+    }
+    s.push_str("\n## Improvements\n\n");
+    let good: Vec<&Finding> = findings
+        .iter()
+        .filter(|f| f.verdict == "improvement")
+        .collect();
+    if good.is_empty() {
+        s.push_str("None.\n");
+    }
+    for f in good {
+        s.push_str(&format!("- {}\n", f.message));
+    }
+    let other: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "change").collect();
+    if !other.is_empty() {
+        s.push_str("\n## Ungated changes\n\n");
+        for f in other {
+            s.push_str(&format!("- {}\n", f.message));
+        }
+    }
+    s.push_str("\n## Table\n\n| metric | tonight | baseline | change | verdict |\n|---|---:|---:|---:|---|\n");
+    let by_name: BTreeMap<&str, &Finding> = findings.iter().map(|f| (f.name.as_str(), f)).collect();
+    let counters = metrics.iter().filter(|m| m.kind == "counter").count();
+    for m in metrics.iter().filter(|m| m.gated && m.kind != "counter") {
+        let f = by_name.get(m.name.as_str());
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} |\n",
+            m.name,
+            crate::nightly::dashboard::fmt_value(m.value),
+            f.and_then(|f| f.baseline)
+                .map(crate::nightly::dashboard::fmt_value)
+                .unwrap_or_default(),
+            f.and_then(|f| f.change_pct)
+                .map(|c| format!("{c:+.2}%"))
+                .unwrap_or_default(),
+            f.map(|f| f.verdict.as_str()).unwrap_or("ok"),
+        ));
+    }
+    let changed = findings
+        .iter()
+        .filter(|f| f.name.contains("/counter."))
+        .count();
+    s.push_str(&format!(
+        "\n{counters} exact counters, {changed} changed.\n"
+    ));
+    s
+}
+
+/// One job's record over the rounds: the samples of every round, the counters of the first.
+fn merge(mut a: RunRecord, b: &RunRecord) -> RunRecord {
+    use rtbench_reports::Spread;
+    let cat = |x: &Spread, y: &Spread| {
+        let mut v = x.samples.clone();
+        v.extend(&y.samples);
+        Spread::of(&v)
+    };
+    let t = &mut a.time_s;
+    t.build = cat(&t.build, &b.time_s.build);
+    t.trace = cat(&t.trace, &b.time_s.trace);
+    t.intersect = cat(&t.intersect, &b.time_s.intersect);
+    t.shade = cat(&t.shade, &b.time_s.shade);
+    t.trace_cpu = cat(&t.trace_cpu, &b.time_s.trace_cpu);
+    a.repeats += b.repeats;
+    a.mrays_per_s = a.rays_total as f64 / a.time_s.trace.median.max(1e-12) / 1e6;
+    a.wall_s += b.wall_s;
+    a.peak_rss_bytes = a.peak_rss_bytes.max(b.peak_rss_bytes);
+    a
+}
+
+/// `rtbench nightly`.
+pub fn run(a: &NightlyArgs) -> Result<()> {
+    let suite = suite::load(&a.suite)?;
+    // Open the history before running anything: a bad file is exit 2 at once.
+    let mut history = History::open(&a.db, true)?;
+    let start = Instant::now();
+    let env = crate::runs::env::capture();
+    let fp = fingerprint(&env);
+    let started_at = crate::runs::env::now_utc();
+    let mut results = match &a.out {
+        Some(d) => Some(ResultsDir::open(d, false)?),
+        None => None,
+    };
+    let jobs = jobs(&suite);
+    // Rounds: every job once per round, one timed repeat each, so that an engine's i-th sample
+    // and Embree's i-th sample are minutes apart at most and a burst of load on a shared machine
+    // touches one sample of many metrics rather than every sample of one.
+    let common = Common {
+        repeats: 1,
+        size: suite.size,
+        check: false,
+        max_seconds: suite.max_seconds,
+        max_memory: None,
+    };
+    eprintln!(
+        "nightly: suite '{}': {} runs × {} rounds, machine {}",
+        suite.name,
+        jobs.len(),
+        suite.repeats,
+        &fp[..12]
+    );
+    let mut progress = plan::Progress::new(jobs.len() * suite.repeats as usize);
+    let mut merged: Vec<Option<RunRecord>> = vec![None; jobs.len()];
+    for _ in 0..suite.repeats {
+        for (job, slot) in jobs.iter().zip(merged.iter_mut()) {
+            if slot.as_ref().is_some_and(|r| !r.ok()) {
+                continue;
+            }
+            let rec = plan::run_child(job, &common);
+            progress.finish(job, &rec, false);
+            *slot = Some(match slot.take() {
+                Some(prev) if rec.ok() => merge(prev, &rec),
+                _ => rec,
+            });
+        }
+    }
+    let records: Vec<RunRecord> = merged.into_iter().flatten().collect();
+    if let Some(r) = results.as_mut() {
+        for rec in &records {
+            r.put(rec.clone())?;
+        }
+    }
+    let mut metrics = record_metrics(&suite, &records);
+    let mut findings: Vec<Finding> = records
+        .iter()
+        .filter(|r| !r.ok())
+        .map(|r| Finding {
+            name: r.key.clone(),
+            verdict: "failed".into(),
+            baseline: None,
+            value: None,
+            change_pct: None,
+            message: format!(
+                "{}: run failed: {}",
+                r.key,
+                r.reason.as_deref().unwrap_or("")
+            ),
+        })
+        .collect();
+    let scratch = match &a.out {
+        Some(d) => d.clone(),
+        None => std::env::temp_dir(),
+    };
+    if let Some(ins) = &suite.instructions {
+        let t = Instant::now();
+        for v in &ins.variants {
+            for &p in &ins.scenes {
+                let subj = format!("{} {}{}", v.label(), p.name(), ins.sf);
+                match tools::instructions(v, p, ins.sf, ins.size, &scratch) {
+                    Ok((ir, wall)) => {
+                        eprintln!(
+                            "nightly: instructions {subj}: {ir} ({wall:.1} s under valgrind)"
+                        );
+                        metrics.push(metric(
+                            format!("{subj}/instructions"),
+                            "instructions",
+                            "Ir",
+                            ir as f64,
+                            suite.gates("instructions"),
+                            vec![],
+                        ));
+                        metrics.push(metric(
+                            format!("{subj}/valgrind_s"),
+                            "time",
+                            "s",
+                            wall,
+                            false,
+                            vec![wall],
+                        ));
+                    }
+                    Err(e) => findings.push(Finding {
+                        name: format!("{subj}/instructions"),
+                        verdict: "failed".into(),
+                        baseline: None,
+                        value: None,
+                        change_pct: None,
+                        message: format!("{subj}: {e}"),
+                    }),
+                }
+            }
+        }
+        eprintln!(
+            "nightly: instruction counts took {}",
+            fmt_secs(t.elapsed().as_secs_f64())
+        );
+    }
+    if let Some(c) = suite.criterion.as_ref().filter(|_| !a.skip_criterion) {
+        let home = scratch.join(format!("criterion-{}", std::process::id()));
+        match tools::criterion(c, &home, suite.gates("criterion")) {
+            Ok((m, wall)) => {
+                eprintln!(
+                    "nightly: criterion: {} benchmarks in {}",
+                    m.len(),
+                    fmt_secs(wall)
+                );
+                metrics.extend(m);
+            }
+            Err(e) => findings.push(Finding {
+                name: "criterion".into(),
+                verdict: "failed".into(),
+                baseline: None,
+                value: None,
+                change_pct: None,
+                message: e,
+            }),
+        }
+        if a.out.is_none() {
+            let _ = std::fs::remove_dir_all(&home);
+        }
+    }
+    let prev = history.runs(Some(&fp), Some(&suite.name))?;
+    let window: Vec<_> = prev
+        .iter()
+        .rev()
+        .take(suite.baseline_nights)
+        .rev()
+        .collect();
+    let mut baseline = Vec::new();
+    for r in &window {
+        baseline.push(history.metrics(r.id)?);
+    }
+    findings.extend(compare(&suite, &metrics, &baseline));
+    let wall_s = start.elapsed().as_secs_f64();
+    let night = Night {
+        suite: suite.name.clone(),
+        suite_sha256: crate::commands::render::hex(&Sha256::digest(suite.text.as_bytes())),
+        started_at,
+        finished_at: crate::runs::env::now_utc(),
+        git_commit: env.git_commit.clone(),
+        git_dirty: env.git_dirty,
+        fingerprint: fp.clone(),
+        env_json: serde_json::to_string(&env).expect("environment serialises"),
+        wall_s,
+        note: a.note.clone(),
+        metrics: metrics.clone(),
+        findings: findings.clone(),
+    };
+    let md = summary_markdown(
+        &suite.name,
+        &env.git_commit,
+        wall_s,
+        window.len(),
+        &metrics,
+        &findings,
+    );
+    if a.no_record {
+        eprintln!(
+            "nightly: --no-record: the night is not written to {}",
+            a.db.display()
+        );
+    } else {
+        let id = history.append(&night)?;
+        eprintln!("nightly: night {id} written to {}", a.db.display());
+    }
+    if let Some(d) = &a.out {
+        crate::output::write_atomic(&d.join("nightly.md"), |w| {
+            std::io::Write::write_all(w, md.as_bytes())
+        })?;
+        dashboard::write(&history, &d.join("dashboard"))?;
+        eprintln!(
+            "nightly: summary {}, dashboard {}",
+            d.join("nightly.md").display(),
+            d.join("dashboard/index.html").display()
+        );
+    }
+    if a.json {
+        crate::output::print_json(&serde_json::json!({
+            "fingerprint": fp,
+            "wall_s": wall_s,
+            "metrics": metrics.len(),
+            "gated": metrics.iter().filter(|m| m.gated).count(),
+            "baseline_nights": window.len(),
+            "findings": findings,
+        }));
+    } else {
+        print!("{md}");
+    }
+    let bad: Vec<String> = findings
+        .iter()
+        .filter(|f| is_bad(f))
+        .map(|f| f.message.clone())
+        .collect();
+    if !bad.is_empty() {
+        return Err(Failure::Check(format!(
+            "nightly regression: {}",
+            bad.join("; ")
+        )));
+    }
+    Ok(())
+}
+
+/// `rtbench history list|show|export|dashboard`.
+pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
+    use crate::cli::HistoryCommand as H;
+    match c {
+        H::List { db, json } => {
+            let h = History::open(db, false)?;
+            let runs = h.runs(None, None)?;
+            if *json {
+                crate::output::print_json(&serde_json::to_value(&runs).expect("rows serialise"));
+            } else {
+                println!("| id | started | suite | commit | machine | metrics | regressions | wall | note |");
+                println!("|---:|---|---|---|---|---:|---:|---:|---|");
+                for r in runs {
+                    println!(
+                        "| {} | {} | {} | {}{} | {} | {} | {} | {} | {} |",
+                        r.id,
+                        r.started_at,
+                        r.suite,
+                        &r.git_commit[..r.git_commit.len().min(10)],
+                        if r.git_dirty { "+" } else { "" },
+                        &r.fingerprint[..r.fingerprint.len().min(10)],
+                        r.metrics,
+                        r.regressions,
+                        fmt_secs(r.wall_s),
+                        r.note.unwrap_or_default()
+                    );
+                }
+            }
+            Ok(())
+        }
+        H::Show { db, run, json } => {
+            let h = History::open(db, false)?;
+            let id = resolve_run(&h, run.as_deref(), db)?;
+            let row = h
+                .run(id)?
+                .ok_or_else(|| input(format!("{}: no night {id}", db.display())))?;
+            let metrics = h.metrics(id)?;
+            let findings = h.findings(id)?;
+            if *json {
+                let env: serde_json::Value = h
+                    .env_json(id)?
+                    .and_then(|t| serde_json::from_str(&t).ok())
+                    .unwrap_or_default();
+                crate::output::print_json(&serde_json::json!({
+                    "run": row, "environment": env, "metrics": metrics, "findings": findings
+                }));
+            } else {
+                print!(
+                    "{}",
+                    summary_markdown(
+                        &row.suite,
+                        &row.git_commit,
+                        row.wall_s,
+                        0,
+                        &metrics,
+                        &findings
+                    )
+                );
+            }
+            Ok(())
+        }
+        H::Export { db, format, run } => {
+            let h = History::open(db, false)?;
+            match format.as_str() {
+                "csv" => print!("{}", crate::history::export::csv(&h)?),
+                "bmf" => {
+                    let id = resolve_run(&h, run.as_deref(), db)?;
+                    crate::output::print_json(&crate::history::export::bmf(&h.metrics(id)?));
+                }
+                f => return Err(input(format!("--format '{f}': expected csv or bmf"))),
+            }
+            Ok(())
+        }
+        H::Check { db } => {
+            let h = History::open(db, false)?;
+            let verdict = h.integrity()?;
+            let runs = h.runs(None, None)?;
+            let samples: usize = runs.iter().map(|r| r.metrics as usize).sum();
+            println!(
+                "{}: integrity_check {verdict}; {} nights, {samples} metrics",
+                db.display(),
+                runs.len()
+            );
+            if verdict != "ok" {
+                return Err(Failure::Check(format!(
+                    "{}: integrity_check: {verdict}",
+                    db.display()
+                )));
+            }
+            Ok(())
+        }
+        H::Dashboard { db, out } => {
+            let h = History::open(db, false)?;
+            dashboard::write(&h, out)?;
+            eprintln!("dashboard: {}", out.join("index.html").display());
+            Ok(())
+        }
+    }
+}
+
+fn resolve_run(h: &History, run: Option<&str>, db: &std::path::Path) -> Result<i64> {
+    match run {
+        None | Some("latest") => h
+            .runs(None, None)?
+            .last()
+            .map(|r| r.id)
+            .ok_or_else(|| input(format!("{}: the history holds no night", db.display()))),
+        Some(s) => s
+            .parse::<i64>()
+            .map_err(|_| input(format!("--run '{s}': expected a night's id or 'latest'"))),
+    }
+}

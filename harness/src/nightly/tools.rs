@@ -1,0 +1,153 @@
+//! The nightly suite's two outside tools: valgrind's cachegrind for instruction counts, and
+//! `cargo bench` for the criterion kernels.
+
+use super::suite::{Criterion, Variant};
+use crate::history::Metric;
+use rtbench_scenes::spd::Program;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+/// Instructions executed by one `rtbench run-one` (scene generation, build, one untimed and one
+/// timed render, one thread) under `valgrind --tool=cachegrind --cache-sim=no`, and the wall
+/// seconds valgrind took.
+pub fn instructions(
+    v: &Variant,
+    program: Program,
+    sf: u32,
+    size: u32,
+    scratch: &Path,
+) -> Result<(u64, f64), String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find rtbench: {e}"))?;
+    let out = scratch.join(format!(
+        "cachegrind-{}-{}-{}.out",
+        std::process::id(),
+        v.label().replace(['[', ']', '=', ','], "_"),
+        program.name()
+    ));
+    let mut cmd = Command::new("valgrind");
+    cmd.args(["--tool=cachegrind", "--cache-sim=no"])
+        .arg(format!("--cachegrind-out-file={}", out.display()))
+        .arg(exe)
+        .args(["run-one", "--engine", &v.engine, "--scene", program.name()])
+        .args(["--sf", &sf.to_string(), "--repeat", "1", "--size"])
+        .arg(size.to_string())
+        .args(["--threads", "1", "--no-check"]);
+    for (k, val) in &v.settings {
+        cmd.args(["--set", &format!("{k}={val}")]);
+    }
+    let t = Instant::now();
+    let o = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .output()
+        .map_err(|e| format!("cannot start valgrind: {e} (apt-get install valgrind)"))?;
+    let wall = t.elapsed().as_secs_f64();
+    if !o.status.success() {
+        let err = String::from_utf8_lossy(&o.stderr);
+        let last = err
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        return Err(format!("valgrind failed: {}", last.trim()));
+    }
+    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let _ = std::fs::remove_file(&out);
+    let ir = text
+        .lines()
+        .find_map(|l| l.strip_prefix("summary:"))
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse::<u64>().ok())
+        .ok_or_else(|| "cachegrind wrote no summary line".to_string())?;
+    Ok((ir, wall))
+}
+
+fn read_json(p: &Path) -> Option<serde_json::Value> {
+    serde_json::from_str(&std::fs::read_to_string(p).ok()?).ok()
+}
+
+/// Runs `cargo bench -p rtbench-engines --bench BENCH -- ARGS` with its results in `home`
+/// (CRITERION_HOME), from the current directory (the workspace), and reads back every
+/// benchmark's mean estimate and samples (nanoseconds per iteration).
+pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>, f64), String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let _ = std::fs::remove_dir_all(home);
+    let t = Instant::now();
+    let o = Command::new(cargo)
+        .args(["bench", "-p", "rtbench-engines", "--bench", &c.bench, "--"])
+        .args(&c.args)
+        .env("CRITERION_HOME", home)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .output()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    let wall = t.elapsed().as_secs_f64();
+    if !o.status.success() {
+        let err = String::from_utf8_lossy(&o.stderr);
+        let last = err
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        return Err(format!("cargo bench failed: {}", last.trim()));
+    }
+    let mut out = Vec::new();
+    let mut stack = vec![home.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        let Ok(rd) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in rd.flatten() {
+            let p = e.path();
+            if !p.is_dir() {
+                continue;
+            }
+            if p.file_name().is_some_and(|n| n == "new") {
+                let (Some(b), Some(est)) = (
+                    read_json(&p.join("benchmark.json")),
+                    read_json(&p.join("estimates.json")),
+                ) else {
+                    continue;
+                };
+                let (Some(id), Some(mean)) = (
+                    b["full_id"].as_str(),
+                    est["mean"]["point_estimate"].as_f64(),
+                ) else {
+                    continue;
+                };
+                let samples = read_json(&p.join("sample.json"))
+                    .map(|s| {
+                        let iters = s["iters"].as_array().cloned().unwrap_or_default();
+                        let times = s["times"].as_array().cloned().unwrap_or_default();
+                        iters
+                            .iter()
+                            .zip(&times)
+                            .filter_map(|(i, t)| Some(t.as_f64()? / i.as_f64()?))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                out.push(Metric {
+                    name: format!("{id}/criterion_ns"),
+                    kind: "criterion".into(),
+                    unit: "ns".into(),
+                    value: mean,
+                    gated,
+                    samples,
+                });
+            } else {
+                stack.push(p);
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(format!(
+            "cargo bench left no estimates in {}",
+            home.display()
+        ));
+    }
+    out.sort_by(|a, b| a.name.cmp(&b.name));
+    Ok((out, wall))
+}

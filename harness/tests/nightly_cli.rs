@@ -1,0 +1,227 @@
+//! `rtbench nightly` and `rtbench history` as a nightly job uses them: a tiny suite over a few
+//! nights, bad suites and bad databases (exit 2, one line), a planted counter change (exit 1,
+//! named), exports, and the dashboard loaded in headless Chromium without console messages.
+
+mod common;
+
+use common::{expect_input_error, rtbench};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rtbench-nightly-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SUITE: &str = r#"
+name = "tiny"
+engines = ["embree", "grid", "bvh4"]
+scenes = ["tetra"]
+sf = [1]
+repeats = 3
+size = 24
+gate = ["counters", "time_ratio"]
+"#;
+
+fn nightly(suite: &Path, db: &Path, extra: &[&str], plant: Option<&str>) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rtbench"));
+    c.args(["nightly", "--suite"])
+        .arg(suite)
+        .arg("--db")
+        .arg(db)
+        .args(extra);
+    match plant {
+        Some(p) => c.env("RTBENCH_PLANT", p),
+        None => c.env_remove("RTBENCH_PLANT"),
+    };
+    c.output().expect("rtbench runs")
+}
+
+#[test]
+fn bad_suites_and_bad_databases_are_exit_2_with_one_line() {
+    let d = tmp("bad");
+    let good = d.join("good.toml");
+    std::fs::write(&good, SUITE).unwrap();
+    let db = d.join("h.sqlite");
+    let cases = [
+        (
+            SUITE.replace("\"grid\"", "\"gird\""),
+            "unknown engine 'gird'",
+        ),
+        (
+            SUITE.replace("tetra", "tetrahedron"),
+            "unknown scene 'tetrahedron'",
+        ),
+        (
+            SUITE.replace("\"counters\"", "\"latency\""),
+            "unknown metric 'latency'",
+        ),
+        (format!("{SUITE}nights = 3\n"), "unknown field `nights`"),
+    ];
+    for (i, (text, needle)) in cases.iter().enumerate() {
+        let f = d.join(format!("bad{i}.toml"));
+        std::fs::write(&f, text).unwrap();
+        let (fs, dbs) = (f.display().to_string(), db.display().to_string());
+        expect_input_error(&["nightly", "--suite", &fs, "--db", &dbs], needle);
+        expect_input_error(&["nightly", "--suite", &fs, "--db", &dbs], &fs);
+    }
+    // Not SQLite.
+    let junk = d.join("junk.sqlite");
+    std::fs::write(&junk, "not a database\n".repeat(100)).unwrap();
+    let (gs, js) = (good.display().to_string(), junk.display().to_string());
+    expect_input_error(&["nightly", "--suite", &gs, "--db", &js], "not a database");
+    expect_input_error(&["history", "list", "--db", &js], "not a database");
+    // A newer schema.
+    let newer = d.join("newer.sqlite");
+    rusqlite::Connection::open(&newer)
+        .unwrap()
+        .execute_batch("CREATE TABLE x(a); PRAGMA user_version = 99;")
+        .unwrap();
+    let ns = newer.display().to_string();
+    expect_input_error(&["history", "list", "--db", &ns], "schema 99 is newer");
+    expect_input_error(
+        &["nightly", "--suite", &gs, "--db", &ns],
+        "schema 99 is newer",
+    );
+    expect_input_error(
+        &["history", "list", "--db", "/nonexistent/h.sqlite"],
+        "no such history",
+    );
+}
+
+#[test]
+fn nights_accumulate_and_a_planted_counter_change_is_named() {
+    let d = tmp("nights");
+    let suite = d.join("tiny.toml");
+    std::fs::write(&suite, SUITE).unwrap();
+    let db = d.join("h.sqlite");
+    for _ in 0..4 {
+        let o = nightly(&suite, &db, &["--json"], None);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let list = rtbench(&["history", "list", "--db", db.to_str().unwrap(), "--json"]);
+    let runs: Value = serde_json::from_slice(&list.stdout).unwrap();
+    assert_eq!(runs.as_array().unwrap().len(), 4);
+    // Every repeat is stored: 3 ratios per engine but Embree.
+    let show = rtbench(&["history", "show", "--db", db.to_str().unwrap(), "--json"]);
+    let v: Value = serde_json::from_slice(&show.stdout).unwrap();
+    let ratio = v["metrics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "grid tetra1@1/time_ratio")
+        .expect("a ratio");
+    assert_eq!(ratio["samples"].as_array().unwrap().len(), 3);
+    assert!(v["environment"]["cpu_model"].is_string());
+
+    // A planted counter change: exit 1, the counter named; --no-record leaves the history as it was.
+    let o = nightly(&suite, &db, &["--no-record"], Some("counter:grid:tetra"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("grid tetra1@1/counter.primitive_tests"),
+        "{err}"
+    );
+    let list = rtbench(&["history", "list", "--db", db.to_str().unwrap(), "--json"]);
+    let runs: Value = serde_json::from_slice(&list.stdout).unwrap();
+    assert_eq!(runs.as_array().unwrap().len(), 4);
+
+    // Exports.
+    let csv = rtbench(&["history", "export", "--db", db.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&csv.stdout);
+    assert!(text.starts_with("run_id,started_at,git_commit"));
+    assert!(text.lines().count() > 4 * 10, "{text}");
+    let bmf = rtbench(&[
+        "history",
+        "export",
+        "--db",
+        db.to_str().unwrap(),
+        "--format",
+        "bmf",
+    ]);
+    let v: Value = serde_json::from_slice(&bmf.stdout).unwrap();
+    assert!(v["grid tetra1@1"]["time_ratio"]["value"].as_f64().unwrap() > 0.0);
+    let check = rtbench(&["history", "check", "--db", db.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&check.stdout).contains("integrity_check ok"));
+
+    // The dashboard, in headless Chromium.
+    let out = d.join("dash");
+    let o = rtbench(&[
+        "history",
+        "dashboard",
+        "--db",
+        db.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    dashboard_loads_without_console_messages(&out.join("index.html"), &d);
+}
+
+/// Loads a page in headless Chromium; returns its DOM and the console lines Chromium logged.
+fn chromium(page: &Path, profile: &Path) -> Option<(String, Vec<String>)> {
+    let o = Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--dump-dom",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .ok()?;
+    let err = String::from_utf8_lossy(&o.stderr);
+    let console = err
+        .lines()
+        .filter(|l| l.contains(":CONSOLE"))
+        .map(String::from)
+        .collect();
+    Some((String::from_utf8_lossy(&o.stdout).into_owned(), console))
+}
+
+fn dashboard_loads_without_console_messages(page: &Path, dir: &Path) {
+    if std::env::var_os("RTBENCH_SKIP_CHROMIUM").is_some() {
+        eprintln!("RTBENCH_SKIP_CHROMIUM set: the dashboard was not loaded in Chromium");
+        return;
+    }
+    // The canary: a page that logs an error must be caught, or this check proves nothing.
+    let canary = dir.join("canary.html");
+    std::fs::write(
+        &canary,
+        "<html><body><script>console.error('canary')</script></body></html>",
+    )
+    .unwrap();
+    let (_, msgs) = chromium(&canary, &dir.join("profile-canary")).expect(
+        "chromium is not installed: scripts/test.sh installs it (apt-get install chromium), \
+         or set RTBENCH_SKIP_CHROMIUM=1",
+    );
+    assert!(
+        msgs.iter().any(|m| m.contains("canary")),
+        "the canary error was not seen: {msgs:?}"
+    );
+    let (dom, msgs) = chromium(page, &dir.join("profile")).unwrap();
+    assert!(msgs.is_empty(), "console messages: {msgs:?}");
+    assert!(
+        dom.contains("rtbench nightly") && dom.contains("<svg"),
+        "{}",
+        &dom[..dom.len().min(400)]
+    );
+}
