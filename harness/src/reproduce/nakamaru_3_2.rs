@@ -437,9 +437,9 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let frames = memory / PAGE;
     if let Some(c) = caps.iter().find(|c| {
         c.0.as_ref()
-            .is_some_and(|name| !p.sf_ranges.iter().any(|(s, _)| s == name))
+            .is_some_and(|name| !p.sf_ranges.contains_key(name))
     }) {
-        let known: Vec<&str> = p.sf_ranges.iter().map(|(s, _)| s.as_str()).collect();
+        let known: Vec<&str> = p.sf_ranges.keys().map(|s| s.as_str()).collect();
         return Err(input(format!(
             "{}: max-sf names scene '{}', which this table does not run (it runs {})",
             ctx.id,
