@@ -130,6 +130,27 @@ pub fn scenes(ctx: &Ctx, default: &[&str]) -> Result<Vec<String>> {
         .unwrap_or_else(|| default.iter().map(|s| s.to_string()).collect()))
 }
 
+/// The load-balancing tables' shared setting: image size, largest PE count (256 with `--quick`,
+/// else 1,024) and the SPD scenes (tetra with `--quick`, else balls, rings, tetra), each traced with
+/// 003's pass at default costs. A `max-pes` below `min_pes` is refused before anything is traced.
+pub fn load_balancing_setting(ctx: &Ctx, min_pes: u32) -> Result<(u32, u32, Vec<Traced>)> {
+    let size = size(ctx)?;
+    let max_pes = max_pes(ctx, if ctx.quick { 256 } else { 1024 })?;
+    if max_pes < min_pes {
+        return Err(crate::error::input(format!(
+            "{}: max-pes must be at least {min_pes}",
+            ctx.id
+        )));
+    }
+    let default: &[&str] = if ctx.quick {
+        &["tetra"]
+    } else {
+        &["balls", "rings", "tetra"]
+    };
+    let traced = trace_scenes(&scenes(ctx, default)?, size, Costs::default())?;
+    Ok((size, max_pes, traced))
+}
+
 /// Builds the engine on each scene (with the given unit costs: the per-test clocks enter the
 /// record) and traces 003's pass at `size`².
 pub fn trace_scenes(scenes: &[String], size: u32, costs: Costs) -> Result<Vec<Traced>> {

@@ -6,9 +6,9 @@
 use super::object_space_pass::{self as osp, PassRecord, Published, SimRecord, Traced};
 use super::published;
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
-use crate::error::{input, Result};
+use crate::error::Result;
 use crate::workload;
-use rtbench_engines::object_space::config::{Costs, FrameBuffer};
+use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Allocation;
 use rtbench_reports::plot::{Chart, LegendAt};
 use rtbench_reports::{Document, Table as DocTable};
@@ -174,28 +174,17 @@ fn measure(t: &Traced, pe_counts: &[u32], blocks: &[u32]) -> Measured {
 
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
-    let size = osp::size(ctx)?;
-    let max_pes = osp::max_pes(ctx, if ctx.quick { 256 } else { 1024 })?;
-    let default: &[&str] = if ctx.quick {
-        &["tetra"]
-    } else {
-        &["balls", "rings", "tetra"]
-    };
-    let scenes = osp::scenes(ctx, default)?;
+    let (size, max_pes, traced) = osp::load_balancing_setting(ctx, 16)?;
     let pe_counts: Vec<u32> = [16u32, 64, 256, 1024]
         .into_iter()
         .filter(|&p| p <= max_pes)
         .collect();
-    if pe_counts.is_empty() {
-        return Err(input(format!("{}: max-pes must be at least 16", ctx.id)));
-    }
     let blocks: Vec<u32> = if ctx.quick {
         vec![1, 2, 4, 8, 16]
     } else {
         vec![1, 2, 4, 8, 16, 32]
     };
     let pool = workload::pool(ctx.params.threads()?)?;
-    let traced = osp::trace_scenes(&scenes, size, Costs::default())?;
     let measured: Vec<Measured> = traced
         .iter()
         .map(|t| pool.install(|| measure(t, &pe_counts, &blocks)))

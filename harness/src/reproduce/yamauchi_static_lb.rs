@@ -8,7 +8,7 @@ use super::published;
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::Result;
 use crate::workload;
-use rtbench_engines::object_space::config::{Costs, FrameBuffer};
+use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Allocation;
 use rtbench_reports::plot::{Chart, LegendAt};
 use rtbench_reports::{Document, Table as DocTable};
@@ -193,16 +193,8 @@ fn measure(t: &Traced, max_pes: u32) -> Measured {
 
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
-    let size = osp::size(ctx)?;
-    let max_pes = osp::max_pes(ctx, if ctx.quick { 256 } else { 1024 })?;
-    let default: &[&str] = if ctx.quick {
-        &["tetra"]
-    } else {
-        &["balls", "rings", "tetra"]
-    };
-    let scenes = osp::scenes(ctx, default)?;
+    let (size, max_pes, traced) = osp::load_balancing_setting(ctx, 1)?;
     let pool = workload::pool(ctx.params.threads()?)?;
-    let traced = osp::trace_scenes(&scenes, size, Costs::default())?;
     let measured: Vec<Measured> = traced
         .iter()
         .map(|t| pool.install(|| measure(t, max_pes)))
