@@ -18,11 +18,26 @@ fn main() {
     if let Ok(dir) = std::env::var("DEP_RTBENCH_EMBREE_LIB_DIR") {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
     }
-    // Rebuild when HEAD moves or the index changes (a commit or a staged change).
-    for f in ["../.git/HEAD", "../.git/index"] {
-        if std::path::Path::new(f).exists() {
-            println!("cargo:rerun-if-changed={f}");
+    // Rebuild when HEAD moves or the index changes (a commit or a staged change): the checkout's own
+    // HEAD and index, and the branch HEAD names, found through git so that a linked worktree (whose
+    // `.git` is a file) and packed refs are followed too.
+    let mut watch: Vec<std::path::PathBuf> = Vec::new();
+    if let Some(git_dir) = output("git", &["rev-parse", "--absolute-git-dir"]) {
+        let git_dir = std::path::PathBuf::from(git_dir);
+        watch.extend([git_dir.join("HEAD"), git_dir.join("index")]);
+    }
+    if let Some(common) = output(
+        "git",
+        &["rev-parse", "--path-format=absolute", "--git-common-dir"],
+    ) {
+        let common = std::path::PathBuf::from(common);
+        if let Some(branch) = output("git", &["symbolic-ref", "-q", "HEAD"]) {
+            watch.push(common.join(branch));
         }
+        watch.push(common.join("packed-refs"));
+    }
+    for f in watch.iter().filter(|f| f.exists()) {
+        println!("cargo:rerun-if-changed={}", f.display());
     }
     let commit = output("git", &["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
     let dirty = output("git", &["status", "--porcelain", "--untracked-files=no"])
