@@ -288,12 +288,15 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
     let (a, b, c) = (tmp("cmp-a"), tmp("cmp-b"), tmp("cmp-c"));
     quick_run(&a, None);
     quick_run(&b, None);
-    // test-slow spins 20% of its query time more: 13–16% of its trace time relative to Embree,
-    // as measured (queries are 75–90% of a trace here; the rest is shading). A 15% plant gave
-    // +11% against a noise bar of ~10%: too close to be a test that cannot flake.
-    quick_run(&c, Some("0.2"));
+    // test-slow spins its whole query time again: +75–90% of its trace time relative to Embree
+    // (queries are 75–90% of a trace here). A 20% plant (+13–16%) failed in 3 of 7 runs of this
+    // test on a loaded machine, as did the same-commit check at the default 5% threshold: this
+    // test checks that compare matches runs, names a large regression and spares Embree, with
+    // margins wide of this machine's noise. How small a change is caught is issue 16's benchmark
+    // (docs/benchmarks.md), not a test.
+    quick_run(&c, Some("1.0"));
     let same = rtbench()
-        .args(["compare"])
+        .args(["compare", "--threshold", "30"])
         .arg(&a)
         .arg(&b)
         .output()

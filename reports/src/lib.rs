@@ -42,4 +42,4 @@ pub use results::{
     read_environment, read_results, run_key, CheckResult, Environment, ReadError, RunRecord,
     SceneInfo, Spread, Timings,
 };
-pub use summary::{Failure, Row, Summary};
+pub use summary::{engine_label, Failure, Row, Summary};

@@ -77,11 +77,23 @@ pub fn latest_per_key(records: Vec<RunRecord>) -> Vec<RunRecord> {
 
 /// The engine and its settings, as a plot legend names it.
 pub fn label(r: &RunRecord) -> String {
-    if r.settings.is_empty() {
-        r.engine.clone()
+    engine_label(&r.engine, &r.settings)
+}
+
+/// An engine with its settings, as every report names it: `bvh4` or `bvh4[leaf=1,simd=off]`.
+pub fn engine_label<'a, K, V>(engine: &str, settings: impl IntoIterator<Item = (K, V)>) -> String
+where
+    K: std::fmt::Display + 'a,
+    V: std::fmt::Display + 'a,
+{
+    let s: Vec<String> = settings
+        .into_iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
+    if s.is_empty() {
+        engine.to_string()
     } else {
-        let s: Vec<String> = r.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        format!("{}[{}]", r.engine, s.join(","))
+        format!("{engine}[{}]", s.join(","))
     }
 }
 

@@ -59,11 +59,7 @@ fn jobs(s: &Suite) -> Vec<Job> {
 }
 
 fn subject(r: &RunRecord) -> String {
-    let mut label = r.engine.clone();
-    if !r.settings.is_empty() {
-        let s: Vec<String> = r.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        label = format!("{label}[{}]", s.join(","));
-    }
+    let label = rtbench_reports::engine_label(&r.engine, &r.settings);
     format!("{label} {}@{}", r.scene.name, r.threads)
 }
 

@@ -85,15 +85,7 @@ pub struct Variant {
 impl Variant {
     /// `bvh4` or `bvh4[simd=off]`, as reports name it.
     pub fn label(&self) -> String {
-        if self.settings.is_empty() {
-            return self.engine.clone();
-        }
-        let s: Vec<String> = self
-            .settings
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
-        format!("{}[{}]", self.engine, s.join(","))
+        rtbench_reports::engine_label(&self.engine, self.settings.iter().map(|(k, v)| (k, v)))
     }
 }
 

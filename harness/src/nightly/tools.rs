@@ -36,23 +36,7 @@ pub fn instructions(
     for (k, val) in &v.settings {
         cmd.args(["--set", &format!("{k}={val}")]);
     }
-    let t = Instant::now();
-    let o = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .output()
-        .map_err(|e| format!("cannot start valgrind: {e} (apt-get install valgrind)"))?;
-    let wall = t.elapsed().as_secs_f64();
-    if !o.status.success() {
-        let err = String::from_utf8_lossy(&o.stderr);
-        let last = err
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("");
-        return Err(format!("valgrind failed: {}", last.trim()));
-    }
+    let wall = run_tool(&mut cmd, "valgrind", " (apt-get install valgrind)")?;
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let _ = std::fs::remove_file(&out);
     let ir = text
@@ -74,26 +58,11 @@ fn read_json(p: &Path) -> Option<serde_json::Value> {
 pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>, f64), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let _ = std::fs::remove_dir_all(home);
-    let t = Instant::now();
-    let o = Command::new(cargo)
-        .args(["bench", "-p", "rtbench-engines", "--bench", &c.bench, "--"])
+    let mut cmd = Command::new(cargo);
+    cmd.args(["bench", "-p", "rtbench-engines", "--bench", &c.bench, "--"])
         .args(&c.args)
-        .env("CRITERION_HOME", home)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .output()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
-    let wall = t.elapsed().as_secs_f64();
-    if !o.status.success() {
-        let err = String::from_utf8_lossy(&o.stderr);
-        let last = err
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("");
-        return Err(format!("cargo bench failed: {}", last.trim()));
-    }
+        .env("CRITERION_HOME", home);
+    let wall = run_tool(&mut cmd, "cargo bench", "")?;
     let mut out = Vec::new();
     let mut stack = vec![home.to_path_buf()];
     while let Some(dir) = stack.pop() {
@@ -150,4 +119,27 @@ pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>
     }
     out.sort_by(|a, b| a.name.cmp(&b.name));
     Ok((out, wall))
+}
+
+/// Runs an external tool with no input and its output discarded; returns its wall seconds, or an
+/// error with the last line it wrote to stderr.
+fn run_tool(cmd: &mut Command, name: &str, hint: &str) -> Result<f64, String> {
+    let t = Instant::now();
+    let o = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .output()
+        .map_err(|e| format!("cannot start {name}: {e}{hint}"))?;
+    let wall = t.elapsed().as_secs_f64();
+    if !o.status.success() {
+        let err = String::from_utf8_lossy(&o.stderr);
+        let last = err
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        return Err(format!("{name} failed: {}", last.trim()));
+    }
+    Ok(wall)
 }

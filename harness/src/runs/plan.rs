@@ -38,15 +38,7 @@ impl Job {
 
     /// The engine with its settings, as reports name it: `bvh4[simd=off]`.
     fn label(&self) -> String {
-        if self.settings.is_empty() {
-            return self.engine.clone();
-        }
-        let s: Vec<String> = self
-            .settings
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
-        format!("{}[{}]", self.engine, s.join(","))
+        rtbench_reports::engine_label(&self.engine, self.settings.iter().map(|(k, v)| (k, v)))
     }
 
     fn threads_count(&self) -> usize {
