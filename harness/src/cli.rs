@@ -217,6 +217,10 @@ pub struct RunOneArgs {
     pub size: u32,
     #[arg(long)]
     pub no_check: bool,
+    /// Also time N back-to-back pairs of this engine and Embree in this process (alternating
+    /// which goes first) and record their trace-CPU-time ratios: the low-noise yardstick.
+    #[arg(long, default_value_t = 0)]
+    pub paired: u32,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -161,6 +161,12 @@ pub struct RunRecord {
     pub counters: BTreeMap<String, u64>,
     pub build_stats: BTreeMap<String, f64>,
     pub check: Option<CheckResult>,
+    /// Trace CPU time over Embree's, measured in pairs in the same process (`--paired N`):
+    /// the engine and Embree trace the workload back to back, alternating which goes first,
+    /// so a burst of load from other processes falls on both sides of a ratio. One sample per
+    /// pair. `None` when not asked for (and for Embree itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paired_ratio: Option<Spread>,
     pub image_sha256: Option<String>,
     /// Wall seconds of the whole child process.
     pub wall_s: f64,

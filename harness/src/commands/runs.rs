@@ -138,6 +138,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         repeats: p.repeat,
         size: p.size,
         check: !p.no_check,
+        paired: 0,
         max_seconds: p.max_seconds,
         max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
     })
@@ -243,6 +244,7 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
         repeats: a.repeat,
         size: a.size,
         check: !a.no_check,
+        paired: a.paired,
     };
     let rec = run_one(&spec)?;
     println!(

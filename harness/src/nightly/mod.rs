@@ -105,32 +105,21 @@ pub fn record_metrics(s: &Suite, records: &[RunRecord]) -> Vec<Metric> {
             r.time_s.build.samples.clone(),
         ));
         if r.engine != "embree" {
-            let yard = records.iter().find(|y| {
-                y.ok()
-                    && y.engine == "embree"
-                    && y.settings.is_empty()
-                    && y.scene.name == r.scene.name
-                    && y.threads == r.threads
-            });
-            if let Some(y) = yard {
-                let ys = &y.time_s.trace_for_compare().samples;
-                let ratios: Vec<f64> = tr
-                    .samples
-                    .iter()
-                    .zip(ys)
-                    .filter(|(_, b)| **b > 0.0)
-                    .map(|(a, b)| a / b)
-                    .collect();
-                if !ratios.is_empty() {
-                    out.push(metric(
-                        format!("{subj}/time_ratio"),
-                        "time_ratio",
-                        "ratio",
-                        detect::median(&ratios),
-                        s.gates("time_ratio"),
-                        ratios,
-                    ));
-                }
+            let ratios = match &r.paired_ratio {
+                // Pairs timed back to back in one process: every pair of every round.
+                Some(p) if !p.samples.is_empty() => p.samples.clone(),
+                // Otherwise one ratio per round, engine round over Embree round.
+                _ => round_ratios(records, r, &tr.samples),
+            };
+            if !ratios.is_empty() {
+                out.push(metric(
+                    format!("{subj}/time_ratio"),
+                    "time_ratio",
+                    "ratio",
+                    detect::median(&ratios),
+                    s.gates("time_ratio"),
+                    ratios,
+                ));
             }
         }
         let gate = s.gates("counters");
@@ -154,6 +143,24 @@ pub fn record_metrics(s: &Suite, records: &[RunRecord]) -> Vec<Metric> {
         }
     }
     out
+}
+
+/// The engine's trace CPU time in each round over Embree's in the same round.
+fn round_ratios(records: &[RunRecord], r: &RunRecord, samples: &[f64]) -> Vec<f64> {
+    let yard = records.iter().find(|y| {
+        y.ok()
+            && y.engine == "embree"
+            && y.settings.is_empty()
+            && y.scene.name == r.scene.name
+            && y.threads == r.threads
+    });
+    let Some(y) = yard else { return vec![] };
+    samples
+        .iter()
+        .zip(&y.time_s.trace_for_compare().samples)
+        .filter(|(_, b)| **b > 0.0)
+        .map(|(a, b)| a / b)
+        .collect()
 }
 
 /// Tonight's metrics against the baseline nights (oldest first): the findings.
@@ -369,6 +376,10 @@ fn merge(mut a: RunRecord, b: &RunRecord) -> RunRecord {
     t.intersect = cat(&t.intersect, &b.time_s.intersect);
     t.shade = cat(&t.shade, &b.time_s.shade);
     t.trace_cpu = cat(&t.trace_cpu, &b.time_s.trace_cpu);
+    a.paired_ratio = match (&a.paired_ratio, &b.paired_ratio) {
+        (Some(x), Some(y)) => Some(cat(x, y)),
+        (x, y) => x.clone().or_else(|| y.clone()),
+    };
     a.repeats += b.repeats;
     a.mrays_per_s = a.rays_total as f64 / a.time_s.trace.median.max(1e-12) / 1e6;
     a.wall_s += b.wall_s;
@@ -397,6 +408,7 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         repeats: 1,
         size: suite.size,
         check: false,
+        paired: suite.paired,
         max_seconds: suite.max_seconds,
         max_memory: None,
     };

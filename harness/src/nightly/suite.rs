@@ -8,6 +8,7 @@
 //! sf = [2, 3]
 //! threads = [1]
 //! repeats = 5
+//! paired = 8                                # engine/Embree pairs timed back to back per run
 //! size = 128                                # image side of the workload, pixels
 //! gate = ["counters", "time_ratio", "instructions"]
 //! false_alarm_budget = 0.03                 # accepted nights with a false alarm, per night
@@ -47,6 +48,7 @@ struct RawSuite {
     #[serde(default)]
     threads: Option<Vec<usize>>,
     repeats: Option<u32>,
+    paired: Option<u32>,
     size: Option<u32>,
     gate: Vec<String>,
     false_alarm_budget: Option<f64>,
@@ -116,6 +118,9 @@ pub struct Suite {
     /// `None`: all cores.
     pub threads: Vec<Option<usize>>,
     pub repeats: u32,
+    /// Pairs of engine and Embree traces timed back to back in each run (0: the ratio of an
+    /// engine's round to Embree's round, which are separate processes).
+    pub paired: u32,
     pub size: u32,
     pub gate: Vec<String>,
     pub false_alarm_budget: f64,
@@ -254,6 +259,13 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
             "{file}: repeats = {repeats}: from 2 (a rank test needs samples) to 1000"
         )));
     }
+    let paired = raw.paired.unwrap_or(0);
+    if paired > crate::runs::one::MAX_PAIRS {
+        return Err(input(format!(
+            "{file}: paired = {paired}: at most {}",
+            crate::runs::one::MAX_PAIRS
+        )));
+    }
     let size = raw.size.unwrap_or(128);
     crate::workload::check_size(size).map_err(|e| input(format!("{file}: {e}")))?;
     let budget = positive(
@@ -339,6 +351,7 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         sf: raw.sf,
         threads,
         repeats,
+        paired,
         size,
         gate: raw.gate,
         false_alarm_budget: budget,

@@ -21,6 +21,49 @@ pub struct OneSpec {
     pub size: u32,
     /// Cross-check against Embree (skipped for Embree itself, or when it is unavailable).
     pub check: bool,
+    /// Pairs of this engine's and Embree's traces to time back to back (0: none).
+    pub paired: u32,
+}
+
+/// The most pairs `--paired` takes: each pair traces the whole workload twice.
+pub const MAX_PAIRS: u32 = 1000;
+
+fn embree_available() -> bool {
+    rtbench_engines::registry()
+        .iter()
+        .any(|e| e.name == "embree" && (e.available)().is_ok())
+}
+
+/// Trace CPU time of `engine` over Embree's, `pairs` times, back to back in this process. Pair i
+/// traces the engine first when i is even and Embree first when it is odd, so a drift in the
+/// machine's speed within a pair cancels over two pairs.
+fn paired_ratios(
+    pool: &rayon::ThreadPool,
+    scene: &rtbench_scenes::Scene,
+    engine: &dyn rtbench_engines::Engine,
+    yardstick: &dyn rtbench_engines::Engine,
+    size: u32,
+    pairs: u32,
+) -> Vec<f64> {
+    let time = |e: &dyn rtbench_engines::Engine| {
+        pool.install(|| trace::render(scene, e, size, None))
+            .trace_cpu_s
+    };
+    // Embree's first render in a process is slow (cold caches, first-touch page faults), as the
+    // engine's was before its untimed render above.
+    time(yardstick);
+    (0..pairs)
+        .map(|i| {
+            let (a, b) = if i % 2 == 0 {
+                let a = time(engine);
+                (a, time(yardstick))
+            } else {
+                let b = time(yardstick);
+                (time(engine), b)
+            };
+            a / b.max(1e-12)
+        })
+        .collect()
 }
 
 /// Counters as a flat name → value map (common fields and the engine's own).
@@ -62,6 +105,12 @@ fn plant(
 pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     let start = Instant::now();
     workload::check_size(spec.size)?;
+    if spec.paired > MAX_PAIRS {
+        return Err(crate::error::input(format!(
+            "--paired {}: at most {MAX_PAIRS} pairs",
+            spec.paired
+        )));
+    }
     let pool = workload::pool(spec.threads)?;
     let prepared = workload::prepare(&spec.source)?;
     let scene = &prepared.input.scene;
@@ -93,13 +142,24 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     let (engine, render) = last.expect("at least one repeat");
     // Before the cross-check builds Embree too.
     let peak_rss_bytes = workload::peak_rss_bytes().unwrap_or(0);
-    let check = if spec.check
-        && spec.engine != "embree"
-        && rtbench_engines::registry()
-            .iter()
-            .any(|e| e.name == "embree" && (e.available)().is_ok())
-    {
-        let (yardstick, _) = workload::build("embree", &prepared.input, vec![])?;
+    let wants_yardstick = (spec.check || spec.paired > 0) && spec.engine != "embree";
+    let yardstick = if wants_yardstick && embree_available() {
+        Some(workload::build("embree", &prepared.input, vec![])?.0)
+    } else {
+        None
+    };
+    let paired_ratio = match (&yardstick, spec.paired) {
+        (Some(y), n) if n > 0 => Some(Spread::of(&paired_ratios(
+            &pool,
+            scene,
+            engine.as_ref(),
+            y.as_ref(),
+            spec.size,
+            n,
+        ))),
+        _ => None,
+    };
+    let check = if let (true, Some(yardstick)) = (spec.check, &yardstick) {
         let c = pool.install(|| {
             crosscheck::cross_check(scene, engine.as_ref(), yardstick.as_ref(), spec.size)
         });
@@ -161,6 +221,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         counters: flatten_counters(&render.counters),
         build_stats: engine.build_stats(),
         check,
+        paired_ratio,
         image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(&pixels))),
         wall_s: start.elapsed().as_secs_f64(),
         finished_at: super::env::now_utc(),

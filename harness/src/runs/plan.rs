@@ -66,6 +66,8 @@ pub struct Common {
     pub repeats: u32,
     pub size: u32,
     pub check: bool,
+    /// Pairs of engine and Embree traces timed back to back in the child (0: none).
+    pub paired: u32,
     pub max_seconds: Option<f64>,
     pub max_memory: Option<u64>,
 }
@@ -193,6 +195,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     ]);
     if !common.check {
         cmd.arg("--no-check");
+    }
+    if common.paired > 0 {
+        cmd.args(["--paired", &common.paired.to_string()]);
     }
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
