@@ -143,6 +143,11 @@ pub struct PlanArgs {
     /// Skip the cross-check against Embree.
     #[arg(long)]
     pub no_check: bool,
+    /// In every run, also time N back-to-back pairs of the engine and Embree in one process
+    /// (alternating which goes first); `compare` then uses these ratios, which a burst of load
+    /// on a shared machine moves far less than the ratio of two separate runs.
+    #[arg(long, default_value_t = 0)]
+    pub paired: u32,
     /// A run still going after this many seconds is stopped and recorded as failed.
     #[arg(long)]
     pub max_seconds: Option<f64>,

@@ -369,6 +369,15 @@ fn compare_times(
     anchors_b: &Anchors,
     c: &mut Comparison,
 ) {
+    // Both runs timed in pairs with Embree in their own processes (`run --paired N`): those
+    // ratios, with their own spread.
+    if let (Some(pa), Some(pb)) = (paired(ra), paired(rb)) {
+        c.times_compared += 1;
+        let change_pct = (pb.median / pa.median - 1.0) * 100.0;
+        let spread_pct = 2.0 * pa.rel_noise().max(pb.rel_noise()) * 100.0;
+        time_finding(ra, pa.median, pb.median, change_pct, spread_pct, c);
+        return;
+    }
     let (Some(q_a), Some(q_b)) = (anchors_a.compare_ratio(ra), anchors_b.compare_ratio(rb)) else {
         let missing = match (
             anchors_a.anchor(ra).is_none(),
@@ -403,6 +412,25 @@ fn compare_times(
     };
     let spread_pct =
         2.0 * noise(ra, anchors_a.anchor(ra)).max(noise(rb, anchors_b.anchor(rb))) * 100.0;
+    time_finding(ra, q_a, q_b, change_pct, spread_pct, c);
+}
+
+/// A run's paired ratios to Embree, when it has some.
+fn paired(r: &RunRecord) -> Option<&crate::results::Spread> {
+    r.paired_ratio
+        .as_ref()
+        .filter(|p| r.ok() && !p.samples.is_empty())
+}
+
+/// A time-ratio finding when the change passes the threshold and the ratios' own spread.
+fn time_finding(
+    ra: &RunRecord,
+    q_a: f64,
+    q_b: f64,
+    change_pct: f64,
+    spread_pct: f64,
+    c: &mut Comparison,
+) {
     let tolerance_pct = c.threshold_pct.max(spread_pct);
     if change_pct.abs() <= tolerance_pct {
         return;

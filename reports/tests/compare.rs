@@ -261,3 +261,37 @@ fn bad_input_is_an_error() {
         Err(ReportError::BadThreshold(_))
     ));
 }
+
+/// Paired ratios (engine and Embree timed back to back in one process), 1% spread around `q`.
+fn pair(r: &mut RunRecord, q: f64) {
+    r.paired_ratio = Some(samples(q, 0.01));
+}
+
+#[test]
+fn paired_ratios_are_compared_when_both_runs_have_them() {
+    let (mut a, mut b) = (base(), base());
+    // Embree's separate run in B was unlucky: the separate-run ratio of grid/balls3 moves 40%...
+    scale_trace(find(&mut b, "embree/balls3@1"), 0.6);
+    // ...while the pairs timed in one process say grid is as fast as before.
+    pair(find(&mut a, "grid/balls3@1"), 0.5);
+    pair(find(&mut b, "grid/balls3@1"), 0.5);
+    let c = compare_sets(&a, &b, 5.0);
+    assert!(
+        c.regressions
+            .iter()
+            .all(|f| !f.key.starts_with("grid/balls3")),
+        "{}",
+        c.to_markdown()
+    );
+    // bvh2 on balls3 has no pairs: its separate-run ratio shows Embree's luck as a regression.
+    assert!(c.regressions.iter().any(|f| f.key == "bvh2/balls3@1"));
+    // A 20% slower engine in its pairs is a regression.
+    pair(find(&mut b, "grid/balls3@1"), 0.6);
+    let c = compare_sets(&a, &b, 5.0);
+    let f = c
+        .regressions
+        .iter()
+        .find(|f| f.key == "grid/balls3@1")
+        .expect("the paired slowdown is found");
+    assert!((f.change_pct.unwrap() - 20.0).abs() < 0.5, "{f:?}");
+}

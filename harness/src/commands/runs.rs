@@ -138,7 +138,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         repeats: p.repeat,
         size: p.size,
         check: !p.no_check,
-        paired: 0,
+        paired: p.paired,
         max_seconds: p.max_seconds,
         max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
     })
