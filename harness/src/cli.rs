@@ -104,6 +104,17 @@ pub enum HistoryCommand {
         #[arg(long)]
         run: Option<String>,
     },
+    /// The detection run again over a suite's nights in the history, each night against the
+    /// nights before it, with the suite file's settings: which nights report a regression.
+    Replay {
+        #[arg(long)]
+        db: PathBuf,
+        /// The suite file (its name selects the nights; its settings drive the detection).
+        #[arg(long)]
+        suite: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
     /// `PRAGMA integrity_check` of the history, and its nights (exit 1 when not whole).
     Check {
         #[arg(long)]

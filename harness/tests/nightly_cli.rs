@@ -22,6 +22,7 @@ engines = ["embree", "grid", "bvh4"]
 scenes = ["tetra"]
 sf = [1]
 repeats = 3
+paired = 2
 size = 24
 gate = ["counters", "time_ratio"]
 "#;
@@ -110,7 +111,7 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
     let list = rtbench(&["history", "list", "--db", db.to_str().unwrap(), "--json"]);
     let runs: Value = serde_json::from_slice(&list.stdout).unwrap();
     assert_eq!(runs.as_array().unwrap().len(), 4);
-    // Every repeat is stored: 3 ratios per engine but Embree.
+    // Every pair of every round is stored: 3 rounds × 2 pairs of ratios per engine but Embree.
     let show = rtbench(&["history", "show", "--db", db.to_str().unwrap(), "--json"]);
     let v: Value = serde_json::from_slice(&show.stdout).unwrap();
     let ratio = v["metrics"]
@@ -119,7 +120,7 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
         .iter()
         .find(|m| m["name"] == "grid tetra1@1/time_ratio")
         .expect("a ratio");
-    assert_eq!(ratio["samples"].as_array().unwrap().len(), 3);
+    assert_eq!(ratio["samples"].as_array().unwrap().len(), 6);
     assert!(v["environment"]["cpu_model"].is_string());
 
     // A planted counter change: exit 1, the counter named; --no-record leaves the history as it was.
@@ -151,6 +152,25 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
     assert!(v["grid tetra1@1"]["time_ratio"]["value"].as_f64().unwrap() > 0.0);
     let check = rtbench(&["history", "check", "--db", db.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&check.stdout).contains("integrity_check ok"));
+
+    // Replay: the detection again over the four nights, each against the nights before it.
+    let replay = rtbench(&[
+        "history",
+        "replay",
+        "--db",
+        db.to_str().unwrap(),
+        "--suite",
+        suite.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: Value = serde_json::from_slice(&replay.stdout).unwrap();
+    assert_eq!(v["nights"], 4, "{v}");
+    let nights = v["nights_detail"].as_array().unwrap();
+    let baselines: Vec<u64> = nights
+        .iter()
+        .map(|n| n["baseline_nights"].as_u64().unwrap())
+        .collect();
+    assert_eq!(baselines, [0, 1, 2, 3]);
 
     // The dashboard, in headless Chromium.
     let out = d.join("dash");

@@ -163,6 +163,18 @@ fn round_ratios(records: &[RunRecord], r: &RunRecord, samples: &[f64]) -> Vec<f6
         .collect()
 }
 
+/// The median of each round of a time metric: a time ratio's samples come `paired` per round
+/// (one per round without pairs); a criterion estimate is one round.
+fn round_medians(s: &Suite, m: &Metric) -> Vec<f64> {
+    if m.kind != "time_ratio" || m.samples.is_empty() {
+        return vec![m.value];
+    }
+    m.samples
+        .chunks(s.paired.max(1) as usize)
+        .map(detect::median)
+        .collect()
+}
+
 /// Tonight's metrics against the baseline nights (oldest first): the findings.
 pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<Finding> {
     let mut out = Vec::new();
@@ -240,9 +252,15 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                         nights.drain(..cp);
                     }
                 }
-                let Some(v) =
-                    detect::time_verdict(m.value, &m.samples, &nights, alpha, s.min_change_pct)
-                else {
+                let rounds = round_medians(s, m);
+                let Some(v) = detect::time_verdict(
+                    m.value,
+                    &m.samples,
+                    &rounds,
+                    &nights,
+                    alpha,
+                    s.min_change_pct,
+                ) else {
                     continue;
                 };
                 if v.direction != 0 {
@@ -253,7 +271,7 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                         value: Some(m.value),
                         change_pct: Some(v.change_pct),
                         message: format!(
-                            "{}: {:.4} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3})",
+                            "{}: {:.4} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3}; every round {:+.2}% or more)",
                             m.name,
                             m.value,
                             v.baseline,
@@ -262,7 +280,8 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                             v.score,
                             v.threshold,
                             alpha,
-                            v.mw_p
+                            v.mw_p,
+                            v.weakest_round_pct
                         ),
                     });
                 }
@@ -682,6 +701,7 @@ pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
             }
             Ok(())
         }
+        H::Replay { db, suite, json } => replay(db, suite, *json),
         H::Check { db } => {
             let h = History::open(db, false)?;
             let verdict = h.integrity()?;
@@ -707,6 +727,79 @@ pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `rtbench history replay`: every night of the suite, in order, compared (by [`compare`], as
+/// `rtbench nightly` compares) with the nights of the same machine before it.
+fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Result<()> {
+    let s = suite::load(suite_file)?;
+    let h = History::open(db, false)?;
+    let runs = h.runs(None, Some(&s.name))?;
+    if runs.is_empty() {
+        return Err(input(format!(
+            "{}: no night of suite '{}' in the history",
+            db.display(),
+            s.name
+        )));
+    }
+    let mut rows = Vec::new();
+    let mut alarmed = 0;
+    for (i, r) in runs.iter().enumerate() {
+        let prev: Vec<_> = runs[..i]
+            .iter()
+            .filter(|p| p.fingerprint == r.fingerprint)
+            .collect();
+        let window = &prev[prev.len().saturating_sub(s.baseline_nights)..];
+        let baseline = window
+            .iter()
+            .map(|p| h.metrics(p.id))
+            .collect::<Result<Vec<_>>>()?;
+        let findings = compare(&s, &h.metrics(r.id)?, &baseline);
+        let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
+        if !bad.is_empty() {
+            alarmed += 1;
+        }
+        if !json {
+            println!(
+                "night {} ({}, {} baseline nights): {}",
+                r.id,
+                r.note.as_deref().unwrap_or(""),
+                window.len(),
+                if bad.is_empty() {
+                    "no regression".to_string()
+                } else {
+                    bad.iter()
+                        .map(|f| f.message.as_str())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                }
+            );
+        }
+        rows.push(serde_json::json!({
+            "id": r.id,
+            "note": r.note,
+            "baseline_nights": window.len(),
+            "recorded_regressions": r.regressions,
+            "regressions": bad.iter().map(|f| &f.message).collect::<Vec<_>>(),
+        }));
+    }
+    let recorded = runs.iter().filter(|r| r.regressions > 0).count();
+    if json {
+        crate::output::print_json(&serde_json::json!({
+            "suite": s.name,
+            "nights": runs.len(),
+            "nights_with_regression": alarmed,
+            "nights_with_regression_recorded": recorded,
+            "nights_detail": rows,
+        }));
+    } else {
+        println!(
+            "replay: {} nights of suite '{}': {alarmed} with a reported regression ({recorded} when they ran)",
+            runs.len(),
+            s.name
+        );
+    }
+    Ok(())
 }
 
 fn resolve_run(h: &History, run: Option<&str>, db: &std::path::Path) -> Result<i64> {
