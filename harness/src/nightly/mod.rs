@@ -176,7 +176,16 @@ fn round_medians(s: &Suite, m: &Metric) -> Vec<f64> {
 }
 
 /// Tonight's metrics against the baseline nights (oldest first): the findings.
-pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<Finding> {
+/// `suspects`: the time metrics the last baseline night found changed on their first night
+/// (verdict `suspect`); with `confirm_nights = 2` a time regression is reported only when the
+/// night before was a suspect for the same metric, and a suspect night leaves that metric's
+/// baseline.
+pub fn compare(
+    s: &Suite,
+    tonight: &[Metric],
+    baseline: &[Vec<Metric>],
+    suspects: &std::collections::BTreeSet<String>,
+) -> Vec<Finding> {
     let mut out = Vec::new();
     let lookup: Vec<BTreeMap<&str, &Metric>> = baseline
         .iter()
@@ -245,6 +254,10 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                     .iter()
                     .map(|h| (h.value, h.samples.clone()))
                     .collect();
+                let confirming = suspects.contains(&m.name);
+                if confirming {
+                    nights.pop();
+                }
                 // Start the baseline after the latest change point within it (if ≥ 3 nights remain).
                 let values: Vec<f64> = nights.iter().map(|n| n.0).collect();
                 if let Some(&cp) = detect::change_points(&values, 0.01, 3).last() {
@@ -264,9 +277,16 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                     continue;
                 };
                 if v.direction != 0 {
+                    let first_night =
+                        v.direction == 1 && m.gated && s.confirm_nights > 1 && !confirming;
                     out.push(Finding {
                         name: m.name.clone(),
-                        verdict: verdict(v.direction).into(),
+                        verdict: if first_night {
+                            "suspect"
+                        } else {
+                            verdict(v.direction)
+                        }
+                        .into(),
                         baseline: Some(v.baseline),
                         value: Some(m.value),
                         change_pct: Some(v.change_pct),
@@ -284,6 +304,14 @@ pub fn compare(s: &Suite, tonight: &[Metric], baseline: &[Vec<Metric>]) -> Vec<F
                             v.weakest_round_pct
                         ),
                     });
+                    if let (true, Some(f)) = (first_night, out.last_mut()) {
+                        f.message
+                            .push_str(" — first night: a regression if the next night confirms it");
+                    }
+                    if let (true, Some(f)) = (confirming && v.direction == 1, out.last_mut()) {
+                        f.message
+                            .push_str(" — confirmed: the night before was a suspect");
+                    }
                 }
             }
             _ => {}
@@ -298,6 +326,15 @@ fn fmt_secs(s: f64) -> String {
     } else {
         format!("{s:.1}s")
     }
+}
+
+/// The metrics a night found changed for the first time (verdict `suspect`).
+fn suspects_of(findings: &[Finding]) -> std::collections::BTreeSet<String> {
+    findings
+        .iter()
+        .filter(|f| f.verdict == "suspect")
+        .map(|f| f.name.clone())
+        .collect()
 }
 
 fn is_bad(f: &Finding) -> bool {
@@ -345,6 +382,13 @@ pub fn summary_markdown(
     }
     for f in good {
         s.push_str(&format!("- {}\n", f.message));
+    }
+    let watch: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "suspect").collect();
+    if !watch.is_empty() {
+        s.push_str("\n## Watch: time changes on their first night\n\n");
+        for f in watch {
+            s.push_str(&format!("- {}\n", f.message));
+        }
     }
     let other: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "change").collect();
     if !other.is_empty() {
@@ -558,7 +602,11 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
     for r in &window {
         baseline.push(history.metrics(r.id)?);
     }
-    findings.extend(compare(&suite, &metrics, &baseline));
+    let suspects = match window.last() {
+        Some(r) => suspects_of(&history.findings(r.id)?),
+        None => Default::default(),
+    };
+    findings.extend(compare(&suite, &metrics, &baseline, &suspects));
     let wall_s = start.elapsed().as_secs_f64();
     let night = Night {
         suite: suite.name.clone(),
@@ -744,6 +792,7 @@ fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Res
     }
     let mut rows = Vec::new();
     let mut alarmed = 0;
+    let mut previous: BTreeMap<i64, std::collections::BTreeSet<String>> = BTreeMap::new();
     for (i, r) in runs.iter().enumerate() {
         let prev: Vec<_> = runs[..i]
             .iter()
@@ -754,7 +803,14 @@ fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Res
             .iter()
             .map(|p| h.metrics(p.id))
             .collect::<Result<Vec<_>>>()?;
-        let findings = compare(&s, &h.metrics(r.id)?, &baseline);
+        // The suspects of the night before, as this replay found them (the live run read them
+        // from the history the same way).
+        let suspects = match window.last() {
+            Some(p) => previous.get(&p.id).cloned().unwrap_or_default(),
+            None => Default::default(),
+        };
+        let findings = compare(&s, &h.metrics(r.id)?, &baseline, &suspects);
+        previous.insert(r.id, suspects_of(&findings));
         let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
         if !bad.is_empty() {
             alarmed += 1;
@@ -781,6 +837,7 @@ fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Res
             "baseline_nights": window.len(),
             "recorded_regressions": r.regressions,
             "regressions": bad.iter().map(|f| &f.message).collect::<Vec<_>>(),
+            "suspects": findings.iter().filter(|f| f.verdict == "suspect").map(|f| &f.message).collect::<Vec<_>>(),
         }));
     }
     let recorded = runs.iter().filter(|r| r.regressions > 0).count();
@@ -812,5 +869,67 @@ fn resolve_run(h: &History, run: Option<&str>, db: &std::path::Path) -> Result<i
         Some(s) => s
             .parse::<i64>()
             .map_err(|_| input(format!("--run '{s}': expected a night's id or 'latest'"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ratio(value: f64) -> Metric {
+        Metric {
+            name: "grid tetra3@1/time_ratio".into(),
+            kind: "time_ratio".into(),
+            unit: "ratio".into(),
+            value,
+            gated: true,
+            samples: vec![value * 0.999, value, value * 1.001],
+        }
+    }
+
+    #[test]
+    fn a_time_change_is_a_suspect_first_and_a_regression_when_the_next_night_confirms() {
+        let text = |confirm: u32| {
+            format!(
+                "engines = [\"embree\", \"grid\"]\nscenes = [\"tetra\"]\nsf = [3]\n\
+                 gate = [\"time_ratio\"]\nconfirm_nights = {confirm}\n"
+            )
+        };
+        let two = suite::parse("s.toml", &text(2)).unwrap();
+        let one = suite::parse("s.toml", &text(1)).unwrap();
+        let baseline: Vec<Vec<Metric>> = [1.0, 1.004, 0.997, 1.002, 0.999, 1.001]
+            .iter()
+            .map(|&v| vec![ratio(v)])
+            .collect();
+        let none = Default::default();
+        let slow = [ratio(1.10)];
+        let f = compare(&two, &slow, &baseline, &none);
+        assert_eq!(f.len(), 1);
+        assert_eq!(f[0].verdict, "suspect", "{}", f[0].message);
+        assert!(!is_bad(&f[0]));
+        assert_eq!(
+            compare(&one, &slow, &baseline, &none)[0].verdict,
+            "regression"
+        );
+        // The next night: the suspect night (the last of the baseline) is left out of the
+        // baseline, and the change confirmed is a regression.
+        let mut with_suspect = baseline.clone();
+        with_suspect.push(vec![ratio(1.10)]);
+        let f = compare(&two, &slow, &with_suspect, &suspects_of(&f));
+        assert_eq!(f[0].verdict, "regression", "{}", f[0].message);
+        assert!(f[0].message.contains("confirmed"));
+        // A suspect the next night does not confirm is nothing.
+        let f = compare(
+            &two,
+            &[ratio(1.0)],
+            &with_suspect,
+            &["grid tetra3@1/time_ratio".to_string()].into(),
+        );
+        assert!(f.is_empty(), "{f:?}");
+        assert!(suite::parse("s.toml", &text(3))
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("confirm_nights = 3: 1 or 2"));
     }
 }

@@ -12,6 +12,7 @@
 //! size = 128                                # image side of the workload, pixels
 //! gate = ["counters", "time_ratio", "instructions"]
 //! false_alarm_budget = 0.03                 # accepted nights with a false alarm, per night
+//! confirm_nights = 2                        # a time regression needs two nights in a row (1: one)
 //!
 //! [instructions]                            # valgrind (cachegrind) instruction counts
 //! engines = ["grid", "bvh4"]
@@ -54,6 +55,7 @@ struct RawSuite {
     false_alarm_budget: Option<f64>,
     min_change_pct: Option<f64>,
     baseline_nights: Option<usize>,
+    confirm_nights: Option<u32>,
     max_seconds: Option<f64>,
     instructions: Option<RawInstructions>,
     criterion: Option<RawCriterion>,
@@ -126,6 +128,9 @@ pub struct Suite {
     pub false_alarm_budget: f64,
     pub min_change_pct: f64,
     pub baseline_nights: usize,
+    /// 1: a time regression is reported on its first night; 2: the first night is a `suspect`
+    /// (reported, not failing) and the regression is reported when the next night confirms it.
+    pub confirm_nights: u32,
     pub max_seconds: Option<f64>,
     pub instructions: Option<Instructions>,
     pub criterion: Option<Criterion>,
@@ -290,6 +295,12 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
             "{file}: baseline_nights = {baseline_nights}: at least 3"
         )));
     }
+    let confirm_nights = raw.confirm_nights.unwrap_or(1);
+    if !(1..=2).contains(&confirm_nights) {
+        return Err(input(format!(
+            "{file}: confirm_nights = {confirm_nights}: 1 or 2"
+        )));
+    }
     if let Some(s) = raw.max_seconds {
         positive(file, "max_seconds", s)?;
     }
@@ -357,6 +368,7 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         false_alarm_budget: budget,
         min_change_pct,
         baseline_nights,
+        confirm_nights,
         max_seconds: raw.max_seconds,
         instructions,
         criterion,
