@@ -105,7 +105,10 @@ impl<const N: usize> ChildTest<N> for ScalarPerBox {
     fn prepare(r: &SlabRay) -> PlainRay {
         let dir = r.rdir.recip();
         let org = (r.org_rdir_near + r.org_rdir_far) * 0.5 * dir;
-        PlainRay { org: org.to_array(), dir: dir.to_array() }
+        PlainRay {
+            org: org.to_array(),
+            dir: dir.to_array(),
+        }
     }
 
     #[inline(always)]

@@ -228,7 +228,11 @@ mod tests {
         assert!(!parse(2, &[]).unwrap().packets);
         assert!(parse(4, &[]).unwrap().precompute);
         assert!(parse(4, &[("precompute", "off")]).is_err());
-        assert!(!parse(4, &[("precompute", "off"), ("simd", "off")]).unwrap().precompute);
+        assert!(
+            !parse(4, &[("precompute", "off"), ("simd", "off")])
+                .unwrap()
+                .precompute
+        );
         assert!(matches!(
             parse(4, &[("colour", "red")]),
             Err(EngineError::UnknownKey { .. })

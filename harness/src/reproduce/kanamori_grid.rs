@@ -544,7 +544,8 @@ fn chart(id: &str, scene: &str, sweep: &[GridPoint]) -> Chart {
             .map(|(i, &sf)| Series {
                 name: format!("{scene}{sf} {name}"),
                 color: 1 + i,
-                points: sweep.iter().filter(|g| g.scene == scene && g.sf == sf).map(|g| PlotPoint { x: g.res[0] as f64, y: f(g).max(1e-3), y_range: None }).collect(),
+                // Zero (no empty cell visited) has no place on a log axis: those points are left out.
+                points: sweep.iter().filter(|g| g.scene == scene && g.sf == sf && f(g) > 0.0).map(|g| PlotPoint { x: g.res[0] as f64, y: f(g), y_range: None }).collect(),
             })
             .collect()
     };
