@@ -156,7 +156,7 @@ fn measure(p: &Published, quick: bool, trees: &mut Vec<Tree>, renders: &mut Vec<
         let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
         let rays = Camera::new(&prepared.input.scene.view).pixel_centre_rays(IMAGE.0, IMAGE.1);
-        renders.extend(engine_timing::time_engines(RENDERED, &prepared.input, &rays, if quick { 3 } else { 5 }, 1, (scene, sf), "kimura-3.3")?);
+        renders.extend(engine_timing::time_engines(RENDERED, &prepared.input, &rays, if quick { 1 } else { 5 }, 1, (scene, sf), "kimura-3.3")?);
         let geometry = &prepared.input.geometry;
         let tris = geometry.prims.len() as u64;
         let published_tris = p
