@@ -200,7 +200,7 @@ struct BuildPoint {
     build_s: f64,
 }
 
-const BUILD_ENGINES: &[(&str, &str, &[(&str, &str)])] = &[
+const BUILD_ENGINES: &[super::engine_timing::Timee] = &[
     ("grid (lecture, n^(1/3) per axis)", "grid", &[("res", "cuberoot"), ("insert", "exact"), ("mailbox", "false"), ("preset", "rss-r")]),
     ("grid (bbox insertion)", "grid", &[("res", "cuberoot"), ("insert", "bbox"), ("mailbox", "false"), ("preset", "rss-r")]),
     ("bvh2 (binned SAH)", "bvh2", &[]),

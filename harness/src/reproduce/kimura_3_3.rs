@@ -34,6 +34,7 @@ pub const TABLE: Table = Table {
         Claim { key: "sah-memory-min-4-8", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "sah-deeper", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "integer-depth-b10", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "sah-build-same", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "sah-nodes-smooth", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "median-nodes-extreme-8", fidelity: Fidelity::Faithful, why: "" },
         Claim {
@@ -213,6 +214,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let scenes = measure(&p, ctx.quick, &mut trees, &mut renders)?;
     let mut rows = analyse(&p, &scenes);
     rows.extend(render_rows(&p, &renders));
+    rows.extend(build_rows(&trees));
     let doc = document(&p, &trees, &renders, &rows, ctx.quick);
     let compare = rows
         .iter()
@@ -381,6 +383,32 @@ fn scene_builder_rows(rows: &mut Vec<Row>, on: &str, builder: &str, widths: &[us
 /// both readings are shown, each labelled.
 type Bytes = fn(&TreeStats) -> u64;
 const READINGS: [(&str, Bytes); 2] = [("empty nodes not counted", TreeStats::model_bytes), ("empty nodes counted", TreeStats::model_bytes_with_empty)];
+
+/// §3.5 (claimed, not measured by 001): the N-ary SAH build costs about what the binary one does, since
+/// it does the same splits. One build per tree (`tree_statistics`), wall time (pure).
+fn build_rows(trees: &[Tree]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let mut scenes: Vec<(&str, u32)> = trees.iter().map(|t| (t.scene, t.sf)).collect();
+    scenes.dedup();
+    for (scene, sf) in scenes {
+        let at = |n: usize| trees.iter().find(|t| t.scene == scene && t.sf == sf && t.builder == "sah-sweep" && t.width == n).map(|t| t.build_s);
+        let Some(b2) = at(2) else { continue };
+        let ratios: Vec<(usize, f64)> = [4, 8, 16].into_iter().filter_map(|n| at(n).map(|b| (n, b / b2))).collect();
+        let four = ratios.iter().find(|r| r.0 == 4).map_or(f64::NAN, |r| r.1);
+        rows.push(
+            Row::new(
+                "sah-build-same",
+                format!("{scene}{sf}"),
+                "almost the same as binary (§3.5, claimed without a measurement)",
+                format!("N=2 {:.0} ms; N / N=2: {}", b2 * 1e3, ratios.iter().map(|(n, r)| format!("{n}: {r:.2}")).collect::<Vec<_>>().join(", ")),
+                Kind::Ratio,
+                Verdict::of(four <= 1.25),
+            )
+            .with_note("sah-sweep: build wall time N / N=2, one build each; holds when N=4 is within 1.25x"),
+        );
+    }
+    rows
+}
 
 /// Fig. 3.17 (SAH renders faster than object median, per width) and §4.2.2's box-test count (pure).
 fn render_rows(p: &Published, renders: &[Timed]) -> Vec<Row> {
