@@ -17,8 +17,8 @@ use std::collections::BTreeMap;
 pub const TABLE: Table = Table {
     id: "kimura-3.3",
     seed: "001",
-    source: "§3.3–3.5, Tables 3.1, 3.3, Figs. 3.12–3.19",
-    about: "001 (Kimura 2007) §3.3-3.5: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
+    source: "§3.3–3.5, Figs. 3.12–3.19",
+    about: "001 (Kimura 2007) §3.3-3.5, Tables 3.1, 3.3: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
     runtime: Runtime {
         quick: "seconds",
         full: "minutes",

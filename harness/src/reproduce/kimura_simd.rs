@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 pub const TABLE: Table = Table {
     id: "kimura-simd",
     seed: "001",
-    source: "§4.2–4.3, Table 4.1, Fig. 4.5",
+    source: "§4.2–4.3, T. 4.1, Fig. 4.5",
     about: "001 (Kimura 2007) §4.3: SIMD 4-ary single-ray traversal speed-up (2.32-4.45x)",
     runtime: Runtime {
         quick: "seconds",
