@@ -83,6 +83,29 @@ fn kimura_trees_quick_four_ary_is_shallower() {
             depth(2)
         );
     }
+    // Issue 17: both memory readings and the render timings of Fig. 3.17 are there, each row labelled.
+    let claims: Vec<(&str, &str)> = v["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["claim"].as_str().unwrap(), r["subject"].as_str().unwrap()))
+        .collect();
+    for reading in ["empty nodes counted", "empty nodes not counted"] {
+        assert!(
+            claims
+                .iter()
+                .any(|(c, s)| *c == "memory-less-than-binary" && s.ends_with(reading)),
+            "no memory row for '{reading}'"
+        );
+    }
+    assert_eq!(
+        claims
+            .iter()
+            .filter(|(c, _)| *c == "sah-renders-faster")
+            .count(),
+        3
+    );
+    assert!(claims.iter().any(|(c, _)| *c == "integer-depth-b10"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

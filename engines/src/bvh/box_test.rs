@@ -85,6 +85,60 @@ impl<const N: usize> ChildTest<N> for Scalar {
     }
 }
 
+/// The scalar slab test without 001's per-ray precomputation (§1.7, thesis Ch. 4.2.2): the ray
+/// is kept as origin and direction, and every box test divides by the direction and orders each
+/// slab's two distances with a min and a max, as PBRT's `BBox::IntersectP` [PH04] does. For
+/// `precompute=off` only: 001's ablation of what the precomputation is worth.
+pub struct ScalarPerBox;
+
+/// The ray as origin and direction (recovered from the slab ray to within its rounding pad).
+#[derive(Clone, Copy)]
+pub struct PlainRay {
+    org: [f32; 3],
+    dir: [f32; 3],
+}
+
+impl<const N: usize> ChildTest<N> for ScalarPerBox {
+    type Ray = PlainRay;
+
+    #[inline(always)]
+    fn prepare(r: &SlabRay) -> PlainRay {
+        let dir = r.rdir.recip();
+        let org = (r.org_rdir_near + r.org_rdir_far) * 0.5 * dir;
+        PlainRay {
+            org: org.to_array(),
+            dir: dir.to_array(),
+        }
+    }
+
+    #[inline(always)]
+    fn test(node: &WideNode<N>, r: &PlainRay, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32 {
+        // Plane 2a is the minimum along axis a and 2a + 1 the maximum (`SlabRay::near_plane`).
+        let p = &node.planes;
+        let mut mask = 0;
+        for i in 0..(node.len as usize).min(N) {
+            // The empty box (minimum above maximum) is missed, as by the other forms.
+            if p[0][i] > p[1][i] {
+                continue;
+            }
+            let (mut t0, mut t1) = (tmin, tmax);
+            for a in 0..3 {
+                let ta = (p[2 * a][i] - r.org[a]) / r.dir[a];
+                let tb = (p[2 * a + 1][i] - r.org[a]) / r.dir[a];
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            }
+            // The recovered origin rounds; widen by a few ulps so no box the precomputed test
+            // reports is lost.
+            if t0 <= t1 + 4.0 * f32::EPSILON * t1.abs().max(t0.abs()) {
+                mask |= 1 << i;
+                dist[i] = t0;
+            }
+        }
+        mask
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::node::{WideNode, PLANES};

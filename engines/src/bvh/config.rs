@@ -9,6 +9,7 @@
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
+//! | `precompute` | `on`: the ray's reciprocal direction and origin terms are computed once per ray (001 §1.7, thesis Ch. 4.2.2); `off`: each box test divides by the direction and orders the slabs itself (scalar only, for 001's ablation) | `on` |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
@@ -115,6 +116,8 @@ pub struct Config {
     pub bins: usize,
     pub packets: bool,
     pub split_leaves: bool,
+    /// Per-ray precomputation of the slab test (`precompute=off` needs `simd=off`).
+    pub precompute: bool,
 }
 
 impl Config {
@@ -135,7 +138,15 @@ impl Config {
         let bins = settings.get("bins", 32usize)?;
         let packets = settings.get("packets", OnOff(width > 2))?.0;
         let split_leaves = settings.get("split_leaves", OnOff(!packets))?.0;
+        let precompute = settings.get("precompute", OnOff(true))?.0;
         settings.finish()?;
+        if !precompute && simd {
+            return Err(bad(
+                "precompute",
+                "off".into(),
+                "the SIMD box tests always precompute; precompute=off needs simd=off",
+            ));
+        }
         if !(1..=MAX_LEAF_PRIMS).contains(&leaf) {
             return Err(bad(
                 "leaf",
@@ -164,6 +175,7 @@ impl Config {
             bins,
             packets,
             split_leaves,
+            precompute,
         })
     }
 }
@@ -214,6 +226,13 @@ mod tests {
         let c = parse(4, &[("packets", "off")]).unwrap();
         assert_eq!((c.packets, c.split_leaves), (false, true));
         assert!(!parse(2, &[]).unwrap().packets);
+        assert!(parse(4, &[]).unwrap().precompute);
+        assert!(parse(4, &[("precompute", "off")]).is_err());
+        assert!(
+            !parse(4, &[("precompute", "off"), ("simd", "off")])
+                .unwrap()
+                .precompute
+        );
         assert!(matches!(
             parse(4, &[("colour", "red")]),
             Err(EngineError::UnknownKey { .. })

@@ -3,6 +3,7 @@
 //! `is_x86_feature_detected!`. The whole traversal loop is compiled inside a
 //! `#[target_feature]` function for AVX2 so the box test's intrinsics inline.
 
+use super::box_test::ScalarPerBox;
 use super::traverse::{self, Bvh};
 use crate::engine::Counters;
 use crate::geometry::lanes::Scalar;
@@ -31,6 +32,17 @@ pub fn scalar<const N: usize>() -> Kernels<N> {
         any: traverse::any_batch::<N, Scalar, Scalar>,
         lanes: 0,
         name: "scalar",
+    }
+}
+
+/// The scalar kernels without the per-ray precomputation (`precompute=off`): each box test
+/// divides by the direction and orders the slabs itself ([`super::box_test::ScalarPerBox`]).
+pub fn scalar_per_box<const N: usize>() -> Kernels<N> {
+    Kernels {
+        closest: traverse::closest_batch::<N, ScalarPerBox, Scalar>,
+        any: traverse::any_batch::<N, ScalarPerBox, Scalar>,
+        lanes: 0,
+        name: "scalar, no per-ray precomputation",
     }
 }
 
@@ -222,6 +234,10 @@ mod tests {
         let (bvh4, _) = build_bvh::<4>(&g, &config(4)).unwrap();
         let want4 = run(&bvh4, &scalar::<4>(), &rays);
         assert!(want4.0.iter().filter(|h| h.is_hit()).count() > 100);
+        // Without the per-ray precomputation: the same hits (node counts may differ by a
+        // grazing box, the test being widened by a few ulps).
+        let per_box = run(&bvh4, &scalar_per_box::<4>(), &rays);
+        assert_eq!((&per_box.0, &per_box.1), (&want4.0, &want4.1));
         let mut fours: Vec<Kernels<4>> = sse4().into_iter().collect();
         #[cfg(target_arch = "x86_64")]
         fours.push(Kernels {

@@ -234,6 +234,8 @@ fn build_engine<const N: usize>(
     // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
     let kernels = if config.simd {
         simd_kernels().unwrap_or_else(dispatch::scalar::<N>)
+    } else if !config.precompute {
+        dispatch::scalar_per_box::<N>()
     } else {
         dispatch::scalar::<N>()
     };

@@ -3,11 +3,12 @@
 //! scenes tessellated as 001 did, built with the library call behind `rtbench tree-stats` (no
 //! traversal). 001's plotted values (Figs. 3.12–3.19) are lost: its orderings and ratios compare.
 
+use super::engine_timing::{self, Timed, Timee};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::Result;
 use crate::source::Source as SceneSource;
-use crate::workload;
+use crate::workload::{self, camera::Camera};
 use rtbench_engines::bvh::{config::Config, stats::TreeStats, tree_statistics};
 use rtbench_reports::{Document, Table as DocTable};
 use serde::{Deserialize, Serialize};
@@ -16,8 +17,8 @@ use std::collections::BTreeMap;
 pub const TABLE: Table = Table {
     id: "kimura-3.3",
     seed: "001",
-    source: "§3.3–3.5, Tables 3.1, 3.3",
-    about: "001 (Kimura 2007) §3.3-3.5: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
+    source: "§3.3–3.5, Figs. 3.12–3.19",
+    about: "001 (Kimura 2007) §3.3-3.5, Tables 3.1, 3.3: node statistics of N-ary BVHs, N = 2…16 (orderings and ratios)",
     runtime: Runtime {
         quick: "seconds",
         full: "minutes",
@@ -32,10 +33,24 @@ pub const TABLE: Table = Table {
         Claim { key: "memory-less-than-binary", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "sah-memory-min-4-8", fidelity: Fidelity::Faithful, why: "" },
         Claim { key: "sah-deeper", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "integer-depth-b10", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "sah-build-same", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "sah-nodes-smooth", fidelity: Fidelity::Faithful, why: "" },
+        Claim { key: "median-nodes-extreme-8", fidelity: Fidelity::Faithful, why: "" },
+        Claim {
+            key: "sah-renders-faster",
+            fidelity: Fidelity::Substituted,
+            why: "001 does not say which traversal, widths or image it timed: scalar closest-hit traversal of the widths with a traversal here (2, 4, 8), 800x600 eye rays, one thread, today's CPU",
+        },
+        Claim {
+            key: "box-tests-800x600",
+            fidelity: Fidelity::Substituted,
+            why: "001's figure is for cloister, which has no source: the SPD scenes' counts are shown beside it",
+        },
         Claim {
             key: "cloister",
             fidelity: Fidelity::NotReproducible,
-            why: "001's cloister scene (81,410 triangles) has no published source",
+            why: "001's cloister scene (81,410 triangles) has no published source, and no scene of its kind ships in a package on the registries we reach (npm and PyPI lists searched for cloister, sibenik, sponza)",
         },
     ],
     run,
@@ -68,6 +83,7 @@ struct Published {
     source: Source,
     scenes: PublishedScenes,
     internal_node_bytes: NodeBytes,
+    box_tests_800x600: f64,
 }
 #[derive(Deserialize)]
 struct PublishedScenes {
@@ -112,6 +128,8 @@ struct Result_ {
     id: &'static str,
     published: serde_json::Value,
     measured: Vec<Tree>,
+    /// Fig. 3.17: closest-hit render times of object-median and SAH trees per width (one thread).
+    renders: Vec<Timed>,
     compare: Vec<Check>,
     quick: bool,
     not_built: &'static str,
@@ -121,11 +139,25 @@ struct Result_ {
 /// Per scene: (scene, sf, triangles, published triangles, builder → width → stats).
 type SceneTrees = (&'static str, u32, u64, Option<u64>, BTreeMap<&'static str, BTreeMap<usize, TreeStats>>);
 
-fn measure(p: &Published, quick: bool, trees: &mut Vec<Tree>) -> Result<Vec<SceneTrees>> {
+/// Fig. 3.17's trees: 001's builders at the widths with a traversal, scalar, one triangle per leaf.
+const RENDERED: &[Timee] = &[
+    ("N=2 median", "bvh2", &[("builder", "median"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+    ("N=2 SAH", "bvh2", &[("builder", "sah-sweep"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+    ("N=4 median", "bvh4", &[("builder", "median"), ("wide", "direct"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+    ("N=4 SAH", "bvh4", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+    ("N=8 median", "bvh8", &[("builder", "median"), ("wide", "direct"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+    ("N=8 SAH", "bvh8", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "1"), ("packets", "off"), ("simd", "off")]),
+];
+/// 001's image (§4.3).
+const IMAGE: (u32, u32) = (800, 600);
+
+fn measure(p: &Published, quick: bool, trees: &mut Vec<Tree>, renders: &mut Vec<Timed>) -> Result<Vec<SceneTrees>> {
     let mut out = Vec::new();
     for &(scene, sf) in scenes(quick) {
         let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
+        let rays = Camera::new(&prepared.input.scene.view).pixel_centre_rays(IMAGE.0, IMAGE.1);
+        renders.extend(engine_timing::time_engines(RENDERED, &prepared.input, &rays, if quick { 1 } else { 5 }, 1, (scene, sf), "kimura-3.3")?);
         let geometry = &prepared.input.geometry;
         let tris = geometry.prims.len() as u64;
         let published_tris = p
@@ -178,10 +210,12 @@ pub fn kimura_tree(builder: &str) -> Vec<(String, String)> {
 
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
-    let mut trees = Vec::new();
-    let scenes = measure(&p, ctx.quick, &mut trees)?;
-    let rows = analyse(&p, &scenes);
-    let doc = document(&p, &trees, &rows, ctx.quick);
+    let (mut trees, mut renders) = (Vec::new(), Vec::new());
+    let scenes = measure(&p, ctx.quick, &mut trees, &mut renders)?;
+    let mut rows = analyse(&p, &scenes);
+    rows.extend(render_rows(&p, &renders));
+    rows.extend(build_rows(&trees));
+    let doc = document(&p, &trees, &renders, &rows, ctx.quick);
     let compare = rows
         .iter()
         .filter(|r| r.claim != "cloister")
@@ -197,6 +231,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         id: ctx.id,
         published: raw,
         measured: trees,
+        renders,
         compare,
         quick: ctx.quick,
         not_built: "cloister (no source)",
@@ -295,23 +330,128 @@ fn scene_builder_rows(rows: &mut Vec<Row>, on: &str, builder: &str, widths: &[us
         )
         .with_note(format!("{builder}: N=2 leaves = internal + 1, no empty nodes")),
     );
-    let m2 = t2.model_bytes() as f64;
-    let ratios: Vec<String> = widths[1..].iter().map(|n| format!("{n}: {:.3}", w[n].model_bytes() as f64 / m2)).collect();
-    let below = widths[1..].iter().filter(|n| (w[*n].model_bytes() as f64) < m2).count();
-    rows.push(
-        Row::new(
-            "memory-less-than-binary",
+    for (reading, bytes) in READINGS {
+        let m2 = bytes(t2) as f64;
+        let ratios: Vec<String> = widths[1..].iter().map(|n| format!("{n}: {:.3}", bytes(&w[n]) as f64 / m2)).collect();
+        let below = widths[1..].iter().filter(|n| (bytes(&w[*n]) as f64) < m2).count();
+        rows.push(
+            Row::new(
+                "memory-less-than-binary",
+                format!("{on}, {reading}"),
+                "below 1 for almost every N (Figs. 3.14, 3.19 prose)",
+                format!("{} ({below} of {} below 1)", ratios.join(", "), widths.len() - 1),
+                Kind::Ordering,
+                Verdict::of(below + 1 >= widths.len() - 1),
+            )
+            .with_note(format!("{builder}: Eq. 3.3 memory N / N=2, every N > 2, {reading}")),
+        );
+    }
+    // Fig. 3.12: at B = 10 the average leaf depth is an integer (exactly 5 for gears4 and cloister).
+    if let Some(t10) = w.get(&10) {
+        let d = t10.avg_leaf_depth;
+        let gears = on == "gears4";
+        let row = Row::new(
+            "integer-depth-b10",
             on,
-            "below 1 for almost every N (Figs. 3.14, 3.19 prose)",
-            format!("{} ({below} of {} below 1)", ratios.join(", "), widths.len() - 1),
-            Kind::Ordering,
-            Verdict::of(below + 1 >= widths.len() - 1),
-        )
-        .with_note(format!("{builder}: Eq. 3.3 memory N / N=2, every N > 2")),
-    );
+            if gears { "exactly 5 (Fig. 3.12 prose)" } else { "an integer at high N (Fig. 3.12 prose; 5 named for gears4 and cloister only)" },
+            format!("{d:.6} (with empty slots {:.6}; max depth {})", t10.avg_leaf_depth_with_empty, t10.max_leaf_depth),
+            Kind::Count,
+            if gears { Verdict::of(d == 5.0) } else { Verdict::Shown },
+        );
+        rows.push(row.with_note(format!("{builder}: avg leaf depth at N=10")));
+    }
+    // Fig. 3.18: total and empty node counts per width.
+    let totals: Vec<u64> = widths.iter().map(|n| w[n].internal_nodes + w[n].leaf_nodes + w[n].empty_nodes).collect();
+    let shown: Vec<String> = widths.iter().zip(&totals).map(|(n, t)| format!("{n}: {t} ({} empty)", w[n].empty_nodes)).collect();
+    if builder == "sah-sweep" {
+        // Smooth: the totals move one way (no interior local extreme).
+        let monotone = totals.windows(2).all(|p| p[1] <= p[0]) || totals.windows(2).all(|p| p[1] >= p[0]);
+        rows.push(
+            Row::new("sah-nodes-smooth", on, "node counts vary smoothly with N (Fig. 3.18 prose)", shown.join(", "), Kind::Shape, Verdict::of(monotone))
+                .with_note(format!("{builder}: total nodes (internal + leaves + empty) per N, holds when monotone")),
+        );
+    } else if let Some(i8) = widths.iter().position(|&n| n == 8) {
+        let spike = i8 > 0 && i8 + 1 < totals.len() && totals[i8] > totals[i8 - 1] && totals[i8] > totals[i8 + 1];
+        rows.push(
+            Row::new("median-nodes-extreme-8", on, "node count rises extremely at N = 8 (Fig. 3.18 prose)", shown.join(", "), Kind::Shape, Verdict::of(spike))
+                .with_note(format!("{builder}: total nodes per N, holds when N=8 is above both N=6 and N=10")),
+        );
+    }
 }
 
-fn document(p: &Published, trees: &[Tree], rows: &[Row], quick: bool) -> Document {
+/// 001's memory is Eq. 3.3 over node counts; whether empty nodes count as leaves is not stated, so
+/// both readings are shown, each labelled.
+type Bytes = fn(&TreeStats) -> u64;
+const READINGS: [(&str, Bytes); 2] = [("empty nodes not counted", TreeStats::model_bytes), ("empty nodes counted", TreeStats::model_bytes_with_empty)];
+
+/// §3.5 (claimed, not measured by 001): the N-ary SAH build costs about what the binary one does, since
+/// it does the same splits. One build per tree (`tree_statistics`), wall time (pure).
+fn build_rows(trees: &[Tree]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let mut scenes: Vec<(&str, u32)> = trees.iter().map(|t| (t.scene, t.sf)).collect();
+    scenes.dedup();
+    for (scene, sf) in scenes {
+        let at = |n: usize| trees.iter().find(|t| t.scene == scene && t.sf == sf && t.builder == "sah-sweep" && t.width == n).map(|t| t.build_s);
+        let Some(b2) = at(2) else { continue };
+        let ratios: Vec<(usize, f64)> = [4, 8, 16].into_iter().filter_map(|n| at(n).map(|b| (n, b / b2))).collect();
+        let four = ratios.iter().find(|r| r.0 == 4).map_or(f64::NAN, |r| r.1);
+        rows.push(
+            Row::new(
+                "sah-build-same",
+                format!("{scene}{sf}"),
+                "almost the same as binary (§3.5, claimed without a measurement)",
+                format!("N=2 {:.0} ms; N / N=2: {}", b2 * 1e3, ratios.iter().map(|(n, r)| format!("{n}: {r:.2}")).collect::<Vec<_>>().join(", ")),
+                Kind::Ratio,
+                Verdict::of(four <= 1.25),
+            )
+            .with_note("sah-sweep: build wall time N / N=2, one build each; holds when N=4 is within 1.25x"),
+        );
+    }
+    rows
+}
+
+/// Fig. 3.17 (SAH renders faster than object median, per width) and §4.2.2's box-test count (pure).
+fn render_rows(p: &Published, renders: &[Timed]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let mut scenes: Vec<(&str, u32)> = renders.iter().map(|t| (t.scene, t.sf)).collect();
+    scenes.dedup();
+    for (scene, sf) in scenes {
+        let on = format!("{scene}{sf}");
+        let get = |l: &str| renders.iter().find(|t| t.scene == scene && t.sf == sf && t.engine == l);
+        for n in [2, 4, 8] {
+            let (Some(m), Some(s)) = (get(&format!("N={n} median")), get(&format!("N={n} SAH"))) else { continue };
+            rows.push(
+                Row::new(
+                    "sah-renders-faster",
+                    format!("{on} N={n}"),
+                    "SAH clearly faster despite deeper trees (Fig. 3.17 prose)",
+                    format!("median {:.0} ms, SAH {:.0} ms: median / SAH = {:.2}", m.cpu_s * 1e3, s.cpu_s * 1e3, m.cpu_s / s.cpu_s),
+                    Kind::Ordering,
+                    Verdict::of(s.cpu_s < m.cpu_s),
+                )
+                .with_note(format!("N={n}: render CPU time, object median / SAH, scalar, one thread")),
+            );
+        }
+        if let Some(s) = get("N=4 SAH") {
+            let rays = s.rays as f64;
+            let b = s.counters.box_tests as f64;
+            rows.push(
+                Row::new(
+                    "box-tests-800x600",
+                    format!("{on} N=4 SAH"),
+                    format!("about {:.2e} box tests at 800x600 on cloister ({:.1} per ray)", p.box_tests_800x600, p.box_tests_800x600 / 480_000.0),
+                    format!("{b:.3e} box tests ({:.1} per ray), {} node visits ({:.1} per ray); {:.2}x 001's", b / rays, s.counters.nodes_visited, s.counters.nodes_visited as f64 / rays, b / p.box_tests_800x600),
+                    Kind::Ratio,
+                    Verdict::Shown,
+                )
+                .with_note("N=4 SAH: ray-box tests over 800x600 primary rays (001: cloister; here SPD)"),
+            );
+        }
+    }
+    rows
+}
+
+fn document(p: &Published, trees: &[Tree], renders: &[Timed], rows: &[Row], quick: bool) -> Document {
     let mut doc = Document::new("kimura-3.3: node statistics of N-ary BVHs (N = 2…16), 001 vs measured");
     doc.paragraph(format!("Source: {}.", p.source.cite()));
     doc.paragraph("001's plotted values (Figs. 3.12-3.19) are lost; what compares is its orderings and ratios, not absolute values. Cloister is not reproduced (no source).");
@@ -338,6 +478,23 @@ fn document(p: &Published, trees: &[Tree], rows: &[Row], quick: bool) -> Documen
         ]);
     }
     doc.table(t);
+    doc.heading("Memory, both readings (001 Eq. 3.3; whether empty nodes count as leaves is not stated)");
+    let mut m = DocTable::new("", &["scene", "builder", "N", "bytes, empty not counted", "÷ N=2", "bytes, empty counted", "÷ N=2"]);
+    for tr in trees {
+        let s = |t: &Tree, k: &str| t.stats.get(k).copied().unwrap_or(f64::NAN);
+        let base = trees.iter().find(|b| b.scene == tr.scene && b.builder == tr.builder && b.width == 2);
+        let ratio = |k: &str| base.map_or("-".into(), |b| format!("{:.3}", s(tr, k) / s(b, k)));
+        m.push(vec![format!("{}{}", tr.scene, tr.sf), name(tr.builder).into(), tr.width.to_string(), s(tr, "model_bytes").to_string(), ratio("model_bytes"), s(tr, "model_bytes_with_empty").to_string(), ratio("model_bytes_with_empty")]);
+    }
+    doc.table(m);
+    doc.heading("Fig. 3.17: render time, object median vs SAH (scalar traversal, one thread, 800x600 eye rays)");
+    doc.table({
+        let mut t = DocTable::new("", &engine_timing::HEADER);
+        for r in engine_timing::rows(renders) {
+            t.push(r);
+        }
+        t
+    });
     doc.paragraph("001 §3.3's worked example (16 primitives): balanced depth 4 (N=2) vs 2 (N=4), 15 vs 5 internal nodes (a unit test builds it); Table 3.3's internal-node bytes 28 + 4N are what the Eq. 3.3 columns use.");
     let mut c = DocTable::new("", &["scene", "claim", "published", "measured", "how it compares"]);
     for r in rows.iter().filter(|r| r.claim != "cloister") {

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 pub const TABLE: Table = Table {
     id: "kimura-simd",
     seed: "001",
-    source: "§4.3, Fig. 4.5",
+    source: "§4.2–4.3, T. 4.1, Fig. 4.5",
     about: "001 (Kimura 2007) §4.3: SIMD 4-ary single-ray traversal speed-up (2.32-4.45x)",
     runtime: Runtime {
         quick: "seconds",
@@ -27,6 +27,31 @@ pub const TABLE: Table = Table {
             key: "simd-speedup",
             fidelity: Fidelity::Substituted,
             why: "today's CPU (AVX2) and compiler against 001's Core Duo T2050 and MSVC 2005; 001's baseline (binary or 4-ary) is not stated, so both are shown",
+        },
+        Claim {
+            key: "ablation",
+            fidelity: Fidelity::Substituted,
+            why: "001's trees on today's CPU and compiler; 001's cloister has no source; ray packets are not implemented in rtbench (issue 20)",
+        },
+        Claim {
+            key: "speedup-larger-where-slower",
+            fidelity: Fidelity::Substituted,
+            why: "the three SPD scenes without cloister (the scene 001 names as the slow one)",
+        },
+        Claim {
+            key: "table-4.1-layout",
+            fidelity: Fidelity::Substituted,
+            why: "our 4-wide node keeps its children's boxes as 6 plane rows of 4 floats (SoA, as 001's aabbMin[3]/aabbMax[3]); the ray keeps its reciprocal direction and origin x reciprocal direction splatted (Embree's form) instead of the origin",
+        },
+        Claim {
+            key: "packets-10x",
+            fidelity: Fidelity::NotReproducible,
+            why: "packets: not implemented in rtbench (issue 20)",
+        },
+        Claim {
+            key: "cloister",
+            fidelity: Fidelity::NotReproducible,
+            why: "001's cloister (81,410 triangles, where 001 says rendering and the speed-up were largest) has no published source, and no scene of its kind ships in a package on the registries we reach (npm and PyPI lists searched for cloister, sibenik, sponza)",
         },
         Claim {
             key: "engine-goal",
@@ -59,6 +84,49 @@ const SIMD_ENGINES: &[Timee] = &[
     ("bvh8 SIMD", "bvh8", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "1"), ("simd", "on"), ("packets", "off")]),
     ("embree", "embree", &[]),
 ];
+
+/// The ablation on the same trees (full-sweep SAH, 001's direct N-ary builder): what 001's speed-up
+/// may have included besides the 4-wide box test. `precompute=off`: each box test divides by the
+/// direction and orders the slabs (no replicated origin or reciprocal direction, 001 §1.7).
+const ABLATION: &[Timee] = &[
+    ("bvh2 scalar, no precompute", "bvh2", &[("builder", "sah-sweep"), ("leaf", "1"), ("simd", "off"), ("packets", "off"), ("precompute", "off")]),
+    ("bvh4 scalar, no precompute", "bvh4", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "1"), ("simd", "off"), ("packets", "off"), ("precompute", "off")]),
+    ("bvh4 scalar leaf 4", "bvh4", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "4"), ("simd", "off"), ("packets", "off")]),
+    ("bvh4 SIMD leaf 4", "bvh4", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "4"), ("simd", "on"), ("packets", "off")]),
+    ("bvh4 SIMD leaf 4 + tri packets", "bvh4", &[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "4"), ("simd", "on"), ("packets", "on")]),
+];
+
+/// The ablation's ratios: (label, numerator engine, denominator engine, what it isolates).
+const FACTORS: &[(&str, &str, &str, &str)] = &[
+    ("SIMD box test alone (same 4-ary tree, precomputed ray)", "bvh4 scalar", "bvh4 SIMD", "4 boxes per instruction"),
+    ("per-ray precomputation (4-ary, scalar)", "bvh4 scalar, no precompute", "bvh4 scalar", "one division per slab per box"),
+    ("per-ray precomputation (binary, scalar)", "bvh2 scalar, no precompute", "bvh2 scalar", "one division per slab per box"),
+    ("4-ary over binary tree (scalar, precomputed)", "bvh2 scalar", "bvh4 scalar", "tree shape"),
+    ("001's widest reading: binary scalar, no precompute → 4-ary SIMD", "bvh2 scalar, no precompute", "bvh4 SIMD", "everything 001 credits"),
+    ("leaf 4 over leaf 1 (SIMD)", "bvh4 SIMD", "bvh4 SIMD leaf 4", "fewer, fuller nodes"),
+    ("leaf 4 over leaf 1 (scalar)", "bvh4 scalar", "bvh4 scalar leaf 4", "fewer, fuller nodes"),
+    ("triangle packets (leaf 4, SIMD)", "bvh4 SIMD leaf 4", "bvh4 SIMD leaf 4 + tri packets", "4 triangles per test"),
+];
+
+#[derive(Serialize)]
+struct Factor {
+    scene: String,
+    factor: &'static str,
+    over: &'static str,
+    under: &'static str,
+    ratio: f64,
+    isolates: &'static str,
+}
+
+/// Time outside traversal, per scene: eye-ray generation and a headlight-shading stand-in.
+#[derive(Serialize)]
+struct Share {
+    scene: String,
+    generate_s: f64,
+    shade_s: f64,
+    traverse_scalar_s: f64,
+    traverse_simd_s: f64,
+}
 
 /// The engines as users run them (their default trees and leaves), with obvhs's two layouts.
 const DEFAULT_ENGINES: &[Timee] = &[
@@ -99,6 +167,9 @@ struct Result_ {
     quick: bool,
     defaults: Vec<Timed>,
     goals: Vec<Goal>,
+    ablation: Vec<Timed>,
+    factors: Vec<Factor>,
+    shares: Vec<Share>,
     image: [u32; 2],
     environment: serde_json::Value,
 }
@@ -106,19 +177,28 @@ struct Result_ {
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
     let repeats: usize = if ctx.quick { 3 } else { 7 };
-    let (mut measured, mut defaults) = (Vec::new(), Vec::new());
+    let (mut measured, mut defaults, mut ablation, mut shares) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &(scene, sf) in scenes(ctx.quick) {
         let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
-        let rays = Camera::new(&prepared.input.scene.view).pixel_centre_rays(IMAGE.0, IMAGE.1);
+        let camera = Camera::new(&prepared.input.scene.view);
+        let c0 = workload::thread_cpu_seconds();
+        let rays = camera.pixel_centre_rays(IMAGE.0, IMAGE.1);
+        let generate_s = workload::thread_cpu_seconds() - c0;
         let on = (scene, sf);
-        measured.extend(engine_timing::time_engines(SIMD_ENGINES, &prepared.input, &rays, repeats, 1, on, ctx.id)?);
+        let simd = engine_timing::time_engines(SIMD_ENGINES, &prepared.input, &rays, repeats, 1, on, ctx.id)?;
+        ablation.extend(engine_timing::time_engines(ABLATION, &prepared.input, &rays, repeats, 1, on, ctx.id)?);
+        shares.push(share(&format!("{scene}{sf}"), &prepared.input, &rays, generate_s, &simd)?);
+        measured.extend(simd);
         defaults.extend(engine_timing::time_engines(DEFAULT_ENGINES, &prepared.input, &rays, repeats, 3, on, ctx.id)?);
     }
     let speedups = speedups(&p, &measured);
     let goals = goals(&defaults);
-    let rows = rows(&speedups, &goals);
-    let doc = document(&p, &measured, &speedups, &defaults, &goals, ctx.quick, repeats);
+    let factors = factors(&measured, &ablation);
+    let mut rows = rows(&speedups, &goals);
+    rows.extend(ablation_rows(&factors, &shares, &speedups, &measured));
+    let mut doc = document(&p, &measured, &speedups, &defaults, &goals, ctx.quick, repeats);
+    ablation_document(&mut doc, &ablation, &factors, &shares);
     let result = Result_ {
         id: ctx.id,
         published: raw,
@@ -127,10 +207,110 @@ fn run(ctx: &Ctx) -> Result<Output> {
         quick: ctx.quick,
         defaults,
         goals,
+        ablation,
+        factors,
+        shares,
         image: [IMAGE.0, IMAGE.1],
         environment: environment(1),
     };
     Ok(Output::new(result, rows, doc))
+}
+
+/// Eye-ray generation (timed by the caller) and a headlight-shading stand-in over the SIMD tree's
+/// hits, beside the traversal times: the share of a render that traversal is.
+fn share(scene: &str, input: &rtbench_engines::BuildInput, rays: &[rtbench_engines::Ray], generate_s: f64, simd: &[Timed]) -> Result<Share> {
+    let (e, _) = workload::build("bvh4", input, engine_timing::settings(&[("builder", "sah-sweep"), ("wide", "direct"), ("leaf", "1"), ("packets", "off")]))?;
+    let mut hits = vec![rtbench_engines::Hit::MISS; rays.len()];
+    e.intersect(rays, &mut hits, &mut rtbench_engines::Counters::default());
+    // Stand-in for 001's dot(direction, normal): the hit point's direction from the origin as the
+    // normal (one normalise and one dot per hit, as a triangle normal lookup and dot would cost).
+    let c0 = workload::thread_cpu_seconds();
+    let mut image = vec![0u8; rays.len()];
+    for ((r, h), px) in rays.iter().zip(&hits).zip(image.iter_mut()) {
+        if h.t.is_finite() {
+            let n = (r.origin + r.dir * h.t).normalize_or_zero();
+            *px = (r.dir.dot(n).abs() * 255.0) as u8;
+        }
+    }
+    let shade_s = workload::thread_cpu_seconds() - c0;
+    std::hint::black_box(&image);
+    let get = |l: &str| simd.iter().find(|t| t.engine == l).map_or(f64::NAN, |t| t.cpu_s);
+    Ok(Share { scene: scene.into(), generate_s, shade_s, traverse_scalar_s: get("bvh4 scalar"), traverse_simd_s: get("bvh4 SIMD") })
+}
+
+/// The ablation's ratios per scene (pure).
+fn factors(measured: &[Timed], ablation: &[Timed]) -> Vec<Factor> {
+    let mut out = Vec::new();
+    let all: Vec<&Timed> = measured.iter().chain(ablation).collect();
+    let mut scenes: Vec<(&str, u32)> = all.iter().map(|t| (t.scene, t.sf)).collect();
+    scenes.dedup();
+    for (scene, sf) in scenes {
+        let get = |l: &str| all.iter().find(|t| t.scene == scene && t.sf == sf && t.engine == l).map(|t| t.cpu_s);
+        for &(factor, over, under, isolates) in FACTORS {
+            if let (Some(a), Some(b)) = (get(over), get(under)) {
+                out.push(Factor { scene: format!("{scene}{sf}"), factor, over, under, ratio: a / b, isolates });
+            }
+        }
+    }
+    out
+}
+
+fn ablation_rows(factors: &[Factor], shares: &[Share], speedups: &[Speedup], measured: &[Timed]) -> Vec<Row> {
+    let mut rows: Vec<Row> = factors
+        .iter()
+        .map(|f| Row::new("ablation", format!("{}: {}", f.scene, f.factor), "2.32-4.45 (the whole speed-up)", format!("{:.2} ({} ÷ {})", f.ratio, f.over, f.under), Kind::Ratio, Verdict::Shown))
+        .collect();
+    rows.push(Row::new("table-4.1-layout", "bvh4 SIMD", "aabbMin[3], aabbMax[3] (__m128 SoA), ray.o4[3], ray.invRayDir[3] (Table 4.1)", "planes[6][4] f32 SoA per node; ray: rdir and origin x rdir splatted per ray", Kind::Count, Verdict::Shown));
+    rows.push(Row::new("packets-10x", "-", "packet tracers [RSH05, WBS07] about 10x (§4.3)", "packets: not implemented in rtbench (issue 20)", Kind::Ratio, Verdict::NotMeasured));
+    rows.push(Row::new("cloister", "cloister", "81,410 triangles (Table 3.1); the largest speed-up (§4.3)", "no source; no same-kind scene in a registry package", Kind::Count, Verdict::NotMeasured));
+    rows.push(Row::new("ablation", "ray packets", "not used by 001 (future work)", "packets: not implemented in rtbench (issue 20)", Kind::Ratio, Verdict::NotMeasured));
+    for s in shares {
+        let other = s.generate_s + s.shade_s;
+        rows.push(Row::new(
+            "ablation",
+            format!("{}: traversal share of a render", s.scene),
+            "render time (001 times whole renders)",
+            format!("scalar {:.1}%, SIMD {:.1}% (ray generation {:.1} ms, shading stand-in {:.1} ms)", 100.0 * s.traverse_scalar_s / (s.traverse_scalar_s + other), 100.0 * s.traverse_simd_s / (s.traverse_simd_s + other), s.generate_s * 1e3, s.shade_s * 1e3),
+            Kind::Ratio,
+            Verdict::Shown,
+        ));
+    }
+    // 001: the speed-up is larger where rendering takes longer. Over the scenes measured: the order of
+    // the bvh4 scalar times equals the order of the speed-ups over it.
+    let pairs: Vec<(f64, f64)> = speedups
+        .iter()
+        .filter(|s| s.over == "bvh4 scalar")
+        .filter_map(|s| measured.iter().find(|t| format!("{}{}", t.scene, t.sf) == s.scene && t.engine == "bvh4 scalar").map(|t| (t.cpu_s, s.speedup)))
+        .collect();
+    let shown: Vec<String> = speedups.iter().filter(|s| s.over == "bvh4 scalar").map(|s| format!("{} {:.2}", s.scene, s.speedup)).collect();
+    let verdict = if pairs.len() < 2 {
+        Verdict::NotMeasured
+    } else {
+        let mut by_time = pairs.clone();
+        by_time.sort_by(|a, b| a.0.total_cmp(&b.0));
+        Verdict::of(by_time.windows(2).all(|w| w[1].1 >= w[0].1))
+    };
+    rows.push(
+        Row::new("speedup-larger-where-slower", "bvh4 SIMD over bvh4 scalar, per scene", "larger where rendering takes longer (§4.3)", if shown.is_empty() { "-".into() } else { format!("{} (scenes ordered by scalar time: {})", shown.join(", "), pairs.iter().map(|p| format!("{:.0} ms", p.0 * 1e3)).collect::<Vec<_>>().join(", ")) }, Kind::Ordering, verdict)
+            .with_note(if pairs.len() < 2 { "needs two scenes or more: run without --quick" } else { "holds when the speed-up rises with the scalar render time across scenes" }),
+    );
+    rows
+}
+
+fn ablation_document(doc: &mut Document, ablation: &[Timed], factors: &[Factor], shares: &[Share]) {
+    doc.heading("Ablation on the same trees: where 001's 2.32-4.45x could come from");
+    doc.paragraph("Same rays, one thread, full-sweep SAH trees built by 001's direct N-ary builder. `precompute=off`: each box test divides by the direction and orders the two slab distances (no replicated origin or reciprocal direction). Ray packets: not implemented in rtbench (issue 20). The bvh2/bvh4 scalar and SIMD rows are in the first table.");
+    doc.table(timed_table(ablation));
+    let mut t = DocTable::new("", &["scene", "factor", "ratio", "numerator ÷ denominator", "isolates"]);
+    for f in factors {
+        t.push(vec![f.scene.clone(), f.factor.into(), format!("{:.2}", f.ratio), format!("{} ÷ {}", f.over, f.under), f.isolates.into()]);
+    }
+    doc.table(t);
+    let mut t = DocTable::new("", &["scene", "ray generation ms", "shading stand-in ms", "traversal ms scalar", "traversal ms SIMD"]);
+    for s in shares {
+        t.push(vec![s.scene.clone(), format!("{:.1}", s.generate_s * 1e3), format!("{:.1}", s.shade_s * 1e3), format!("{:.1}", s.traverse_scalar_s * 1e3), format!("{:.1}", s.traverse_simd_s * 1e3)]);
+    }
+    doc.table(t);
 }
 
 /// The timings of one scene.

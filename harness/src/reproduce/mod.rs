@@ -44,6 +44,7 @@ registry! {
     kimura_3_2,
     kimura_3_3,
     kimura_simd,
+    kanamori_grid,
     nakamaru_3_1,
     nakamaru_3_2,
     yamauchi_static_lb,
