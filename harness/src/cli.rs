@@ -284,6 +284,10 @@ pub enum SceneCommand {
         /// renamed when complete.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
+        /// `split` (bbox.bin + geometry.bin, seed 000 Ch.4 "S") or `basic` (one objects.bin of
+        /// (box, object) records, Ch.3); the breadth-first engine's `layout` must match.
+        #[arg(long, default_value = "split")]
+        layout: String,
         #[arg(long)]
         json: bool,
     },

@@ -46,10 +46,12 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene(SceneCommand::Store {
             scene,
             output,
+            layout,
             json,
         }) => commands::scene::store(
             &Source::from_args(&scene.scene, &scene.opts)?,
             &output,
+            &layout,
             json,
         ),
         Command::Scene(SceneCommand::Stats { scene, json }) => {

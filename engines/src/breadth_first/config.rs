@@ -97,6 +97,32 @@ pub struct BreadthFirstConfig {
     /// Check every record of a store when it is opened (`verify=full`, the default), not only
     /// those the algorithm reads (`verify=records`).
     pub verify: bool,
+    /// The store layout this engine reads (a store of the other layout is refused): `basic`,
+    /// one file of (box, object) records read whole (Ch.3), or `split` (Ch.4's "S").
+    pub layout: Layout,
+    /// Read an object's geometry only when a ray hits its box (Ch.4's "G"; split layout only).
+    pub lazy: bool,
+    /// Register rays only at voxel-boundary entries (§3.2); off: in every marked voxel.
+    pub boundary: bool,
+    /// Skip an object when the ray's last voxel of the previous pass lies in its box (§3.3).
+    pub prev_skip: bool,
+    /// Refill memory with new rays at every pass (§3.3); off: a batch of rays runs until all are
+    /// done before the next is read (Algorithm 3.3).
+    pub refill: bool,
+    /// What sizes the grid: the primitives, or the objects as Rayshade counted them.
+    pub count: Count,
+}
+
+pub use crate::grid::config::Count;
+pub use crate::store::Layout;
+
+fn on_off(s: &mut Settings, key: &'static str) -> Result<bool, EngineError> {
+    let v: String = s.get(key, "on".to_string())?;
+    match v.as_str() {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        v => Err(bad(key, v, "on or off")),
+    }
 }
 
 pub use crate::grid::config::Floor;
@@ -138,6 +164,24 @@ impl BreadthFirstConfig {
             "records" => false,
             v => return Err(bad("verify", v, "full or records")),
         };
+        let layout = s.get("layout", Layout::Split)?;
+        let lazy: String = s.get("lazy", String::new())?;
+        let lazy = match (lazy.as_str(), layout) {
+            ("" | "on", Layout::Split) => true,
+            ("off", _) | ("", Layout::Basic) => false,
+            ("on", Layout::Basic) => {
+                return Err(bad(
+                    "lazy",
+                    "on",
+                    "layout=basic reads every object whole; lazy=on needs layout=split",
+                ))
+            }
+            (v, _) => return Err(bad("lazy", v, "on or off")),
+        };
+        let boundary = on_off(&mut s, "boundary")?;
+        let prev_skip = on_off(&mut s, "prevskip")?;
+        let refill = on_off(&mut s, "refill")?;
+        let count = s.get("count", Count::Prims)?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -166,6 +210,12 @@ impl BreadthFirstConfig {
             triangle,
             floor,
             verify,
+            layout,
+            lazy,
+            boundary,
+            prev_skip,
+            refill,
+            count,
         })
     }
 }

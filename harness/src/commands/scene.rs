@@ -3,7 +3,7 @@
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
-use rtbench_engines::store::{StoreHeader, StoreWriter};
+use rtbench_engines::store::{Layout, StoreHeader, StoreWriter};
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
@@ -80,7 +80,10 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
 /// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
 /// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
 /// so a failure (bad input, full disk) leaves nothing behind.
-pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
+pub fn store(src: &Source, out: &Path, layout: &str, as_json: bool) -> Result<()> {
+    let layout: Layout = layout
+        .parse()
+        .map_err(|e| input(format!("--layout {layout}: {e}")))?;
     let start = std::time::Instant::now();
     if out.exists()
         && std::fs::read_dir(out)
@@ -108,7 +111,7 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
         let _ = std::fs::remove_dir_all(&tmp);
         input(e)
     };
-    let mut w = StoreWriter::create(&tmp, &src.label())
+    let mut w = StoreWriter::create_layout(&tmp, &src.label(), layout)
         .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
     if let Err(e) = src.stream(&mut w) {
         let _ = std::fs::remove_dir_all(&tmp);
@@ -130,6 +133,7 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
     let secs = start.elapsed().as_secs_f64();
     let v = json!({
         "store": out.display().to_string(),
+        "layout": layout.name(),
         "scene": src.label(),
         "objects": header.objects,
         "primitives": header.primitives,

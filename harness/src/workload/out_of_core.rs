@@ -26,7 +26,7 @@ use super::trace::{shade_hit, GenerationStats, Path, RayStats, Render, MAX_DEPTH
 use glam::Vec3;
 use rtbench_engines::breadth_first::spill::SpillDir;
 use rtbench_engines::breadth_first::BreadthFirst;
-use rtbench_engines::store::{BboxReader, GeometryReader, IoCounters, IoFile, ObjectRecord};
+use rtbench_engines::store::{IoCounters, IoFile, ObjectRecord, SceneReader};
 use rtbench_engines::{Counters, Hit, Ray};
 use std::io;
 use std::path::{Path as FsPath, PathBuf};
@@ -209,8 +209,9 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     let background = h.background.as_vec3();
     let lights = super::trace::scaled_lights(&h.lights);
     let mut io_total = IoCounters::default();
-    let mut bbox = BboxReader::open(&h.dir, h.objects, buffer)?;
-    let mut geometry = GeometryReader::open(&h.dir, buffer)?;
+    // The engine's layout and `lazy`: the basic layout (or `lazy=off`) reads every object up to
+    // the last one hit (Algorithm 3.6), the split one only the objects hit (§4.2.2).
+    let mut scene = SceneReader::open(h, buffer, config.lazy)?;
 
     let mut rays = Records::create(spill.path(), "rays-1", buffer)?;
     for j in 0..w {
@@ -304,23 +305,27 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
                 }
             }
             order.sort_by_key(|&k| (hits[k as usize].object, k));
-            bbox.rewind()?;
-            geometry.rewind()?;
+            scene.rewind()?;
             let mut loaded = u32::MAX;
             out_next.clear();
             out_shadow.clear();
             for &k in &order {
                 let hit = hits[k as usize];
                 if hit.object != loaded {
-                    // Forward through the bounding-box file to the object's geometry offset.
-                    let offset = loop {
-                        match bbox.next_record()? {
-                            Some((id, b)) if id == hit.object => break b.offset,
+                    // Forward through the store to the object (Algorithm 3.6: "while current
+                    // object ID < hit's object ID: read next object").
+                    loop {
+                        match scene.next(&mut record)? {
+                            Some((id, b, read)) if id == hit.object => {
+                                if !read {
+                                    scene.load(&b, &mut record)?;
+                                }
+                                break;
+                            }
                             Some(_) => continue,
                             None => return Err(io::Error::other("hit names no object")),
                         }
-                    };
-                    geometry.read_at(offset, &mut record)?;
+                    }
                     loaded = hit.object;
                 }
                 let (ray, path) = &group[k as usize];
@@ -421,8 +426,7 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
         rays = next;
     }
     io_total.add(&rays.remove()?);
-    io_total.add(&bbox.file.io);
-    io_total.add(&geometry.file.io);
+    io_total.add(&scene.io());
     Ok(OutOfCoreRender {
         render: Render {
             size,
