@@ -162,3 +162,49 @@ fn bad_stores_engines_and_spill_directories_exit_2() {
         .collect();
     assert_eq!(left.len(), 2, "{left:?}");
 }
+
+/// Seed 000's basic layout (one file of box + object records, read whole every sweep and in
+/// shading) renders the split layout's image to the bit; a store of the other layout, or
+/// `lazy=on` with the basic layout, is refused (exit 2, one line).
+#[test]
+fn basic_and_split_layouts_render_the_same_image() {
+    let d = Dir::new("layouts");
+    let (split, basic) = (d.join("split"), d.join("basic"));
+    json(&["scene", "store", "rings", "--sf", "2", "-o", &split, "--json"]);
+    let b = json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &basic, "--layout", "basic", "--json",
+    ]);
+    assert_eq!(b["layout"], "basic");
+    let render = |store: &str, layout: &str| {
+        json(&[
+            "render", "--scene", store, "--engine", "breadth-first", "--size", "48", "--set",
+            &format!("layout={layout}"), "--set", "memory=1MiB", "--json",
+        ])
+    };
+    let (s, b) = (render(&split, "split"), render(&basic, "basic"));
+    assert_eq!(s["image"]["sha256"], b["image"]["sha256"]);
+    let reads = |v: &Value| v["counters"]["extra"]["bf_geometry_records_read"].as_u64().unwrap();
+    assert!(reads(&b) > reads(&s), "{} {}", reads(&b), reads(&s));
+    expect_input_error(
+        &["render", "--scene", &basic, "--engine", "breadth-first", "--size", "16"],
+        "basic layout",
+    );
+    expect_input_error(
+        &[
+            "render", "--scene", &split, "--engine", "breadth-first", "--size", "16", "--set",
+            "layout=basic",
+        ],
+        "split layout",
+    );
+    expect_input_error(
+        &[
+            "render", "--scene", &basic, "--engine", "breadth-first", "--size", "16", "--set",
+            "layout=basic", "--set", "lazy=on",
+        ],
+        "lazy",
+    );
+    expect_input_error(
+        &["scene", "store", "tetra", "-o", &d.join("x"), "--layout", "packed"],
+        "--layout",
+    );
+}
