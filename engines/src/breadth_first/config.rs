@@ -16,6 +16,8 @@ pub enum Registration {
     /// ⌈r/10 + 0.5⌉ to start, then inversely proportional to the rays in memory, so the memory
     /// freed by finished rays goes to those still running (`inverse`; §3.2, dynamic count).
     Inverse,
+    /// As `inverse`, starting from N (`inverse:N`; Fig. 3.2b started at 1 for r = 20, 2 for 40).
+    InverseFrom(u32),
 }
 
 impl FromStr for Registration {
@@ -24,10 +26,19 @@ impl FromStr for Registration {
         match s {
             "thesis" => Ok(Registration::Thesis),
             "inverse" => Ok(Registration::Inverse),
-            _ => match s.strip_prefix("fixed:").map(str::parse::<u32>) {
-                Some(Ok(n)) if n >= 1 => Ok(Registration::Fixed(n)),
-                _ => Err("expected fixed:N (N ≥ 1), thesis or inverse".into()),
-            },
+            _ => {
+                let bad = || "expected fixed:N or inverse:N (N ≥ 1), thesis or inverse".to_string();
+                if let Some(n) = s.strip_prefix("inverse:") {
+                    return match n.parse::<u32>() {
+                        Ok(n) if n >= 1 => Ok(Registration::InverseFrom(n)),
+                        _ => Err(bad()),
+                    };
+                }
+                match s.strip_prefix("fixed:").map(str::parse::<u32>) {
+                    Some(Ok(n)) if n >= 1 => Ok(Registration::Fixed(n)),
+                    _ => Err(bad()),
+                }
+            }
         }
     }
 }
@@ -41,7 +52,7 @@ impl Registration {
     /// The count of the first pass, which sizes the registration memory.
     pub fn initial(&self, res: u32) -> u32 {
         match *self {
-            Registration::Fixed(n) => n,
+            Registration::Fixed(n) | Registration::InverseFrom(n) => n,
             Registration::Thesis | Registration::Inverse => Self::thesis_count(res),
         }
     }
@@ -111,6 +122,10 @@ pub struct BreadthFirstConfig {
     pub refill: bool,
     /// What sizes the grid: the primitives, or the objects as Rayshade counted them.
     pub count: Count,
+    /// Cells per axis, given (`res=N`: N³), in place of ⌊n^(1/3) + 0.5⌋.
+    pub res: Option<u32>,
+    /// At most this many rays in memory (`rays=N`), below what the budget allows.
+    pub max_rays: Option<u64>,
 }
 
 pub use crate::grid::config::Count;
@@ -182,6 +197,15 @@ impl BreadthFirstConfig {
         let prev_skip = on_off(&mut s, "prevskip")?;
         let refill = on_off(&mut s, "refill")?;
         let count = s.get("count", Count::Prims)?;
+        let res: u32 = s.get("res", 0u32)?;
+        if (res as u64).pow(3).saturating_mul(5) > memory {
+            return Err(bad(
+                "res",
+                &res.to_string(),
+                "the grid (5 bytes per voxel) would pass the memory budget",
+            ));
+        }
+        let max_rays: u64 = s.get("rays", 0u64)?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -216,6 +240,8 @@ impl BreadthFirstConfig {
             prev_skip,
             refill,
             count,
+            res: (res > 0).then_some(res),
+            max_rays: (max_rays > 0).then_some(max_rays),
         })
     }
 }

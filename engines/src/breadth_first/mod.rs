@@ -18,7 +18,7 @@
 //! | key | values | default | what |
 //! |---|---|---|---|
 //! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers |
-//! | `registration` | `fixed:N`, `thesis`, `inverse` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
+//! | `registration` | `fixed:N`, `thesis`, `inverse`, `inverse:N` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
 //! | `buffer` | bytes | `64KiB` | each file buffer |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
@@ -29,6 +29,8 @@
 //! | `prevskip` | `on`, `off` | `on` | the previous-voxel skip (§3.3) |
 //! | `refill` | `on`, `off` | `on` | refill memory with new rays every pass (§3.3); `off`: a batch of rays is finished before the next is read (Algorithm 3.3) |
 //! | `count` | `prims`, `objects` | `prims` | the n of ⌊n^(1/3) + 0.5⌋: primitives, or objects as Rayshade counted (the grid engine's `count`) |
+//! | `res` | cells per axis | ⌊n^(1/3) + 0.5⌋ | a given cubic resolution (Fig. 3.2 ran 20 and 40) |
+//! | `rays` | a count | what the budget holds | at most this many rays in memory |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -192,7 +194,7 @@ impl BreadthFirst {
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
         // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
         let voxel_target = grid_n.min(config.memory / 2 / 5).max(1);
-        let mut voxels = Voxels::new(bounds, voxel_target);
+        let mut voxels = Voxels::with_res(bounds, voxel_target, config.res);
         let nvox = voxels.count() as u64;
         let grid_bytes = nvox * 5;
         let buffers = match config.layout {
@@ -202,7 +204,7 @@ impl BreadthFirst {
         let initial = config.registration.initial(voxels.max_res());
         let per_ray = intersect::slot_bytes() + initial as u64 * intersect::reg_bytes();
         let left = config.memory.saturating_sub(grid_bytes + buffers);
-        let capacity = (left / per_ray) as usize;
+        let capacity = (left / per_ray).min(config.max_rays.unwrap_or(u64::MAX)) as usize;
         if capacity == 0 {
             return Err(err(format!(
                 "memory={} B is too small: the grid ({} voxels) and buffers take {} B, and one \
@@ -257,7 +259,10 @@ impl BreadthFirst {
             slots: Vec::with_capacity(capacity),
             capacity,
             initial_count: initial,
-            inverse: config.registration == Registration::Inverse,
+            inverse: matches!(
+                config.registration,
+                Registration::Inverse | Registration::InverseFrom(_)
+            ),
             boundary: config.boundary,
             prev_skip: config.prev_skip,
             refill: config.refill,

@@ -46,6 +46,8 @@ registry! {
     kimura_simd,
     nakamaru_3_1,
     nakamaru_3_2,
+    nakamaru_fig3_2,
+    nakamaru_fig3_3,
     yamauchi_static_lb,
     yamauchi_dynamic_lb,
     yamauchi_cfbs,
