@@ -47,11 +47,13 @@ fn run(cli: Cli) -> Result<()> {
             scene,
             output,
             layout,
+            compress,
             json,
         }) => commands::scene::store(
             &Source::from_args(&scene.scene, &scene.opts)?,
             &output,
             &layout,
+            &compress,
             json,
         ),
         Command::Scene(SceneCommand::Stats { scene, json }) => {

@@ -208,3 +208,55 @@ fn basic_and_split_layouts_render_the_same_image() {
         "--layout",
     );
 }
+
+/// A gzip-compressed basic store (seed 000 Table 3.3) renders the plain store's image, with
+/// gzip spill files too; the engine counts compressed and uncompressed bytes; a truncated or
+/// corrupted compressed store, and compression with the split layout, exit 2 in one line.
+#[test]
+fn compressed_stores_render_the_plain_image_and_refuse_damage() {
+    let d = Dir::new("gzip");
+    let (plain, gz) = (d.join("plain"), d.join("gz"));
+    let p = json(&[
+        "scene", "store", "mount", "--sf", "3", "-o", &plain, "--layout", "basic", "--json",
+    ]);
+    let g = json(&[
+        "scene", "store", "mount", "--sf", "3", "-o", &gz, "--layout", "basic", "--compress",
+        "gzip", "--json",
+    ]);
+    assert_eq!(p["objects_bytes"], g["objects_bytes"]);
+    assert!(g["stored_bytes"].as_u64() < p["stored_bytes"].as_u64());
+    let render = |store: &str, spill: &str| {
+        json(&[
+            "render", "--scene", store, "--engine", "breadth-first", "--size", "32", "--set",
+            "layout=basic", "--set", &format!("spill_codec={spill}"), "--set", "buffer=1KiB",
+            "--json",
+        ])
+    };
+    let (a, b) = (render(&plain, "none"), render(&gz, "gzip"));
+    assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
+    let extra = &b["counters"]["extra"];
+    assert!(extra["io_codec_bytes"].as_u64().unwrap() > extra["io_bytes_read"].as_u64().unwrap());
+    assert!(b["io"]["workload"]["codec_bytes"].as_u64().unwrap() > 0);
+    expect_input_error(
+        &[
+            "scene", "store", "tetra", "-o", &d.join("x"), "--compress", "gzip",
+        ],
+        "--layout basic",
+    );
+    // Corrupted in the middle (size kept), then truncated.
+    let f = format!("{gz}/objects.bin.gz");
+    let bytes = std::fs::read(&f).unwrap();
+    let mut bad = bytes.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0xff;
+    std::fs::write(&f, &bad).unwrap();
+    let args = [
+        "render", "--scene", &gz, "--engine", "breadth-first", "--size", "16", "--set",
+        "layout=basic",
+    ];
+    let out = rtbench(&args);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
+    std::fs::write(&f, &bytes[..bytes.len() - 100]).unwrap();
+    expect_input_error(&args, "header.json says");
+}

@@ -126,7 +126,14 @@ pub struct BreadthFirstConfig {
     pub res: Option<u32>,
     /// At most this many rays in memory (`rays=N`), below what the budget allows.
     pub max_rays: Option<u64>,
+    /// How the out-of-core workload stores its spill files (`spill_codec=none|gzip`).
+    pub spill_codec: Codec,
+    /// The out-of-core workload traces reflection and refraction rays (`secondary=on`), or
+    /// eye and shadow rays only (`off`; seed 000 ran rings80 so, Fig. 3.9).
+    pub secondary: bool,
 }
+
+pub use crate::store::Codec;
 
 pub use crate::grid::config::Count;
 pub use crate::store::Layout;
@@ -206,6 +213,14 @@ impl BreadthFirstConfig {
             ));
         }
         let max_rays: u64 = s.get("rays", 0u64)?;
+        let spill_codec: String = s.get("spill_codec", "none".to_string())?;
+        let spill_codec = match spill_codec.as_str() {
+            "none" => Codec::None,
+            // Fast: spill files are written and read once.
+            "gzip" => Codec::Gzip(1),
+            v => return Err(bad("spill_codec", v, "none or gzip")),
+        };
+        let secondary = on_off(&mut s, "secondary")?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -242,6 +257,8 @@ impl BreadthFirstConfig {
             count,
             res: (res > 0).then_some(res),
             max_rays: (max_rays > 0).then_some(max_rays),
+            spill_codec,
+            secondary,
         })
     }
 }

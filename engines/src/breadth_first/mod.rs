@@ -31,6 +31,8 @@
 //! | `count` | `prims`, `objects` | `prims` | the n of ⌊n^(1/3) + 0.5⌋: primitives, or objects as Rayshade counted (the grid engine's `count`) |
 //! | `res` | cells per axis | ⌊n^(1/3) + 0.5⌋ | a given cubic resolution (Fig. 3.2 ran 20 and 40) |
 //! | `rays` | a count | what the budget holds | at most this many rays in memory |
+//! | `spill_codec` | `none`, `gzip` | `none` | the out-of-core workload's spill files (rays, hit records, shadow rays) gzip-compressed (level 1) |
+//! | `secondary` | `on`, `off` | `on` | the out-of-core workload traces reflection and refraction rays, or eye and shadow rays only (`off`; seed 000's rings80) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -39,7 +41,9 @@
 //! `bf_floor_tests` are the ray–object tests the grid engine counts as `primitive_tests`),
 //! `bf_geometry_records_read` (geometry records read in sweeps), `bf_pass_NNN_rays` (rays in memory at pass NNN, summed over calls: the
 //! surviving rays per pass), `bf_registrations`, `bf_prev_voxel_skips`, `bf_geometry_loads`,
-//! and the exact I/O of the calls: `io_bytes_read`, `io_read_calls`, `io_seeks`.
+//! and the exact I/O of the calls: `io_bytes_read` (on disk: compressed bytes for a compressed
+//! store), `io_codec_bytes` (uncompressed bytes out of the codec; 0 for a plain store),
+//! `io_read_calls`, `io_seeks`.
 
 pub mod config;
 pub mod intersect;
@@ -240,6 +244,9 @@ impl BreadthFirst {
         stats.insert("bytes_per_ray".into(), per_ray as f64);
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
+        stats.insert("preprocess_codec_bytes".into(), pre_io.codec_bytes as f64);
+        stats.insert("store_stored_bytes".into(), (header.stored_bytes + header.bbox_bytes) as f64);
+        stats.insert("store_plain_bytes".into(), (header.geometry_bytes + header.bbox_bytes) as f64);
         stats.insert("floor_objects".into(), floor.len() as f64);
         stats.insert("grid_n".into(), grid_n as f64);
         if let Some((bytes, secs)) = verify {
@@ -308,6 +315,7 @@ impl BreadthFirst {
         *e.entry("io_bytes_read".into()).or_insert(0) += after.bytes_read - before.bytes_read;
         *e.entry("io_read_calls".into()).or_insert(0) += after.read_calls - before.read_calls;
         *e.entry("io_seeks".into()).or_insert(0) += after.seeks - before.seeks;
+        *e.entry("io_codec_bytes".into()).or_insert(0) += after.codec_bytes - before.codec_bytes;
         r
     }
 

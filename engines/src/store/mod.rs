@@ -21,6 +21,11 @@
 //! (whose offset field points at the geometry record right after it) followed by its geometry
 //! record, so the file is read whole and in order on every sweep. `header.json` then says
 //! `"layout": "basic"` and gives `objects_bytes` in place of `bbox_bytes` and `geometry_bytes`.
+//! A basic store may be gzip-compressed (seed 000 §3.4, Table 3.3): `objects.bin.gz` holds the
+//! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
+//! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
+//! offsets). The compressed file's header carries no checksum of `header.json` (it is written
+//! before the header is known); gzip's own CRC-32 and the records' checksums guard its bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
 //! All numbers little-endian; CRC-32 is IEEE's (crate `crc32fast`). Reading checks what it can
@@ -41,7 +46,7 @@ mod read;
 mod surface;
 mod write;
 
-pub use io::{IoCounters, IoFile};
+pub use io::{Codec, IoCounters, IoFile};
 pub use read::{
     BasicReader, BboxReader, BboxRecord, GeometryReader, ObjectRecord, SceneReader, StoreHeader,
 };
@@ -93,6 +98,8 @@ impl std::str::FromStr for Layout {
 
 pub const HEADER_FILE: &str = "header.json";
 pub const OBJECTS_FILE: &str = "objects.bin";
+/// `objects.bin` gzip-compressed (basic layout only: it is read strictly forward, §3.4).
+pub const OBJECTS_FILE_GZ: &str = "objects.bin.gz";
 pub const BBOX_FILE: &str = "bbox.bin";
 pub const GEOMETRY_FILE: &str = "geometry.bin";
 

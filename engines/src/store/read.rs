@@ -1,11 +1,11 @@
 //! Reading a store: its header, the bounding-box file as a forward stream, and the geometry
 //! file with forward-only seeks (seed 000 §4.2.2, "G": geometry is read only when needed).
 
-use super::io::{IoCounters, IoFile};
+use super::io::{Codec, IoCounters, IoFile};
 use super::write::bbox_checksum;
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE,
-    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_MAGIC, VERSION,
+    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
@@ -28,6 +28,9 @@ pub struct StoreHeader {
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub layout: Layout,
+    /// How `objects.bin` is stored (basic layout), and its size on disk.
+    pub codec: Codec,
+    pub stored_bytes: u64,
     /// Sizes of `bbox.bin` and `geometry.bin`, as recorded (and checked against the files); in
     /// the basic layout `bbox_bytes` is 0 and `geometry_bytes` is the size of `objects.bin`.
     pub bbox_bytes: u64,
@@ -131,6 +134,23 @@ impl StoreHeader {
             Layout::Split => (count("bbox_bytes")?, count("geometry_bytes")?),
             Layout::Basic => (0, count("objects_bytes")?),
         };
+        let codec = match (v["compression"].as_str(), layout) {
+            (None, _) if v["compression"].is_null() => Codec::None,
+            (Some("gzip"), Layout::Basic) => Codec::Gzip(6),
+            _ => {
+                return Err(bad(
+                    dir,
+                    format!(
+                        "compression {} (gzip, basic layout only)",
+                        v["compression"]
+                    ),
+                ))
+            }
+        };
+        let stored_bytes = match codec {
+            Codec::None => geometry_bytes,
+            Codec::Gzip(_) => count("stored_bytes")?,
+        };
         let h = StoreHeader {
             dir: dir.to_path_buf(),
             name: v["name"].as_str().unwrap_or("").to_string(),
@@ -142,6 +162,8 @@ impl StoreHeader {
             lights,
             materials,
             layout,
+            codec,
+            stored_bytes,
             bbox_bytes,
             geometry_bytes,
         };
@@ -189,8 +211,10 @@ impl StoreHeader {
                 (BBOX_FILE, self.bbox_bytes),
                 (GEOMETRY_FILE, self.geometry_bytes),
             ],
-            Layout::Basic => &[(OBJECTS_FILE, self.geometry_bytes)],
+            Layout::Basic if self.codec == Codec::None => &[(OBJECTS_FILE, self.geometry_bytes)],
+            Layout::Basic => &[(OBJECTS_FILE_GZ, self.stored_bytes)],
         };
+        let compressed = self.codec != Codec::None;
         for &(name, want) in files {
             let path = dir.join(name);
             let mut f = std::fs::File::open(&path)
@@ -201,6 +225,10 @@ impl StoreHeader {
                     dir,
                     format!("{name} has {size} bytes, header.json says {want}"),
                 ));
+            }
+            if compressed {
+                // Checked through the codec as it is read (gzip CRC-32, record checksums).
+                continue;
             }
             let mut h = [0u8; FILE_HEADER as usize];
             std::io::Read::read_exact(&mut f, &mut h)
@@ -483,9 +511,23 @@ pub struct BasicReader {
 
 impl BasicReader {
     pub fn open(dir: &Path, objects: u64, buffer: usize) -> io::Result<BasicReader> {
-        let path = dir.join(OBJECTS_FILE);
-        let size = std::fs::metadata(&path)?.len();
-        let mut file = IoFile::open(&path, buffer)?;
+        let size = std::fs::metadata(dir.join(OBJECTS_FILE))?.len();
+        Self::open_codec(dir, objects, buffer, Codec::None, size)
+    }
+
+    /// `objects.bin` (or `objects.bin.gz`) holding `size` uncompressed bytes.
+    pub fn open_codec(
+        dir: &Path,
+        objects: u64,
+        buffer: usize,
+        codec: Codec,
+        size: u64,
+    ) -> io::Result<BasicReader> {
+        let path = dir.join(match codec {
+            Codec::None => OBJECTS_FILE,
+            Codec::Gzip(_) => OBJECTS_FILE_GZ,
+        });
+        let mut file = IoFile::open_codec(&path, buffer, codec)?;
         check_file_header(&mut file, OBJECTS_MAGIC, &path)?;
         Ok(BasicReader {
             file,
@@ -549,7 +591,13 @@ impl SceneReader {
                 geometry: GeometryReader::open(&h.dir, buffer)?,
                 lazy,
             },
-            Layout::Basic => SceneReader::Basic(BasicReader::open(&h.dir, h.objects, buffer)?),
+            Layout::Basic => SceneReader::Basic(BasicReader::open_codec(
+                &h.dir,
+                h.objects,
+                buffer,
+                h.codec,
+                h.geometry_bytes,
+            )?),
         })
     }
 

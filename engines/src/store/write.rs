@@ -2,10 +2,10 @@
 //! preprocessing, "convert all scene data to a binary format, each object with its AABB"). It
 //! holds one object at a time, the lights and the materials, never the scene.
 
-use super::io::{IoCounters, IoFile};
+use super::io::{Codec, IoCounters, IoFile};
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE, OBJECTS_FILE,
-    OBJECTS_MAGIC, VERSION,
+    OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
@@ -23,6 +23,7 @@ pub struct StoreWriter {
     dir: PathBuf,
     name: String,
     layout: Layout,
+    codec: Codec,
     /// `bbox.bin` (split layout; `None` in the basic layout).
     bbox: Option<IoFile>,
     /// `geometry.bin` (split), or `objects.bin` holding each box and its geometry (basic).
@@ -77,6 +78,23 @@ impl StoreWriter {
 
     /// Creates `dir` (and parents) and the binary files of `layout` in it.
     pub fn create_layout(dir: &Path, name: &str, layout: Layout) -> io::Result<StoreWriter> {
+        Self::create_with(dir, name, layout, Codec::None)
+    }
+
+    /// As [`StoreWriter::create_layout`], `objects.bin` stored through `codec` (basic layout
+    /// only: a compressed file is read strictly forward).
+    pub fn create_with(
+        dir: &Path,
+        name: &str,
+        layout: Layout,
+        codec: Codec,
+    ) -> io::Result<StoreWriter> {
+        if codec != Codec::None && layout != Layout::Basic {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "a compressed store needs the basic layout",
+            ));
+        }
         std::fs::create_dir_all(dir)?;
         // The header's checksum goes in at `finish`, when header.json is written.
         let (bbox, geometry) = match layout {
@@ -88,7 +106,12 @@ impl StoreWriter {
                 (Some(bbox), geometry)
             }
             Layout::Basic => {
-                let mut objects = IoFile::create(&dir.join(OBJECTS_FILE), WRITE_BUFFER)?;
+                let mut objects = match codec {
+                    Codec::None => IoFile::create(&dir.join(OBJECTS_FILE), WRITE_BUFFER)?,
+                    Codec::Gzip(_) => {
+                        IoFile::create_codec(&dir.join(OBJECTS_FILE_GZ), WRITE_BUFFER, codec)?
+                    }
+                };
                 objects.write_all(&file_header(OBJECTS_MAGIC, 0))?;
                 (None, objects)
             }
@@ -97,6 +120,7 @@ impl StoreWriter {
             dir: dir.to_path_buf(),
             name: name.to_string(),
             layout,
+            codec,
             bbox,
             geometry,
             error: None,
@@ -188,6 +212,7 @@ impl StoreWriter {
         let bbox_bytes = self.bbox.as_ref().map_or(0, |b| b.written());
         let geometry_bytes = self.geometry.written();
         let mut io = self.geometry.finish()?;
+        let stored_bytes = io.bytes_written;
         if let Some(b) = self.bbox {
             io.add(&b.finish()?);
         }
@@ -217,6 +242,10 @@ impl StoreWriter {
             Layout::Basic => {
                 header["layout"] = json!("basic");
                 header["objects_bytes"] = json!(geometry_bytes);
+                if self.codec != Codec::None {
+                    header["compression"] = json!(self.codec.name());
+                    header["stored_bytes"] = json!(stored_bytes);
+                }
             }
         }
         let text = serde_json::to_string_pretty(&header).map_err(io::Error::other)?;
@@ -227,7 +256,9 @@ impl StoreWriter {
         let crc = crc32fast::hash(text.as_bytes()).to_le_bytes();
         let files: &[&str] = match self.layout {
             Layout::Split => &[BBOX_FILE, GEOMETRY_FILE],
-            Layout::Basic => &[OBJECTS_FILE],
+            Layout::Basic if self.codec == Codec::None => &[OBJECTS_FILE],
+            // Written compressed: its header cannot be patched in place.
+            Layout::Basic => &[],
         };
         for name in files {
             use std::os::unix::fs::FileExt;

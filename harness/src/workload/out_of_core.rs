@@ -26,7 +26,7 @@ use super::trace::{shade_hit, GenerationStats, Path, RayStats, Render, MAX_DEPTH
 use glam::Vec3;
 use rtbench_engines::breadth_first::spill::SpillDir;
 use rtbench_engines::breadth_first::BreadthFirst;
-use rtbench_engines::store::{IoCounters, IoFile, ObjectRecord, SceneReader};
+use rtbench_engines::store::{Codec, IoCounters, IoFile, ObjectRecord, SceneReader};
 use rtbench_engines::{Counters, Hit, Ray};
 use std::io;
 use std::path::{Path as FsPath, PathBuf};
@@ -133,18 +133,20 @@ struct Records {
     path: PathBuf,
     len: u64,
     buffer: usize,
+    codec: Codec,
     writer: Option<IoFile>,
     io: IoCounters,
 }
 
 impl Records {
-    fn create(dir: &FsPath, name: &str, buffer: usize) -> io::Result<Records> {
+    fn create(dir: &FsPath, name: &str, buffer: usize, codec: Codec) -> io::Result<Records> {
         let path = dir.join(name);
         Ok(Records {
-            writer: Some(IoFile::create(&path, buffer)?),
+            writer: Some(IoFile::create_codec(&path, buffer, codec)?),
             path,
             len: 0,
             buffer,
+            codec,
             io: IoCounters::default(),
         })
     }
@@ -167,7 +169,7 @@ impl Records {
 
     fn reader(&mut self) -> io::Result<IoFile> {
         self.close()?;
-        IoFile::open(&self.path, self.buffer)
+        IoFile::open_codec(&self.path, self.buffer, self.codec)
     }
 
     fn remove(mut self) -> io::Result<IoCounters> {
@@ -213,7 +215,8 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     // the last one hit (Algorithm 3.6), the split one only the objects hit (§4.2.2).
     let mut scene = SceneReader::open(h, buffer, config.lazy)?;
 
-    let mut rays = Records::create(spill.path(), "rays-1", buffer)?;
+    let codec = config.spill_codec;
+    let mut rays = Records::create(spill.path(), "rays-1", buffer, codec)?;
     for j in 0..w {
         for i in 0..w {
             let path = Path {
@@ -243,7 +246,14 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
         let t0 = Instant::now();
         let groups = n.div_ceil(GROUP as u64) as usize;
         let mut buckets = (0..groups)
-            .map(|b| Records::create(spill.path(), &format!("hits-{generation}-{b}"), HIT_BUFFER))
+            .map(|b| {
+                Records::create(
+                    spill.path(),
+                    &format!("hits-{generation}-{b}"),
+                    HIT_BUFFER,
+                    codec,
+                )
+            })
             .collect::<io::Result<Vec<_>>>()?;
         let mut file = rays.reader()?;
         let (mut error, mut write_error) = (None, None);
@@ -266,8 +276,14 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
 
         // Shading, group by group, in object order; emitted records put back in ray order.
         let t1 = Instant::now();
-        let mut next = Records::create(spill.path(), &format!("rays-{}", generation + 1), buffer)?;
-        let mut shadows = Records::create(spill.path(), &format!("shadows-{generation}"), buffer)?;
+        let mut next = Records::create(
+            spill.path(),
+            &format!("rays-{}", generation + 1),
+            buffer,
+            codec,
+        )?;
+        let mut shadows =
+            Records::create(spill.path(), &format!("shadows-{generation}"), buffer, codec)?;
         let mut file = rays.reader()?;
         let mut group: Vec<(Ray, Path)> = Vec::with_capacity(GROUP);
         let mut order: Vec<u32> = Vec::with_capacity(GROUP);
@@ -363,7 +379,8 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
             for (k, (_, path)) in group.iter().enumerate() {
                 corners[path.corner as usize] += term[k];
             }
-            for (_, r, p) in &out_next {
+            // Eye and shadow rays only (`secondary=off`): no next generation.
+            for (_, r, p) in out_next.iter().filter(|_| config.secondary) {
                 next.push(&encode_path(r, p))?;
             }
             for (_, r, corner, gain) in &out_shadow {
