@@ -46,6 +46,7 @@ registry! {
     kimura_simd,
     nakamaru_3_1,
     nakamaru_3_2,
+    nakamaru_3_3,
     nakamaru_fig3_2,
     nakamaru_fig3_3,
     yamauchi_static_lb,
