@@ -170,41 +170,89 @@ fn bad_stores_engines_and_spill_directories_exit_2() {
 fn basic_and_split_layouts_render_the_same_image() {
     let d = Dir::new("layouts");
     let (split, basic) = (d.join("split"), d.join("basic"));
-    json(&["scene", "store", "rings", "--sf", "2", "-o", &split, "--json"]);
+    json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &split, "--json",
+    ]);
     let b = json(&[
         "scene", "store", "rings", "--sf", "2", "-o", &basic, "--layout", "basic", "--json",
     ]);
     assert_eq!(b["layout"], "basic");
     let render = |store: &str, layout: &str| {
         json(&[
-            "render", "--scene", store, "--engine", "breadth-first", "--size", "48", "--set",
-            &format!("layout={layout}"), "--set", "memory=1MiB", "--json",
+            "render",
+            "--scene",
+            store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "48",
+            "--set",
+            &format!("layout={layout}"),
+            "--set",
+            "memory=1MiB",
+            "--json",
         ])
     };
     let (s, b) = (render(&split, "split"), render(&basic, "basic"));
     assert_eq!(s["image"]["sha256"], b["image"]["sha256"]);
-    let reads = |v: &Value| v["counters"]["extra"]["bf_geometry_records_read"].as_u64().unwrap();
+    let reads = |v: &Value| {
+        v["counters"]["extra"]["bf_geometry_records_read"]
+            .as_u64()
+            .unwrap()
+    };
     assert!(reads(&b) > reads(&s), "{} {}", reads(&b), reads(&s));
     expect_input_error(
-        &["render", "--scene", &basic, "--engine", "breadth-first", "--size", "16"],
+        &[
+            "render",
+            "--scene",
+            &basic,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+        ],
         "basic layout",
     );
     expect_input_error(
         &[
-            "render", "--scene", &split, "--engine", "breadth-first", "--size", "16", "--set",
+            "render",
+            "--scene",
+            &split,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+            "--set",
             "layout=basic",
         ],
         "split layout",
     );
     expect_input_error(
         &[
-            "render", "--scene", &basic, "--engine", "breadth-first", "--size", "16", "--set",
-            "layout=basic", "--set", "lazy=on",
+            "render",
+            "--scene",
+            &basic,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+            "--set",
+            "layout=basic",
+            "--set",
+            "lazy=on",
         ],
         "lazy",
     );
     expect_input_error(
-        &["scene", "store", "tetra", "-o", &d.join("x"), "--layout", "packed"],
+        &[
+            "scene",
+            "store",
+            "tetra",
+            "-o",
+            &d.join("x"),
+            "--layout",
+            "packed",
+        ],
         "--layout",
     );
 }
@@ -220,15 +268,36 @@ fn compressed_stores_render_the_plain_image_and_refuse_damage() {
         "scene", "store", "mount", "--sf", "3", "-o", &plain, "--layout", "basic", "--json",
     ]);
     let g = json(&[
-        "scene", "store", "mount", "--sf", "3", "-o", &gz, "--layout", "basic", "--compress",
-        "gzip", "--json",
+        "scene",
+        "store",
+        "mount",
+        "--sf",
+        "3",
+        "-o",
+        &gz,
+        "--layout",
+        "basic",
+        "--compress",
+        "gzip",
+        "--json",
     ]);
     assert_eq!(p["objects_bytes"], g["objects_bytes"]);
     assert!(g["stored_bytes"].as_u64() < p["stored_bytes"].as_u64());
     let render = |store: &str, spill: &str| {
         json(&[
-            "render", "--scene", store, "--engine", "breadth-first", "--size", "32", "--set",
-            "layout=basic", "--set", &format!("spill_codec={spill}"), "--set", "buffer=1KiB",
+            "render",
+            "--scene",
+            store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "32",
+            "--set",
+            "layout=basic",
+            "--set",
+            &format!("spill_codec={spill}"),
+            "--set",
+            "buffer=1KiB",
             "--json",
         ])
     };
@@ -239,7 +308,13 @@ fn compressed_stores_render_the_plain_image_and_refuse_damage() {
     assert!(b["io"]["workload"]["codec_bytes"].as_u64().unwrap() > 0);
     expect_input_error(
         &[
-            "scene", "store", "tetra", "-o", &d.join("x"), "--compress", "gzip",
+            "scene",
+            "store",
+            "tetra",
+            "-o",
+            &d.join("x"),
+            "--compress",
+            "gzip",
         ],
         "--layout basic",
     );
@@ -251,7 +326,14 @@ fn compressed_stores_render_the_plain_image_and_refuse_damage() {
     bad[mid] ^= 0xff;
     std::fs::write(&f, &bad).unwrap();
     let args = [
-        "render", "--scene", &gz, "--engine", "breadth-first", "--size", "16", "--set",
+        "render",
+        "--scene",
+        &gz,
+        "--engine",
+        "breadth-first",
+        "--size",
+        "16",
+        "--set",
         "layout=basic",
     ];
     let out = rtbench(&args);

@@ -164,8 +164,8 @@ impl BreadthFirst {
         } else {
             None
         };
-        let mut scene = SceneReader::open(&header, config.buffer as usize, config.lazy)
-            .map_err(open_err)?;
+        let mut scene =
+            SceneReader::open(&header, config.buffer as usize, config.lazy).map_err(open_err)?;
         // The floor group, and the box and primitive count of the rest (one sweep).
         let (mut floor, mut bounds, mut grid_prims) =
             (Vec::new(), header.bounds, header.primitives);
@@ -245,8 +245,14 @@ impl BreadthFirst {
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
         stats.insert("preprocess_codec_bytes".into(), pre_io.codec_bytes as f64);
-        stats.insert("store_stored_bytes".into(), (header.stored_bytes + header.bbox_bytes) as f64);
-        stats.insert("store_plain_bytes".into(), (header.geometry_bytes + header.bbox_bytes) as f64);
+        stats.insert(
+            "store_stored_bytes".into(),
+            (header.stored_bytes + header.bbox_bytes) as f64,
+        );
+        stats.insert(
+            "store_plain_bytes".into(),
+            (header.geometry_bytes + header.bbox_bytes) as f64,
+        );
         stats.insert("floor_objects".into(), floor.len() as f64);
         stats.insert("grid_n".into(), grid_n as f64);
         if let Some((bytes, secs)) = verify {

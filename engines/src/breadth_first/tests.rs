@@ -202,7 +202,11 @@ fn layouts_and_switches_give_the_same_answers() {
             vec![("boundary", "off")],
             vec![("prevskip", "off")],
             vec![("refill", "off"), ("memory", "200KiB")],
-            vec![("layout", "basic"), ("registration", "fixed:1"), ("count", "objects")],
+            vec![
+                ("layout", "basic"),
+                ("registration", "fixed:1"),
+                ("count", "objects"),
+            ],
         ] {
             let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
             let mut c = Counters::default();

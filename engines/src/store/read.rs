@@ -5,7 +5,8 @@ use super::io::{Codec, IoCounters, IoFile};
 use super::write::bbox_checksum;
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE,
-    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
+    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC,
+    VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
@@ -140,10 +141,7 @@ impl StoreHeader {
             _ => {
                 return Err(bad(
                     dir,
-                    format!(
-                        "compression {} (gzip, basic layout only)",
-                        v["compression"]
-                    ),
+                    format!("compression {} (gzip, basic layout only)", v["compression"]),
                 ))
             }
         };
@@ -459,7 +457,9 @@ fn read_geometry(
     if len < MIN_GEOMETRY_RECORD || offset.saturating_add(len as u64) > size {
         return Err(io::Error::new(
             io::ErrorKind::InvalidData,
-            format!("geometry record at {offset}: length {len} does not fit the file ({size} bytes)"),
+            format!(
+                "geometry record at {offset}: length {len} does not fit the file ({size} bytes)"
+            ),
         ));
     }
     scratch.resize(len - 4, 0);

@@ -188,7 +188,9 @@ fn gzip_files_seek_forward_and_rewind() {
     let dir = TempDir::new("gzip-io");
     std::fs::create_dir_all(&dir.0).unwrap();
     let path = dir.0.join("x.gz");
-    let data: Vec<u8> = (0..200_000u32).flat_map(|i| (i % 251).to_le_bytes()).collect();
+    let data: Vec<u8> = (0..200_000u32)
+        .flat_map(|i| (i % 251).to_le_bytes())
+        .collect();
     let mut w = IoFile::create_codec(&path, 4096, Codec::Gzip(6)).unwrap();
     w.write_all(&data).unwrap();
     let wio = w.finish().unwrap();
@@ -230,7 +232,10 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
         .unwrap()
         .write_scene(&scene)
         .unwrap();
-    let (hp, hg) = (StoreHeader::read(&plain.0).unwrap(), StoreHeader::read(&gz.0).unwrap());
+    let (hp, hg) = (
+        StoreHeader::read(&plain.0).unwrap(),
+        StoreHeader::read(&gz.0).unwrap(),
+    );
     assert_eq!(hg.codec, Codec::Gzip(6));
     assert_eq!(hp.geometry_bytes, hg.geometry_bytes);
     assert!(hg.stored_bytes < hp.stored_bytes);

@@ -4,8 +4,8 @@
 
 use super::io::{Codec, IoCounters, IoFile};
 use super::{
-    Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE, OBJECTS_FILE,
-    OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
+    Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
+    OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};

@@ -282,8 +282,12 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
             buffer,
             codec,
         )?;
-        let mut shadows =
-            Records::create(spill.path(), &format!("shadows-{generation}"), buffer, codec)?;
+        let mut shadows = Records::create(
+            spill.path(),
+            &format!("shadows-{generation}"),
+            buffer,
+            codec,
+        )?;
         let mut file = rays.reader()?;
         let mut group: Vec<(Ray, Path)> = Vec::with_capacity(GROUP);
         let mut order: Vec<u32> = Vec::with_capacity(GROUP);
