@@ -191,7 +191,7 @@ impl IoFile {
                     let c = d.get_ref();
                     self.done_bytes += c.bytes;
                     self.done_calls += c.calls;
-                    *d = Box::new(GzDecoder::new(counted(File::open(&self.path)?)));
+                    **d = GzDecoder::new(counted(File::open(&self.path)?));
                     self.io.seeks += 1;
                     self.base = 0;
                     self.pos = 0;

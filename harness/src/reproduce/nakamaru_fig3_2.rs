@@ -253,7 +253,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
     Ok(out)
 }
 
-fn find<'a>(outs: &'a [CurveOut], fixed: bool, res: u32) -> Option<&'a CurveOut> {
+fn find(outs: &[CurveOut], fixed: bool, res: u32) -> Option<&CurveOut> {
     outs.iter()
         .find(|c| c.curve.res == res && c.curve.registration.starts_with("fixed") == fixed)
 }
