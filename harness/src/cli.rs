@@ -304,6 +304,14 @@ pub enum SceneCommand {
         /// renamed when complete.
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
+        /// `split` (bbox.bin + geometry.bin, seed 000 Ch.4 "S") or `basic` (one objects.bin of
+        /// (box, object) records, Ch.3); the breadth-first engine's `layout` must match.
+        #[arg(long, default_value = "split")]
+        layout: String,
+        /// `none`, or `gzip` / `gzip:LEVEL` (1-9, default 6 as gzip's): objects.bin.gz, read
+        /// through the codec (seed 000 Table 3.3; `--layout basic` only).
+        #[arg(long, default_value = "none")]
+        compress: String,
         #[arg(long)]
         json: bool,
     },

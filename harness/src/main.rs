@@ -46,10 +46,14 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene(SceneCommand::Store {
             scene,
             output,
+            layout,
+            compress,
             json,
         }) => commands::scene::store(
             &Source::from_args(&scene.scene, &scene.opts)?,
             &output,
+            &layout,
+            &compress,
             json,
         ),
         Command::Scene(SceneCommand::Stats { scene, json }) => {

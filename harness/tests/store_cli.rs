@@ -162,3 +162,183 @@ fn bad_stores_engines_and_spill_directories_exit_2() {
         .collect();
     assert_eq!(left.len(), 2, "{left:?}");
 }
+
+/// Seed 000's basic layout (one file of box + object records, read whole every sweep and in
+/// shading) renders the split layout's image to the bit; a store of the other layout, or
+/// `lazy=on` with the basic layout, is refused (exit 2, one line).
+#[test]
+fn basic_and_split_layouts_render_the_same_image() {
+    let d = Dir::new("layouts");
+    let (split, basic) = (d.join("split"), d.join("basic"));
+    json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &split, "--json",
+    ]);
+    let b = json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &basic, "--layout", "basic", "--json",
+    ]);
+    assert_eq!(b["layout"], "basic");
+    let render = |store: &str, layout: &str| {
+        json(&[
+            "render",
+            "--scene",
+            store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "48",
+            "--set",
+            &format!("layout={layout}"),
+            "--set",
+            "memory=1MiB",
+            "--json",
+        ])
+    };
+    let (s, b) = (render(&split, "split"), render(&basic, "basic"));
+    assert_eq!(s["image"]["sha256"], b["image"]["sha256"]);
+    let reads = |v: &Value| {
+        v["counters"]["extra"]["bf_geometry_records_read"]
+            .as_u64()
+            .unwrap()
+    };
+    assert!(reads(&b) > reads(&s), "{} {}", reads(&b), reads(&s));
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            &basic,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+        ],
+        "basic layout",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            &split,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+            "--set",
+            "layout=basic",
+        ],
+        "split layout",
+    );
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            &basic,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "16",
+            "--set",
+            "layout=basic",
+            "--set",
+            "lazy=on",
+        ],
+        "lazy",
+    );
+    expect_input_error(
+        &[
+            "scene",
+            "store",
+            "tetra",
+            "-o",
+            &d.join("x"),
+            "--layout",
+            "packed",
+        ],
+        "--layout",
+    );
+}
+
+/// A gzip-compressed basic store (seed 000 Table 3.3) renders the plain store's image, with
+/// gzip spill files too; the engine counts compressed and uncompressed bytes; a truncated or
+/// corrupted compressed store, and compression with the split layout, exit 2 in one line.
+#[test]
+fn compressed_stores_render_the_plain_image_and_refuse_damage() {
+    let d = Dir::new("gzip");
+    let (plain, gz) = (d.join("plain"), d.join("gz"));
+    let p = json(&[
+        "scene", "store", "mount", "--sf", "3", "-o", &plain, "--layout", "basic", "--json",
+    ]);
+    let g = json(&[
+        "scene",
+        "store",
+        "mount",
+        "--sf",
+        "3",
+        "-o",
+        &gz,
+        "--layout",
+        "basic",
+        "--compress",
+        "gzip",
+        "--json",
+    ]);
+    assert_eq!(p["objects_bytes"], g["objects_bytes"]);
+    assert!(g["stored_bytes"].as_u64() < p["stored_bytes"].as_u64());
+    let render = |store: &str, spill: &str| {
+        json(&[
+            "render",
+            "--scene",
+            store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "32",
+            "--set",
+            "layout=basic",
+            "--set",
+            &format!("spill_codec={spill}"),
+            "--set",
+            "buffer=1KiB",
+            "--json",
+        ])
+    };
+    let (a, b) = (render(&plain, "none"), render(&gz, "gzip"));
+    assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
+    let extra = &b["counters"]["extra"];
+    assert!(extra["io_codec_bytes"].as_u64().unwrap() > extra["io_bytes_read"].as_u64().unwrap());
+    assert!(b["io"]["workload"]["codec_bytes"].as_u64().unwrap() > 0);
+    expect_input_error(
+        &[
+            "scene",
+            "store",
+            "tetra",
+            "-o",
+            &d.join("x"),
+            "--compress",
+            "gzip",
+        ],
+        "--layout basic",
+    );
+    // Corrupted in the middle (size kept), then truncated.
+    let f = format!("{gz}/objects.bin.gz");
+    let bytes = std::fs::read(&f).unwrap();
+    let mut bad = bytes.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0xff;
+    std::fs::write(&f, &bad).unwrap();
+    let args = [
+        "render",
+        "--scene",
+        &gz,
+        "--engine",
+        "breadth-first",
+        "--size",
+        "16",
+        "--set",
+        "layout=basic",
+    ];
+    let out = rtbench(&args);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
+    std::fs::write(&f, &bytes[..bytes.len() - 100]).unwrap();
+    expect_input_error(&args, "header.json says");
+}

@@ -16,6 +16,8 @@ pub enum Registration {
     /// ⌈r/10 + 0.5⌉ to start, then inversely proportional to the rays in memory, so the memory
     /// freed by finished rays goes to those still running (`inverse`; §3.2, dynamic count).
     Inverse,
+    /// As `inverse`, starting from N (`inverse:N`; Fig. 3.2b started at 1 for r = 20, 2 for 40).
+    InverseFrom(u32),
 }
 
 impl FromStr for Registration {
@@ -24,10 +26,19 @@ impl FromStr for Registration {
         match s {
             "thesis" => Ok(Registration::Thesis),
             "inverse" => Ok(Registration::Inverse),
-            _ => match s.strip_prefix("fixed:").map(str::parse::<u32>) {
-                Some(Ok(n)) if n >= 1 => Ok(Registration::Fixed(n)),
-                _ => Err("expected fixed:N (N ≥ 1), thesis or inverse".into()),
-            },
+            _ => {
+                let bad = || "expected fixed:N or inverse:N (N ≥ 1), thesis or inverse".to_string();
+                if let Some(n) = s.strip_prefix("inverse:") {
+                    return match n.parse::<u32>() {
+                        Ok(n) if n >= 1 => Ok(Registration::InverseFrom(n)),
+                        _ => Err(bad()),
+                    };
+                }
+                match s.strip_prefix("fixed:").map(str::parse::<u32>) {
+                    Some(Ok(n)) if n >= 1 => Ok(Registration::Fixed(n)),
+                    _ => Err(bad()),
+                }
+            }
         }
     }
 }
@@ -41,7 +52,7 @@ impl Registration {
     /// The count of the first pass, which sizes the registration memory.
     pub fn initial(&self, res: u32) -> u32 {
         match *self {
-            Registration::Fixed(n) => n,
+            Registration::Fixed(n) | Registration::InverseFrom(n) => n,
             Registration::Thesis | Registration::Inverse => Self::thesis_count(res),
         }
     }
@@ -97,6 +108,43 @@ pub struct BreadthFirstConfig {
     /// Check every record of a store when it is opened (`verify=full`, the default), not only
     /// those the algorithm reads (`verify=records`).
     pub verify: bool,
+    /// The store layout this engine reads (a store of the other layout is refused): `basic`,
+    /// one file of (box, object) records read whole (Ch.3), or `split` (Ch.4's "S").
+    pub layout: Layout,
+    /// Read an object's geometry only when a ray hits its box (Ch.4's "G"; split layout only).
+    pub lazy: bool,
+    /// Register rays only at voxel-boundary entries (§3.2); off: in every marked voxel.
+    pub boundary: bool,
+    /// Skip an object when the ray's last voxel of the previous pass lies in its box (§3.3).
+    pub prev_skip: bool,
+    /// Refill memory with new rays at every pass (§3.3); off: a batch of rays runs until all are
+    /// done before the next is read (Algorithm 3.3).
+    pub refill: bool,
+    /// What sizes the grid: the primitives, or the objects as Rayshade counted them.
+    pub count: Count,
+    /// Cells per axis, given (`res=N`: N³), in place of ⌊n^(1/3) + 0.5⌋.
+    pub res: Option<u32>,
+    /// At most this many rays in memory (`rays=N`), below what the budget allows.
+    pub max_rays: Option<u64>,
+    /// How the out-of-core workload stores its spill files (`spill_codec=none|gzip`).
+    pub spill_codec: Codec,
+    /// The out-of-core workload traces reflection and refraction rays (`secondary=on`), or
+    /// eye and shadow rays only (`off`; seed 000 ran rings80 so, Fig. 3.9).
+    pub secondary: bool,
+}
+
+pub use crate::store::Codec;
+
+pub use crate::grid::config::Count;
+pub use crate::store::Layout;
+
+fn on_off(s: &mut Settings, key: &'static str) -> Result<bool, EngineError> {
+    let v: String = s.get(key, "on".to_string())?;
+    match v.as_str() {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        v => Err(bad(key, v, "on or off")),
+    }
 }
 
 pub use crate::grid::config::Floor;
@@ -138,6 +186,41 @@ impl BreadthFirstConfig {
             "records" => false,
             v => return Err(bad("verify", v, "full or records")),
         };
+        let layout = s.get("layout", Layout::Split)?;
+        let lazy: String = s.get("lazy", String::new())?;
+        let lazy = match (lazy.as_str(), layout) {
+            ("" | "on", Layout::Split) => true,
+            ("off", _) | ("", Layout::Basic) => false,
+            ("on", Layout::Basic) => {
+                return Err(bad(
+                    "lazy",
+                    "on",
+                    "layout=basic reads every object whole; lazy=on needs layout=split",
+                ))
+            }
+            (v, _) => return Err(bad("lazy", v, "on or off")),
+        };
+        let boundary = on_off(&mut s, "boundary")?;
+        let prev_skip = on_off(&mut s, "prevskip")?;
+        let refill = on_off(&mut s, "refill")?;
+        let count = s.get("count", Count::Prims)?;
+        let res: u32 = s.get("res", 0u32)?;
+        if (res as u64).pow(3).saturating_mul(5) > memory {
+            return Err(bad(
+                "res",
+                &res.to_string(),
+                "the grid (5 bytes per voxel) would pass the memory budget",
+            ));
+        }
+        let max_rays: u64 = s.get("rays", 0u64)?;
+        let spill_codec: String = s.get("spill_codec", "none".to_string())?;
+        let spill_codec = match spill_codec.as_str() {
+            "none" => Codec::None,
+            // Fast: spill files are written and read once.
+            "gzip" => Codec::Gzip(1),
+            v => return Err(bad("spill_codec", v, "none or gzip")),
+        };
+        let secondary = on_off(&mut s, "secondary")?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -166,6 +249,16 @@ impl BreadthFirstConfig {
             triangle,
             floor,
             verify,
+            layout,
+            lazy,
+            boundary,
+            prev_skip,
+            refill,
+            count,
+            res: (res > 0).then_some(res),
+            max_rays: (max_rays > 0).then_some(max_rays),
+            spill_codec,
+            secondary,
         })
     }
 }

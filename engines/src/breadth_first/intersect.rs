@@ -28,7 +28,7 @@ use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
-use crate::store::{BboxReader, GeometryReader, IoCounters, ObjectRecord};
+use crate::store::{IoCounters, ObjectRecord, SceneReader};
 use std::io;
 
 #[inline]
@@ -49,8 +49,11 @@ pub struct Work {
     pub(super) capacity: usize,
     pub(super) initial_count: u32,
     pub(super) inverse: bool,
-    pub(super) bbox: BboxReader,
-    pub(super) geometry: GeometryReader,
+    /// The switches of §3.2–3.3 (each on by default).
+    pub(super) boundary: bool,
+    pub(super) prev_skip: bool,
+    pub(super) refill: bool,
+    pub(super) scene: SceneReader,
     pub(super) record: ObjectRecord,
     /// The floor group: (object id, its record), held in memory.
     pub(super) floor: Vec<(u32, ObjectRecord)>,
@@ -60,9 +63,7 @@ pub struct Work {
 
 impl Work {
     pub(super) fn io(&self) -> IoCounters {
-        let mut io = self.bbox.file.io;
-        io.add(&self.geometry.file.io);
-        io
+        self.scene.io()
     }
 }
 
@@ -108,18 +109,19 @@ pub fn reg_bytes() -> u64 {
     std::mem::size_of::<Reg>() as u64
 }
 
+/// With `boundary` off every marked voxel is a candidate.
 #[inline]
-fn is_candidate(g: &Voxels, d: &Dda) -> bool {
+fn is_candidate(g: &Voxels, d: &Dda, boundary: bool) -> bool {
     let f = g.flags[g.lattice.index(d.voxel())];
     // `entered` is 2·axis + side, the numbering of `face_bit(axis, side)`.
-    f & MARKED != 0 && (d.entered == START || f & face_bit_of(d.entered) != 0)
+    f & MARKED != 0 && (!boundary || d.entered == START || f & face_bit_of(d.entered) != 0)
 }
 
 /// Walks to the ray's first candidate voxel; false when it has none.
-fn first_candidate(g: &Voxels, d: &mut Dda, c: &mut Counters) -> bool {
+fn first_candidate(g: &Voxels, d: &mut Dda, boundary: bool, c: &mut Counters) -> bool {
     loop {
         c.cells_visited += 1;
-        if is_candidate(g, d) {
+        if is_candidate(g, d, boundary) {
             return true;
         }
         if !d.advance(g.lattice.res) {
@@ -141,8 +143,10 @@ impl Work {
         let mut input_left = true;
         let mut pass = 0usize;
         loop {
-            // Refill the free slots (Algorithm 3.5, "while memory not full of rays").
-            while input_left && self.slots.len() < self.capacity {
+            // Refill the free slots (Algorithm 3.5, "while memory not full of rays"); without
+            // refill only once the batch in memory is done (Algorithm 3.3).
+            let may_read = self.refill || self.slots.is_empty();
+            while may_read && input_left && self.slots.len() < self.capacity {
                 let Some((id, ray)) = rays.next() else {
                     input_left = false;
                     break;
@@ -155,6 +159,7 @@ impl Work {
                 'floor: for (fid, rec) in &self.floor {
                     for prim in &rec.prims {
                         c.primitive_tests += 1;
+                        *c.extra.entry("bf_floor_tests".into()).or_insert(0) += 1;
                         if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
                             c.primitive_hits += 1;
                             seg.tmax = t;
@@ -175,7 +180,7 @@ impl Work {
                     None
                 } else {
                     Dda::start(&seg, &g.lattice)
-                        .and_then(|mut d| first_candidate(g, &mut d, c).then_some(d))
+                        .and_then(|mut d| first_candidate(g, &mut d, self.boundary, c).then_some(d))
                 };
                 match found {
                     None => out(id, best),
@@ -224,6 +229,7 @@ impl Work {
     /// stands on.
     fn register(&mut self, count: usize, c: &mut Counters) {
         let g = &self.voxels;
+        let boundary = self.boundary;
         for (si, s) in self.slots.iter_mut().enumerate() {
             let mut k = 0;
             'walk: loop {
@@ -248,7 +254,7 @@ impl Work {
                         break 'walk;
                     }
                     c.cells_visited += 1;
-                    if is_candidate(g, &s.dda) {
+                    if is_candidate(g, &s.dda, boundary) {
                         break;
                     }
                     if s.best_t <= s.dda.t_exit() {
@@ -264,17 +270,18 @@ impl Work {
     /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects").
     fn sweep(&mut self, any: bool, test: TriangleTest, c: &mut Counters) -> io::Result<()> {
         let g = &self.voxels;
-        self.bbox.rewind()?;
-        self.geometry.rewind()?;
-        let (mut prev_skips, mut loads) = (0u64, 0u64);
+        let prev_skip = self.prev_skip;
+        self.scene.rewind()?;
+        let (mut prev_skips, mut loads, mut records) = (0u64, 0u64, 0u64);
         let mut next_floor = self.floor.iter().map(|f| f.0).peekable();
-        while let Some((id, b)) = self.bbox.next_record()? {
+        while let Some((id, b, read)) = self.scene.next(&mut self.record)? {
+            records += read as u64;
             if next_floor.next_if_eq(&id).is_some() || !(b.lo.is_finite() && b.hi.is_finite()) {
                 continue;
             }
             let (a, z) = g.range(b.lo, b.hi);
             let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
-            let mut loaded = false;
+            let mut loaded = read;
             for cz in a[2]..=z[2] {
                 for cy in a[1]..=z[1] {
                     let row = g.lattice.index([0, cy, cz]);
@@ -293,7 +300,7 @@ impl Work {
                             }
                             s.mailbox = id;
                             let p = s.prev;
-                            if (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
+                            if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
                                 prev_skips += 1;
                                 continue;
                             }
@@ -302,7 +309,7 @@ impl Work {
                                 continue;
                             }
                             if !loaded {
-                                self.geometry.read_at(b.offset, &mut self.record)?;
+                                self.scene.load(&b, &mut self.record)?;
                                 loaded = true;
                                 loads += 1;
                             }
@@ -335,6 +342,9 @@ impl Work {
         self.regs.clear();
         *c.extra.entry("bf_prev_voxel_skips".into()).or_insert(0) += prev_skips;
         *c.extra.entry("bf_geometry_loads".into()).or_insert(0) += loads;
+        *c.extra
+            .entry("bf_geometry_records_read".into())
+            .or_insert(0) += records + loads;
         Ok(())
     }
 
@@ -342,6 +352,7 @@ impl Work {
     /// candidate of the next pass.
     fn finish_pass(&mut self, any: bool, out: &mut dyn FnMut(u32, Hit), c: &mut Counters) {
         let g = &self.voxels;
+        let boundary = self.boundary;
         let mut i = 0;
         while i < self.slots.len() {
             let s = &mut self.slots[i];
@@ -354,7 +365,7 @@ impl Work {
                         break;
                     }
                     c.cells_visited += 1;
-                    if is_candidate(g, &s.dda) {
+                    if is_candidate(g, &s.dda, boundary) {
                         break;
                     }
                     if s.best_t <= s.dda.t_exit() {

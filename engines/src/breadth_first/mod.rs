@@ -18,18 +18,32 @@
 //! | key | values | default | what |
 //! |---|---|---|---|
 //! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers |
-//! | `registration` | `fixed:N`, `thesis`, `inverse` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
+//! | `registration` | `fixed:N`, `thesis`, `inverse`, `inverse:N` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
 //! | `buffer` | bytes | `64KiB` | each file buffer |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //! | `verify` | `full`, `records` | `full` | `full`: a store opened is read once and every record checked ([`crate::store::StoreHeader::verify`]) before preprocessing, outside the I/O counters (reported as `verify_bytes_read`, `verify_s`); `records`: only the records the algorithm reads are checked |
+//! | `layout` | `split`, `basic` | `split` | the store layout read: `basic` = one file of (box, object) records read whole on every sweep and in shading (seed 000 Ch.3, Algorithms 3.4–3.6); `split` = box and geometry files apart (Ch.4 "S"). A store of the other layout is refused |
+//! | `lazy` | `on`, `off` | `on` (split), `off` (basic) | read an object's geometry only when a ray hits its box (Ch.4 "G"); `off` reads every object's geometry in every sweep. `on` needs `split` |
+//! | `boundary` | `on`, `off` | `on` | register rays only where they enter a voxel boundary (§3.2); `off`: in every marked voxel |
+//! | `prevskip` | `on`, `off` | `on` | the previous-voxel skip (§3.3) |
+//! | `refill` | `on`, `off` | `on` | refill memory with new rays every pass (§3.3); `off`: a batch of rays is finished before the next is read (Algorithm 3.3) |
+//! | `count` | `prims`, `objects` | `prims` | the n of ⌊n^(1/3) + 0.5⌋: primitives, or objects as Rayshade counted (the grid engine's `count`) |
+//! | `res` | cells per axis | ⌊n^(1/3) + 0.5⌋ | a given cubic resolution (Fig. 3.2 ran 20 and 40) |
+//! | `rays` | a count | what the budget holds | at most this many rays in memory |
+//! | `spill_codec` | `none`, `gzip` | `none` | the out-of-core workload's spill files (rays, hit records, shadow rays) gzip-compressed (level 1) |
+//! | `secondary` | `on`, `off` | `on` | the out-of-core workload traces reflection and refraction rays, or eye and shadow rays only (`off`; seed 000's rings80) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
 //! of the sweep), `mailbox_skips`, `cells_visited` (voxels walked); in `extra`: `bf_passes`
-//! (scene sweeps), `bf_pass_NNN_rays` (rays in memory at pass NNN, summed over calls: the
+//! (scene sweeps), `bf_floor_tests` (primitive tests of the floor group; `box_tests` +
+//! `bf_floor_tests` are the ray–object tests the grid engine counts as `primitive_tests`),
+//! `bf_geometry_records_read` (geometry records read in sweeps), `bf_pass_NNN_rays` (rays in memory at pass NNN, summed over calls: the
 //! surviving rays per pass), `bf_registrations`, `bf_prev_voxel_skips`, `bf_geometry_loads`,
-//! and the exact I/O of the calls: `io_bytes_read`, `io_read_calls`, `io_seeks`.
+//! and the exact I/O of the calls: `io_bytes_read` (on disk: compressed bytes for a compressed
+//! store), `io_codec_bytes` (uncompressed bytes out of the codec; 0 for a plain store),
+//! `io_read_calls`, `io_seeks`.
 
 pub mod config;
 pub mod intersect;
@@ -42,10 +56,8 @@ mod tests;
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
 use crate::grid::build::{FLOOR_FLAT, FLOOR_SPAN};
 use crate::ray::{Hit, Ray};
-use crate::store::{
-    BboxReader, GeometryReader, IoCounters, ObjectRecord, StoreHeader, StoreWriter, Surface,
-};
-use config::{BreadthFirstConfig, Floor, Registration};
+use crate::store::{ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface};
+use config::{BreadthFirstConfig, Count, Floor, Registration};
 use glam::Vec3;
 use intersect::Work;
 use spill::SpillDir;
@@ -106,7 +118,7 @@ impl BreadthFirst {
     ) -> Result<BreadthFirst, EngineError> {
         let t = Instant::now();
         let spill = SpillDir::create(config.spill.as_deref()).map_err(err)?;
-        let io = StoreWriter::create(spill.path(), &input.scene.name)
+        let io = StoreWriter::create_layout(spill.path(), &input.scene.name, config.layout)
             .and_then(|w| w.write_scene(&input.scene))
             .map_err(|e| {
                 err(format!(
@@ -135,6 +147,15 @@ impl BreadthFirst {
     pub fn open(dir: &Path, config: BreadthFirstConfig) -> Result<BreadthFirst, EngineError> {
         let t = Instant::now();
         let header = StoreHeader::read(dir).map_err(|e| err(e.to_string()))?;
+        if header.layout != config.layout {
+            return Err(err(format!(
+                "{}: a store of the {} layout, and this engine reads layout={} (set layout={})",
+                dir.display(),
+                header.layout.name(),
+                config.layout.name(),
+                header.layout.name()
+            )));
+        }
         let open_err = |e: std::io::Error| err(format!("{}: {e}", dir.display()));
         let verify = if config.verify {
             let t = Instant::now();
@@ -143,22 +164,23 @@ impl BreadthFirst {
         } else {
             None
         };
-        let mut bbox =
-            BboxReader::open(dir, header.objects, config.buffer as usize).map_err(open_err)?;
-        let mut geometry = GeometryReader::open(dir, config.buffer as usize).map_err(open_err)?;
+        let mut scene =
+            SceneReader::open(&header, config.buffer as usize, config.lazy).map_err(open_err)?;
         // The floor group, and the box and primitive count of the rest (one sweep).
         let (mut floor, mut bounds, mut grid_prims) =
             (Vec::new(), header.bounds, header.primitives);
         if config.floor == Floor::Out {
             let ext = header.bounds[1] - header.bounds[0];
             let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-            while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+            let mut rec = ObjectRecord::default();
+            while let Some((id, b, loaded)) = scene.next(&mut rec).map_err(open_err)? {
                 if is_floor_box(b.lo, b.hi, ext) {
-                    let mut rec = ObjectRecord::default();
-                    geometry.read_at(b.offset, &mut rec).map_err(open_err)?;
+                    if !loaded {
+                        scene.load(&b, &mut rec).map_err(open_err)?;
+                    }
                     if matches!(rec.surface, Some(Surface::Flat { .. })) {
                         grid_prims -= rec.prims.len() as u64;
-                        floor.push((id, rec));
+                        floor.push((id, std::mem::take(&mut rec)));
                         continue;
                     }
                 }
@@ -166,21 +188,27 @@ impl BreadthFirst {
                 hi = hi.max(b.hi);
             }
             bounds = [lo, hi];
-            bbox.rewind().map_err(open_err)?;
-            geometry.rewind().map_err(open_err)?;
+            scene.rewind().map_err(open_err)?;
         }
+        let grid_n = match config.count {
+            Count::Prims => grid_prims,
+            Count::Objects => header.objects - floor.len() as u64,
+        };
         // The grid takes about one voxel per primitive (5 bytes each: flags and a list head).
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
         // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
-        let voxel_target = grid_prims.min(config.memory / 2 / 5).max(1);
-        let mut voxels = Voxels::new(bounds, voxel_target);
+        let voxel_target = grid_n.min(config.memory / 2 / 5).max(1);
+        let mut voxels = Voxels::with_res(bounds, voxel_target, config.res);
         let nvox = voxels.count() as u64;
         let grid_bytes = nvox * 5;
-        let buffers = 2 * config.buffer;
+        let buffers = match config.layout {
+            config::Layout::Split => 2 * config.buffer,
+            config::Layout::Basic => config.buffer,
+        };
         let initial = config.registration.initial(voxels.max_res());
         let per_ray = intersect::slot_bytes() + initial as u64 * intersect::reg_bytes();
         let left = config.memory.saturating_sub(grid_bytes + buffers);
-        let capacity = (left / per_ray) as usize;
+        let capacity = (left / per_ray).min(config.max_rays.unwrap_or(u64::MAX)) as usize;
         if capacity == 0 {
             return Err(err(format!(
                 "memory={} B is too small: the grid ({} voxels) and buffers take {} B, and one \
@@ -192,15 +220,13 @@ impl BreadthFirst {
             )));
         }
         let mut next_floor = floor.iter().map(|f| f.0).peekable();
-        while let Some((id, b)) = bbox.next_record().map_err(open_err)? {
+        let mut rec = ObjectRecord::default();
+        while let Some((id, b, _)) = scene.next(&mut rec).map_err(open_err)? {
             if next_floor.next_if_eq(&id).is_none() {
                 voxels.mark(b.lo, b.hi);
             }
         }
-        let mut pre_io = bbox.file.io;
-        pre_io.add(&geometry.file.io);
-        bbox.file.io = IoCounters::default();
-        geometry.file.io = IoCounters::default();
+        let pre_io = scene.take_io();
         let preprocess_s = t.elapsed().as_secs_f64();
 
         let mut stats = BTreeMap::new();
@@ -218,7 +244,17 @@ impl BreadthFirst {
         stats.insert("bytes_per_ray".into(), per_ray as f64);
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
+        stats.insert("preprocess_codec_bytes".into(), pre_io.codec_bytes as f64);
+        stats.insert(
+            "store_stored_bytes".into(),
+            (header.stored_bytes + header.bbox_bytes) as f64,
+        );
+        stats.insert(
+            "store_plain_bytes".into(),
+            (header.geometry_bytes + header.bbox_bytes) as f64,
+        );
         stats.insert("floor_objects".into(), floor.len() as f64);
+        stats.insert("grid_n".into(), grid_n as f64);
         if let Some((bytes, secs)) = verify {
             stats.insert("verify_bytes_read".into(), bytes as f64);
             stats.insert("verify_s".into(), secs);
@@ -236,9 +272,14 @@ impl BreadthFirst {
             slots: Vec::with_capacity(capacity),
             capacity,
             initial_count: initial,
-            inverse: config.registration == Registration::Inverse,
-            bbox,
-            geometry,
+            inverse: matches!(
+                config.registration,
+                Registration::Inverse | Registration::InverseFrom(_)
+            ),
+            boundary: config.boundary,
+            prev_skip: config.prev_skip,
+            refill: config.refill,
+            scene,
             record: ObjectRecord::default(),
             floor,
         };
@@ -280,6 +321,7 @@ impl BreadthFirst {
         *e.entry("io_bytes_read".into()).or_insert(0) += after.bytes_read - before.bytes_read;
         *e.entry("io_read_calls".into()).or_insert(0) += after.read_calls - before.read_calls;
         *e.entry("io_seeks".into()).or_insert(0) += after.seeks - before.seeks;
+        *e.entry("io_codec_bytes".into()).or_insert(0) += after.codec_bytes - before.codec_bytes;
         r
     }
 

@@ -186,3 +186,123 @@ fn spill_directory_is_removed_on_drop() {
     assert_eq!(std::fs::read_dir(&parent).unwrap().count(), 0);
     std::fs::remove_dir(&parent).unwrap();
 }
+
+/// The basic layout and every switch of §3.2–3.3 change how the answers are found, never the
+/// answers: the same hits (object and t) and the same occlusion as the default engine.
+#[test]
+fn layouts_and_switches_give_the_same_answers() {
+    for (program, sf) in [(Program::Tetra, 3), (Program::Balls, 2)] {
+        let input = spd(program, sf);
+        let rays = rays_for(&input.geometry, 1500);
+        let base = build_engine("breadth-first", &input, vec![]).unwrap();
+        let want = answers(base.as_ref(), &rays, &mut Counters::default());
+        for settings in [
+            vec![("layout", "basic")],
+            vec![("lazy", "off")],
+            vec![("boundary", "off")],
+            vec![("prevskip", "off")],
+            vec![("refill", "off"), ("memory", "200KiB")],
+            vec![
+                ("layout", "basic"),
+                ("registration", "fixed:1"),
+                ("count", "objects"),
+            ],
+        ] {
+            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
+            let mut c = Counters::default();
+            let got = answers(e.as_ref(), &rays, &mut c);
+            let same = got
+                .0
+                .iter()
+                .zip(&want.0)
+                .all(|(a, b)| a.object == b.object && a.t == b.t);
+            assert!(same && got.1 == want.1, "{program:?} {settings:?}");
+            assert!(e.failure().is_none());
+            let reads = c.extra["bf_geometry_records_read"];
+            if settings[0].0 == "layout" || settings[0].0 == "lazy" {
+                // Every object's geometry read in every sweep.
+                let objects = input.scene.objects.len() as u64;
+                assert!(reads >= objects * c.extra["bf_passes"], "{reads}");
+            }
+        }
+        // Without boundary registration rays are registered in more voxels; without the
+        // previous-voxel skip there are more box tests.
+        let count = |s: &[(&str, &str)], key: &str| {
+            let e = build_engine("breadth-first", &input, kv(s)).unwrap();
+            let mut c = Counters::default();
+            answers(e.as_ref(), &rays, &mut c);
+            if key == "box_tests" {
+                c.box_tests
+            } else {
+                c.extra[key]
+            }
+        };
+        let reg1 = [("registration", "fixed:1")];
+        assert!(
+            count(&[reg1[0], ("boundary", "off")], "bf_passes") > count(&reg1, "bf_passes"),
+            "{program:?}"
+        );
+        assert!(count(&[reg1[0], ("prevskip", "off")], "box_tests") > count(&reg1, "box_tests"));
+    }
+}
+
+/// Registration 1 and the grid counted on objects: the ray–object tests equal the rss-r grid's
+/// primitive tests (one primitive per object here), the premise of seed 000's Table 3.1.
+#[test]
+fn registration_one_makes_the_grids_tests() {
+    for (program, sf, floor) in [(Program::Tetra, 3, "in"), (Program::Balls, 2, "out")] {
+        let input = spd(program, sf);
+        let rays = rays_for(&input.geometry, 2000);
+        let grid = build_engine(
+            "grid",
+            &input,
+            kv(&[("preset", "rss-r"), ("count", "objects"), ("floor", floor)]),
+        )
+        .unwrap();
+        let mut gc = Counters::default();
+        let mut hits = vec![Hit::MISS; rays.0.len()];
+        grid.intersect(&rays.0, &mut hits, &mut gc);
+        let bf = build_engine(
+            "breadth-first",
+            &input,
+            kv(&[
+                ("registration", "fixed:1"),
+                ("count", "objects"),
+                ("floor", floor),
+                ("layout", "basic"),
+            ]),
+        )
+        .unwrap();
+        let mut bc = Counters::default();
+        let mut hits = vec![Hit::MISS; rays.0.len()];
+        bf.intersect(&rays.0, &mut hits, &mut bc);
+        let bf_tests = bc.box_tests + bc.extra.get("bf_floor_tests").copied().unwrap_or(0);
+        assert_eq!(bf.build_stats()["res_x"], grid.build_stats()["res_x"]);
+        let diff = (bf_tests as f64 - gc.primitive_tests as f64).abs();
+        assert!(
+            diff <= 0.02 * gc.primitive_tests as f64,
+            "{program:?}: bf {bf_tests} grid {}",
+            gc.primitive_tests
+        );
+    }
+}
+
+/// A store of the other layout is refused with one line naming both layouts.
+#[test]
+fn wrong_layout_is_refused() {
+    let input = spd(Program::Tetra, 1);
+    let dir = crate::store::tests::TempDir::new("bf-layout");
+    StoreWriter::create_layout(&dir.0, "x", crate::store::Layout::Basic)
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let open = |layout: &str| {
+        let s = Settings::new("breadth-first", kv(&[("layout", layout)]));
+        BreadthFirst::open(&dir.0, BreadthFirstConfig::from_settings(s).unwrap())
+    };
+    let e = open("split").err().unwrap().to_string();
+    assert!(e.contains("basic layout") && !e.contains('\n'), "{e}");
+    assert!(open("basic").is_ok());
+    let s = Settings::new("breadth-first", kv(&[("layout", "basic"), ("lazy", "on")]));
+    assert!(BreadthFirstConfig::from_settings(s).is_err());
+}

@@ -33,6 +33,11 @@ pub struct Voxels {
 impl Voxels {
     /// An unmarked grid over `bounds` (of the prepared primitives) for `n` primitives.
     pub fn new(bounds: [Vec3; 2], n: u64) -> Voxels {
+        Self::with_res(bounds, n, None)
+    }
+
+    /// As [`Voxels::new`], with `res` cells per axis when given.
+    pub fn with_res(bounds: [Vec3; 2], n: u64, res: Option<u32>) -> Voxels {
         let [mut lo, mut hi] = bounds;
         if !(lo.is_finite() && hi.is_finite()) || n == 0 {
             // No primitive: one empty voxel that no ray is registered in.
@@ -47,7 +52,10 @@ impl Voxels {
         lo -= Vec3::splat(pad0);
         hi += Vec3::splat(pad0);
         let extent = (hi - lo).as_dvec3().to_array();
-        let res = cells_per_axis(Resolution::CubeRoot, extent, n as usize, 1.0, [0.0; 3]);
+        let res = match res {
+            Some(r) => [r; 3],
+            None => cells_per_axis(Resolution::CubeRoot, extent, n as usize, 1.0, [0.0; 3]),
+        };
         let lattice = Lattice::new(lo, hi, res);
         let cell = lattice.cell;
         Voxels {

@@ -1,10 +1,79 @@
 //! Files read and written through a fixed buffer, with exact I/O counters: bytes, system read
 //! and write calls, and seeks (each a system call, which seed 000 §4.2.1 counts as a cost).
+//!
+//! A file may be gzip-compressed ([`Codec::Gzip`]; seed 000 §3.4 read its scene through gzip,
+//! Table 3.3): offsets and positions are then those of the uncompressed stream, `bytes_read` /
+//! `bytes_written` count the compressed bytes on disk and `codec_bytes` the uncompressed bytes
+//! through the codec. A forward seek decompresses and discards; a backward one (a rewind) opens
+//! the stream again from its start.
 
+use flate2::read::GzDecoder;
+use flate2::write::GzEncoder;
+use flate2::Compression;
 use serde::Serialize;
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// How a file's bytes are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Codec {
+    #[default]
+    None,
+    /// gzip (RFC 1952) at the given level (1 fast … 9 small; gzip's default is 6).
+    Gzip(u32),
+}
+
+impl Codec {
+    pub fn name(self) -> &'static str {
+        match self {
+            Codec::None => "none",
+            Codec::Gzip(_) => "gzip",
+        }
+    }
+}
+
+/// A reader or writer counting the bytes and calls that reach the file.
+struct Counted<F> {
+    inner: F,
+    bytes: u64,
+    calls: u64,
+}
+
+impl<F: Read> Read for Counted<F> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.calls += 1;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+}
+
+impl<F: Write> Write for Counted<F> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.calls += 1;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+fn counted(f: File) -> Counted<File> {
+    Counted {
+        inner: f,
+        bytes: 0,
+        calls: 0,
+    }
+}
+
+enum Backing {
+    Plain(File),
+    GzRead(Box<GzDecoder<Counted<File>>>),
+    GzWrite(Box<GzEncoder<Counted<File>>>),
+}
 
 /// Exact I/O counts of one engine or workload.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -14,6 +83,8 @@ pub struct IoCounters {
     pub read_calls: u64,
     pub write_calls: u64,
     pub seeks: u64,
+    /// Uncompressed bytes through a codec (0 for plain files).
+    pub codec_bytes: u64,
 }
 
 impl IoCounters {
@@ -23,13 +94,18 @@ impl IoCounters {
         self.read_calls += o.read_calls;
         self.write_calls += o.write_calls;
         self.seeks += o.seeks;
+        self.codec_bytes += o.codec_bytes;
     }
 }
 
 /// A file with its own buffer of a fixed size, reading forward (with forward seeks) or
 /// writing sequentially, counting every system call it makes.
 pub struct IoFile {
-    file: File,
+    file: Backing,
+    path: PathBuf,
+    /// Disk bytes and calls of compressed streams already closed (a rewind reopens).
+    done_bytes: u64,
+    done_calls: u64,
     buf: Vec<u8>,
     /// Reading: `buf[pos..len]` is unread. Writing: `buf[..len]` is unwritten.
     pos: usize,
@@ -41,16 +117,40 @@ pub struct IoFile {
 
 impl IoFile {
     pub fn open(path: &Path, buffer: usize) -> io::Result<IoFile> {
-        Ok(Self::new(File::open(path)?, buffer))
+        Self::open_codec(path, buffer, Codec::None)
     }
 
     pub fn create(path: &Path, buffer: usize) -> io::Result<IoFile> {
-        Ok(Self::new(File::create(path)?, buffer))
+        Self::create_codec(path, buffer, Codec::None)
     }
 
-    fn new(file: File, buffer: usize) -> IoFile {
+    pub fn open_codec(path: &Path, buffer: usize, codec: Codec) -> io::Result<IoFile> {
+        let f = File::open(path)?;
+        let file = match codec {
+            Codec::None => Backing::Plain(f),
+            Codec::Gzip(_) => Backing::GzRead(Box::new(GzDecoder::new(counted(f)))),
+        };
+        Ok(Self::new(file, path, buffer))
+    }
+
+    pub fn create_codec(path: &Path, buffer: usize, codec: Codec) -> io::Result<IoFile> {
+        let f = File::create(path)?;
+        let file = match codec {
+            Codec::None => Backing::Plain(f),
+            Codec::Gzip(level) => Backing::GzWrite(Box::new(GzEncoder::new(
+                counted(f),
+                Compression::new(level.min(9)),
+            ))),
+        };
+        Ok(Self::new(file, path, buffer))
+    }
+
+    fn new(file: Backing, path: &Path, buffer: usize) -> IoFile {
         IoFile {
             file,
+            path: path.to_path_buf(),
+            done_bytes: 0,
+            done_calls: 0,
             buf: vec![0; buffer.max(64)],
             pos: 0,
             len: 0,
@@ -76,21 +176,70 @@ impl IoFile {
             self.pos = (offset - self.base) as usize;
             return Ok(());
         }
-        self.file.seek(SeekFrom::Start(offset))?;
-        self.io.seeks += 1;
-        self.base = offset;
-        self.pos = 0;
-        self.len = 0;
-        Ok(())
+        match &mut self.file {
+            Backing::Plain(f) => {
+                f.seek(SeekFrom::Start(offset))?;
+                self.io.seeks += 1;
+                self.base = offset;
+                self.pos = 0;
+                self.len = 0;
+                Ok(())
+            }
+            Backing::GzRead(d) => {
+                if offset < self.base {
+                    // Back: the stream again from its start.
+                    let c = d.get_ref();
+                    self.done_bytes += c.bytes;
+                    self.done_calls += c.calls;
+                    **d = GzDecoder::new(counted(File::open(&self.path)?));
+                    self.io.seeks += 1;
+                    self.base = 0;
+                    self.pos = 0;
+                    self.len = 0;
+                }
+                // Forward: decompress and discard.
+                while offset > self.base + self.len as u64 {
+                    if self.fill()? == 0 {
+                        self.pos = self.len;
+                        return Ok(());
+                    }
+                }
+                self.pos = (offset - self.base) as usize;
+                Ok(())
+            }
+            Backing::GzWrite(_) => Err(io::Error::other("seek in a file being written")),
+        }
     }
 
     fn fill(&mut self) -> io::Result<usize> {
         self.base += self.len as u64;
         self.pos = 0;
         self.len = 0;
-        let n = self.file.read(&mut self.buf)?;
-        self.io.read_calls += 1;
-        self.io.bytes_read += n as u64;
+        let n = match &mut self.file {
+            Backing::Plain(f) => {
+                let n = f.read(&mut self.buf)?;
+                self.io.read_calls += 1;
+                self.io.bytes_read += n as u64;
+                n
+            }
+            Backing::GzRead(d) => {
+                // Fill the whole buffer where the stream allows (the decoder returns in pieces).
+                let mut n = 0;
+                while n < self.buf.len() {
+                    let k = d.read(&mut self.buf[n..])?;
+                    if k == 0 {
+                        break;
+                    }
+                    n += k;
+                }
+                let c = d.get_ref();
+                self.io.read_calls = self.done_calls + c.calls;
+                self.io.bytes_read = self.done_bytes + c.bytes;
+                self.io.codec_bytes += n as u64;
+                n
+            }
+            Backing::GzWrite(_) => return Err(io::Error::other("read from a file being written")),
+        };
         self.len = n;
         Ok(n)
     }
@@ -129,9 +278,21 @@ impl IoFile {
 
     pub fn flush(&mut self) -> io::Result<()> {
         if self.len > 0 {
-            self.file.write_all(&self.buf[..self.len])?;
-            self.io.write_calls += 1;
-            self.io.bytes_written += self.len as u64;
+            match &mut self.file {
+                Backing::Plain(f) => {
+                    f.write_all(&self.buf[..self.len])?;
+                    self.io.write_calls += 1;
+                    self.io.bytes_written += self.len as u64;
+                }
+                Backing::GzWrite(e) => {
+                    e.write_all(&self.buf[..self.len])?;
+                    self.io.codec_bytes += self.len as u64;
+                    let c = e.get_ref();
+                    self.io.write_calls = c.calls;
+                    self.io.bytes_written = c.bytes;
+                }
+                Backing::GzRead(_) => return Err(io::Error::other("write to a file being read")),
+            }
             self.base += self.len as u64;
             self.len = 0;
         }
@@ -141,7 +302,16 @@ impl IoFile {
     /// Flushes and syncs: a full disk shows here at the latest.
     pub fn finish(mut self) -> io::Result<IoCounters> {
         self.flush()?;
-        self.file.sync_data()?;
+        match self.file {
+            Backing::Plain(f) => f.sync_data()?,
+            Backing::GzWrite(e) => {
+                let c = e.finish()?;
+                self.io.write_calls = c.calls;
+                self.io.bytes_written = c.bytes;
+                c.inner.sync_data()?;
+            }
+            Backing::GzRead(_) => {}
+        }
         Ok(self.io)
     }
 }

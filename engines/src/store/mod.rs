@@ -16,6 +16,18 @@
 //! - Each binary file's header: the magic (`RTBBOX\0\0`, `RTGEOM\0\0`), u32 version, and the
 //!   CRC-32 (u32) of `header.json`'s bytes, which ties the header to the files.
 //!
+//! The *basic* layout (seed 000 chapter 3, the thesis's `sray` before Chapter 4's "S") holds the
+//! same records in one file, `objects.bin` (magic `RTOBJS\0\0`): per object its 36-byte box record
+//! (whose offset field points at the geometry record right after it) followed by its geometry
+//! record, so the file is read whole and in order on every sweep. `header.json` then says
+//! `"layout": "basic"` and gives `objects_bytes` in place of `bbox_bytes` and `geometry_bytes`.
+//! A basic store may be gzip-compressed (seed 000 §3.4, Table 3.3): `objects.bin.gz` holds the
+//! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
+//! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
+//! offsets). The compressed file's header carries no checksum of `header.json` (it is written
+//! before the header is known); gzip's own CRC-32 and the records' checksums guard its bytes.
+//! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
+//!
 //! All numbers little-endian; CRC-32 is IEEE's (crate `crc32fast`). Reading checks what it can
 //! before trusting it: [`StoreHeader::read`] the header's checksum, the files' sizes against the
 //! header and the object count against the size of `bbox.bin`, and every value against the scene
@@ -34,8 +46,10 @@ mod read;
 mod surface;
 mod write;
 
-pub use io::{IoCounters, IoFile};
-pub use read::{BboxReader, BboxRecord, GeometryReader, ObjectRecord, StoreHeader};
+pub use io::{Codec, IoCounters, IoFile};
+pub use read::{
+    BasicReader, BboxReader, BboxRecord, GeometryReader, ObjectRecord, SceneReader, StoreHeader,
+};
 pub use surface::Surface;
 pub use write::StoreWriter;
 
@@ -51,9 +65,43 @@ pub const MIN_GEOMETRY_RECORD: usize = 17;
 /// Bytes of each file's header.
 pub const FILE_HEADER: u64 = 16;
 
+pub const OBJECTS_MAGIC: &[u8; 8] = b"RTOBJS\0\0";
+
+/// How a store lays its records out on disk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// `objects.bin`: each object's box and geometry together, one sequential file (Ch.3).
+    Basic,
+    /// `bbox.bin` and `geometry.bin` apart (Ch.4's "S").
+    Split,
+}
+
+impl Layout {
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Basic => "basic",
+            Layout::Split => "split",
+        }
+    }
+}
+
+impl std::str::FromStr for Layout {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "basic" => Ok(Layout::Basic),
+            "split" => Ok(Layout::Split),
+            _ => Err("expected basic or split".into()),
+        }
+    }
+}
+
 pub const HEADER_FILE: &str = "header.json";
+pub const OBJECTS_FILE: &str = "objects.bin";
+/// `objects.bin` gzip-compressed (basic layout only: it is read strictly forward, §3.4).
+pub const OBJECTS_FILE_GZ: &str = "objects.bin.gz";
 pub const BBOX_FILE: &str = "bbox.bin";
 pub const GEOMETRY_FILE: &str = "geometry.bin";
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -1,11 +1,12 @@
 //! Reading a store: its header, the bounding-box file as a forward stream, and the geometry
 //! file with forward-only seeks (seed 000 §4.2.2, "G": geometry is read only when needed).
 
-use super::io::IoFile;
+use super::io::{Codec, IoCounters, IoFile};
 use super::write::bbox_checksum;
 use super::{
-    Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE, GEOMETRY_MAGIC,
-    HEADER_FILE, MIN_GEOMETRY_RECORD, VERSION,
+    Layout, Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE,
+    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC,
+    VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
@@ -27,7 +28,12 @@ pub struct StoreHeader {
     pub view: View,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
-    /// Sizes of `bbox.bin` and `geometry.bin`, as recorded (and checked against the files).
+    pub layout: Layout,
+    /// How `objects.bin` is stored (basic layout), and its size on disk.
+    pub codec: Codec,
+    pub stored_bytes: u64,
+    /// Sizes of `bbox.bin` and `geometry.bin`, as recorded (and checked against the files); in
+    /// the basic layout `bbox_bytes` is 0 and `geometry_bytes` is the size of `objects.bin`.
     pub bbox_bytes: u64,
     pub geometry_bytes: u64,
 }
@@ -119,6 +125,30 @@ impl StoreHeader {
             v[k].as_u64()
                 .ok_or_else(|| bad(dir, format!("'{k}' is not a whole number")))
         };
+        let layout = match v["layout"].as_str() {
+            None if v["layout"].is_null() => Layout::Split,
+            Some("split") => Layout::Split,
+            Some("basic") => Layout::Basic,
+            _ => return Err(bad(dir, format!("unknown layout {}", v["layout"]))),
+        };
+        let (bbox_bytes, geometry_bytes) = match layout {
+            Layout::Split => (count("bbox_bytes")?, count("geometry_bytes")?),
+            Layout::Basic => (0, count("objects_bytes")?),
+        };
+        let codec = match (v["compression"].as_str(), layout) {
+            (None, _) if v["compression"].is_null() => Codec::None,
+            (Some("gzip"), Layout::Basic) => Codec::Gzip(6),
+            _ => {
+                return Err(bad(
+                    dir,
+                    format!("compression {} (gzip, basic layout only)", v["compression"]),
+                ))
+            }
+        };
+        let stored_bytes = match codec {
+            Codec::None => geometry_bytes,
+            Codec::Gzip(_) => count("stored_bytes")?,
+        };
         let h = StoreHeader {
             dir: dir.to_path_buf(),
             name: v["name"].as_str().unwrap_or("").to_string(),
@@ -129,8 +159,11 @@ impl StoreHeader {
             view,
             lights,
             materials,
-            bbox_bytes: count("bbox_bytes")?,
-            geometry_bytes: count("geometry_bytes")?,
+            layout,
+            codec,
+            stored_bytes,
+            bbox_bytes,
+            geometry_bytes,
         };
         h.check(crc)?;
         Ok(h)
@@ -159,7 +192,7 @@ impl StoreHeader {
             return Err(bad(dir, "header.json: objects but no materials"));
         }
         let want_bbox = FILE_HEADER + self.objects * BBOX_RECORD as u64;
-        if self.bbox_bytes != want_bbox {
+        if self.layout == Layout::Split && self.bbox_bytes != want_bbox {
             return Err(bad(
                 dir,
                 format!(
@@ -171,10 +204,16 @@ impl StoreHeader {
         if self.objects > 0 && !(self.bounds[0].is_finite() && self.bounds[1].is_finite()) {
             return Err(bad(dir, "header.json: bounds are not finite"));
         }
-        for (name, want) in [
-            (BBOX_FILE, self.bbox_bytes),
-            (GEOMETRY_FILE, self.geometry_bytes),
-        ] {
+        let files: &[(&str, u64)] = match self.layout {
+            Layout::Split => &[
+                (BBOX_FILE, self.bbox_bytes),
+                (GEOMETRY_FILE, self.geometry_bytes),
+            ],
+            Layout::Basic if self.codec == Codec::None => &[(OBJECTS_FILE, self.geometry_bytes)],
+            Layout::Basic => &[(OBJECTS_FILE_GZ, self.stored_bytes)],
+        };
+        let compressed = self.codec != Codec::None;
+        for &(name, want) in files {
             let path = dir.join(name);
             let mut f = std::fs::File::open(&path)
                 .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
@@ -184,6 +223,10 @@ impl StoreHeader {
                     dir,
                     format!("{name} has {size} bytes, header.json says {want}"),
                 ));
+            }
+            if compressed {
+                // Checked through the codec as it is read (gzip CRC-32, record checksums).
+                continue;
             }
             let mut h = [0u8; FILE_HEADER as usize];
             std::io::Read::read_exact(&mut f, &mut h)
@@ -203,21 +246,24 @@ impl StoreHeader {
     /// object order, that each box is its primitives' box, and that the object and primitive
     /// counts and the bounds are the header's. Returns the bytes read.
     pub fn verify(&self) -> io::Result<u64> {
-        let mut bbox = BboxReader::open(&self.dir, self.objects, 1 << 16)?;
-        let mut geometry = GeometryReader::open(&self.dir, 1 << 16)?;
+        let mut scene = SceneReader::open(self, 1 << 16, false)?;
         let mut rec = ObjectRecord::default();
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         let mut next = FILE_HEADER;
         let mut prims = 0u64;
-        while let Some((id, b)) = bbox.next_record()? {
+        let gap = match self.layout {
+            Layout::Split => 0,
+            Layout::Basic => BBOX_RECORD as u64,
+        };
+        while let Some((id, b, _)) = scene.next(&mut rec)? {
+            next += gap;
             if b.offset != next {
                 return Err(bad(
                     &self.dir,
                     format!("bbox record {id}: offset {} (expected {next})", b.offset),
                 ));
             }
-            geometry.read_at(b.offset, &mut rec)?;
-            next = geometry.file.position();
+            next = scene.position();
             let (mut a, mut c) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
             for p in &rec.prims {
                 let (pa, pc) = p.bounds();
@@ -261,7 +307,7 @@ impl StoreHeader {
                 "header.json's primitive count or bounds differ from the records",
             ));
         }
-        Ok(bbox.file.io.bytes_read + geometry.file.io.bytes_read)
+        Ok(scene.io().bytes_read)
     }
 }
 
@@ -339,24 +385,10 @@ impl BboxReader {
         }
         let mut b = [0u8; BBOX_RECORD];
         self.file.read_exact(&mut b)?;
-        let crc = u32::from_le_bytes(b[32..36].try_into().unwrap());
-        if bbox_checksum(self.next_id, &b[..32]) != crc {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("bbox record {}: checksum mismatch", self.next_id),
-            ));
-        }
-        let f = |i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
+        let rec = decode_bbox(self.next_id, &b)?;
         let id = self.next_id as u32;
         self.next_id += 1;
-        Ok(Some((
-            id,
-            BboxRecord {
-                lo: Vec3::new(f(0), f(1), f(2)),
-                hi: Vec3::new(f(3), f(4), f(5)),
-                offset: u64::from_le_bytes(b[24..32].try_into().unwrap()),
-            },
-        )))
+        Ok(Some((id, rec)))
     }
 }
 
@@ -404,38 +436,240 @@ impl GeometryReader {
             )));
         }
         self.file.seek_to(offset)?;
-        let mut len = [0u8; 4];
-        self.file.read_exact(&mut len)?;
-        let len_bytes = len;
-        let len = u32::from_le_bytes(len) as usize;
-        // Checked before anything is allocated for it: a corrupt length asked for gigabytes.
-        if len < MIN_GEOMETRY_RECORD || offset.saturating_add(len as u64) > self.size {
+        read_geometry(&mut self.file, self.size, &mut self.scratch, out)
+    }
+}
+
+/// Reads the geometry record at the file's position into `out`, checking its length against
+/// `size` (the file's) before allocating, and its checksum.
+fn read_geometry(
+    file: &mut IoFile,
+    size: u64,
+    scratch: &mut Vec<u8>,
+    out: &mut ObjectRecord,
+) -> io::Result<()> {
+    let offset = file.position();
+    let mut len = [0u8; 4];
+    file.read_exact(&mut len)?;
+    let len_bytes = len;
+    let len = u32::from_le_bytes(len) as usize;
+    // Checked before anything is allocated for it: a corrupt length asked for gigabytes.
+    if len < MIN_GEOMETRY_RECORD || offset.saturating_add(len as u64) > size {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "geometry record at {offset}: length {len} does not fit the file ({size} bytes)"
+            ),
+        ));
+    }
+    scratch.resize(len - 4, 0);
+    file.read_exact(scratch)?;
+    let (body, crc) = scratch.split_at(len - 8);
+    let mut h = crc32fast::Hasher::new();
+    h.update(&len_bytes);
+    h.update(body);
+    if h.finalize() != u32::from_le_bytes(crc.try_into().unwrap()) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("geometry record at {offset}: checksum mismatch"),
+        ));
+    }
+    decode_record(body, out).ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("geometry record at {offset} is malformed"),
+        )
+    })
+}
+
+/// A bounding-box record from its 36 bytes, checked against its checksum.
+fn decode_bbox(id: u64, b: &[u8; BBOX_RECORD]) -> io::Result<BboxRecord> {
+    let crc = u32::from_le_bytes(b[32..36].try_into().unwrap());
+    if bbox_checksum(id, &b[..32]) != crc {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("bbox record {id}: checksum mismatch"),
+        ));
+    }
+    let f = |i: usize| f32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
+    Ok(BboxRecord {
+        lo: Vec3::new(f(0), f(1), f(2)),
+        hi: Vec3::new(f(3), f(4), f(5)),
+        offset: u64::from_le_bytes(b[24..32].try_into().unwrap()),
+    })
+}
+
+/// `objects.bin` of the basic layout: each object's box record and geometry record, read
+/// together, forward, record by record (seed 000 Algorithms 3.4–3.6: "read object").
+pub struct BasicReader {
+    pub file: IoFile,
+    scratch: Vec<u8>,
+    size: u64,
+    next_id: u64,
+    objects: u64,
+}
+
+impl BasicReader {
+    pub fn open(dir: &Path, objects: u64, buffer: usize) -> io::Result<BasicReader> {
+        let size = std::fs::metadata(dir.join(OBJECTS_FILE))?.len();
+        Self::open_codec(dir, objects, buffer, Codec::None, size)
+    }
+
+    /// `objects.bin` (or `objects.bin.gz`) holding `size` uncompressed bytes.
+    pub fn open_codec(
+        dir: &Path,
+        objects: u64,
+        buffer: usize,
+        codec: Codec,
+        size: u64,
+    ) -> io::Result<BasicReader> {
+        let path = dir.join(match codec {
+            Codec::None => OBJECTS_FILE,
+            Codec::Gzip(_) => OBJECTS_FILE_GZ,
+        });
+        let mut file = IoFile::open_codec(&path, buffer, codec)?;
+        check_file_header(&mut file, OBJECTS_MAGIC, &path)?;
+        Ok(BasicReader {
+            file,
+            scratch: Vec::new(),
+            size,
+            next_id: 0,
+            objects,
+        })
+    }
+
+    pub fn rewind(&mut self) -> io::Result<()> {
+        self.file.seek_to(FILE_HEADER)?;
+        self.next_id = 0;
+        Ok(())
+    }
+
+    /// The next object: its id and box, its geometry in `out`; `None` after the last.
+    pub fn next_record(&mut self, out: &mut ObjectRecord) -> io::Result<Option<(u32, BboxRecord)>> {
+        if self.next_id == self.objects {
+            return Ok(None);
+        }
+        let mut b = [0u8; BBOX_RECORD];
+        self.file.read_exact(&mut b)?;
+        let rec = decode_bbox(self.next_id, &b)?;
+        if rec.offset != self.file.position() {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
                 format!(
-                    "geometry record at {offset}: length {len} does not fit the file ({} bytes)",
-                    self.size
+                    "object record {}: geometry offset {} (expected {})",
+                    self.next_id,
+                    rec.offset,
+                    self.file.position()
                 ),
             ));
         }
-        self.scratch.resize(len - 4, 0);
-        self.file.read_exact(&mut self.scratch)?;
-        let (body, crc) = self.scratch.split_at(len - 8);
-        let mut h = crc32fast::Hasher::new();
-        h.update(&len_bytes);
-        h.update(body);
-        if h.finalize() != u32::from_le_bytes(crc.try_into().unwrap()) {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("geometry record at {offset}: checksum mismatch"),
-            ));
-        }
-        decode_record(body, out).ok_or_else(|| {
-            io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("geometry record at {offset} is malformed"),
-            )
+        read_geometry(&mut self.file, self.size, &mut self.scratch, out)?;
+        let id = self.next_id as u32;
+        self.next_id += 1;
+        Ok(Some((id, rec)))
+    }
+}
+
+/// A store's objects as one forward stream, whatever its layout: (id, box, and whether the
+/// geometry was read with it). Split layout with `lazy` reads geometry only on
+/// [`SceneReader::load`] (seed 000 §4.2.2, "G"); without `lazy`, and always in the basic layout,
+/// every object's geometry is read as the stream passes it.
+pub enum SceneReader {
+    Split {
+        bbox: BboxReader,
+        geometry: GeometryReader,
+        lazy: bool,
+    },
+    Basic(BasicReader),
+}
+
+impl SceneReader {
+    pub fn open(h: &StoreHeader, buffer: usize, lazy: bool) -> io::Result<SceneReader> {
+        Ok(match h.layout {
+            Layout::Split => SceneReader::Split {
+                bbox: BboxReader::open(&h.dir, h.objects, buffer)?,
+                geometry: GeometryReader::open(&h.dir, buffer)?,
+                lazy,
+            },
+            Layout::Basic => SceneReader::Basic(BasicReader::open_codec(
+                &h.dir,
+                h.objects,
+                buffer,
+                h.codec,
+                h.geometry_bytes,
+            )?),
         })
+    }
+
+    pub fn rewind(&mut self) -> io::Result<()> {
+        match self {
+            SceneReader::Split { bbox, geometry, .. } => {
+                bbox.rewind()?;
+                geometry.rewind()
+            }
+            SceneReader::Basic(b) => b.rewind(),
+        }
+    }
+
+    /// The next object; `out` holds its geometry when the flag is true.
+    pub fn next(&mut self, out: &mut ObjectRecord) -> io::Result<Option<(u32, BboxRecord, bool)>> {
+        match self {
+            SceneReader::Split {
+                bbox,
+                geometry,
+                lazy,
+            } => {
+                let Some((id, b)) = bbox.next_record()? else {
+                    return Ok(None);
+                };
+                if !*lazy {
+                    geometry.read_at(b.offset, out)?;
+                }
+                Ok(Some((id, b, !*lazy)))
+            }
+            SceneReader::Basic(r) => Ok(r.next_record(out)?.map(|(id, b)| (id, b, true))),
+        }
+    }
+
+    /// Reads the geometry of the object `next` just gave without it (forward only).
+    pub fn load(&mut self, b: &BboxRecord, out: &mut ObjectRecord) -> io::Result<()> {
+        match self {
+            SceneReader::Split { geometry, .. } => geometry.read_at(b.offset, out),
+            SceneReader::Basic(_) => Ok(()),
+        }
+    }
+
+    /// Position in the geometry file (split) or in `objects.bin` (basic).
+    pub fn position(&self) -> u64 {
+        match self {
+            SceneReader::Split { geometry, .. } => geometry.file.position(),
+            SceneReader::Basic(b) => b.file.position(),
+        }
+    }
+
+    /// The I/O made so far.
+    pub fn io(&self) -> IoCounters {
+        match self {
+            SceneReader::Split { bbox, geometry, .. } => {
+                let mut io = bbox.file.io;
+                io.add(&geometry.file.io);
+                io
+            }
+            SceneReader::Basic(b) => b.file.io,
+        }
+    }
+
+    /// The I/O made so far, the counters then zeroed.
+    pub fn take_io(&mut self) -> IoCounters {
+        let io = self.io();
+        match self {
+            SceneReader::Split { bbox, geometry, .. } => {
+                bbox.file.io = IoCounters::default();
+                geometry.file.io = IoCounters::default();
+            }
+            SceneReader::Basic(b) => b.file.io = IoCounters::default(),
+        }
+        io
     }
 }
 

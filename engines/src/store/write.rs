@@ -2,8 +2,11 @@
 //! preprocessing, "convert all scene data to a binary format, each object with its AABB"). It
 //! holds one object at a time, the lights and the materials, never the scene.
 
-use super::io::{IoCounters, IoFile};
-use super::{Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE, VERSION};
+use super::io::{Codec, IoCounters, IoFile};
+use super::{
+    Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
+    OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
+};
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
 use rtbench_scenes::{Light, Material, Scene, ShapeRef, Sink, View};
@@ -19,7 +22,11 @@ const WRITE_BUFFER: usize = 1 << 16;
 pub struct StoreWriter {
     dir: PathBuf,
     name: String,
-    bbox: IoFile,
+    layout: Layout,
+    codec: Codec,
+    /// `bbox.bin` (split layout; `None` in the basic layout).
+    bbox: Option<IoFile>,
+    /// `geometry.bin` (split), or `objects.bin` holding each box and its geometry (basic).
     geometry: IoFile,
     error: Option<io::Error>,
     view: View,
@@ -64,17 +71,56 @@ fn file_header(magic: &[u8; 8], extra: u32) -> [u8; 16] {
 }
 
 impl StoreWriter {
-    /// Creates `dir` (and parents) and the two binary files in it.
+    /// Creates `dir` (and parents) and the two binary files of the split layout in it.
     pub fn create(dir: &Path, name: &str) -> io::Result<StoreWriter> {
+        Self::create_layout(dir, name, Layout::Split)
+    }
+
+    /// Creates `dir` (and parents) and the binary files of `layout` in it.
+    pub fn create_layout(dir: &Path, name: &str, layout: Layout) -> io::Result<StoreWriter> {
+        Self::create_with(dir, name, layout, Codec::None)
+    }
+
+    /// As [`StoreWriter::create_layout`], `objects.bin` stored through `codec` (basic layout
+    /// only: a compressed file is read strictly forward).
+    pub fn create_with(
+        dir: &Path,
+        name: &str,
+        layout: Layout,
+        codec: Codec,
+    ) -> io::Result<StoreWriter> {
+        if codec != Codec::None && layout != Layout::Basic {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "a compressed store needs the basic layout",
+            ));
+        }
         std::fs::create_dir_all(dir)?;
-        let mut bbox = IoFile::create(&dir.join(BBOX_FILE), WRITE_BUFFER)?;
-        let mut geometry = IoFile::create(&dir.join(GEOMETRY_FILE), WRITE_BUFFER)?;
         // The header's checksum goes in at `finish`, when header.json is written.
-        bbox.write_all(&file_header(BBOX_MAGIC, 0))?;
-        geometry.write_all(&file_header(GEOMETRY_MAGIC, 0))?;
+        let (bbox, geometry) = match layout {
+            Layout::Split => {
+                let mut bbox = IoFile::create(&dir.join(BBOX_FILE), WRITE_BUFFER)?;
+                let mut geometry = IoFile::create(&dir.join(GEOMETRY_FILE), WRITE_BUFFER)?;
+                bbox.write_all(&file_header(BBOX_MAGIC, 0))?;
+                geometry.write_all(&file_header(GEOMETRY_MAGIC, 0))?;
+                (Some(bbox), geometry)
+            }
+            Layout::Basic => {
+                let mut objects = match codec {
+                    Codec::None => IoFile::create(&dir.join(OBJECTS_FILE), WRITE_BUFFER)?,
+                    Codec::Gzip(_) => {
+                        IoFile::create_codec(&dir.join(OBJECTS_FILE_GZ), WRITE_BUFFER, codec)?
+                    }
+                };
+                objects.write_all(&file_header(OBJECTS_MAGIC, 0))?;
+                (None, objects)
+            }
+        };
         Ok(StoreWriter {
             dir: dir.to_path_buf(),
             name: name.to_string(),
+            layout,
+            codec,
             bbox,
             geometry,
             error: None,
@@ -128,15 +174,27 @@ impl StoreWriter {
         r[..4].copy_from_slice(&len.to_le_bytes());
         let crc = crc32fast::hash(r);
         r.extend_from_slice(&crc.to_le_bytes());
-        let offset = self.geometry.written();
-        self.geometry.write_all(r)?;
+        // Basic layout: the box record, then the geometry record right after it.
+        let offset = match self.bbox {
+            Some(_) => self.geometry.written(),
+            None => self.geometry.written() + super::BBOX_RECORD as u64,
+        };
         let mut b = Vec::with_capacity(super::BBOX_RECORD);
         v3(&mut b, lo);
         v3(&mut b, hi);
         b.extend_from_slice(&offset.to_le_bytes());
         let crc = bbox_checksum(self.objects, &b);
         b.extend_from_slice(&crc.to_le_bytes());
-        self.bbox.write_all(&b)?;
+        match self.bbox.as_mut() {
+            Some(bbox) => {
+                self.geometry.write_all(r)?;
+                bbox.write_all(&b)?;
+            }
+            None => {
+                self.geometry.write_all(&b)?;
+                self.geometry.write_all(r)?;
+            }
+        }
         if !self.prims.is_empty() {
             self.lo = self.lo.min(lo);
             self.hi = self.hi.max(hi);
@@ -151,21 +209,22 @@ impl StoreWriter {
         if let Some(e) = self.error {
             return Err(e);
         }
-        let bbox_bytes = self.bbox.written();
+        let bbox_bytes = self.bbox.as_ref().map_or(0, |b| b.written());
         let geometry_bytes = self.geometry.written();
-        let mut io = self.bbox.finish()?;
-        io.add(&self.geometry.finish()?);
+        let mut io = self.geometry.finish()?;
+        let stored_bytes = io.bytes_written;
+        if let Some(b) = self.bbox {
+            io.add(&b.finish()?);
+        }
         let v = &self.view;
         let d3 = |v: DVec3| json!([v.x, v.y, v.z]);
-        let header = json!({
+        let mut header = json!({
             "format": "rtbench-store",
             "version": VERSION,
             "name": self.name,
             "objects": self.objects,
             "primitives": self.prims_total,
             "bounds": [self.lo.to_array(), self.hi.to_array()],
-            "bbox_bytes": bbox_bytes,
-            "geometry_bytes": geometry_bytes,
             "background": d3(self.background),
             "view": {"from": d3(v.from), "at": d3(v.at), "up": d3(v.up), "angle": v.angle,
                      "hither": v.hither, "resolution": v.resolution},
@@ -175,13 +234,33 @@ impl StoreWriter {
                 "color": d3(m.color), "kd": m.kd, "ks": m.ks, "shine": m.shine, "t": m.t,
                 "ior": m.ior})).collect::<Vec<_>>(),
         });
+        match self.layout {
+            Layout::Split => {
+                header["bbox_bytes"] = json!(bbox_bytes);
+                header["geometry_bytes"] = json!(geometry_bytes);
+            }
+            Layout::Basic => {
+                header["layout"] = json!("basic");
+                header["objects_bytes"] = json!(geometry_bytes);
+                if self.codec != Codec::None {
+                    header["compression"] = json!(self.codec.name());
+                    header["stored_bytes"] = json!(stored_bytes);
+                }
+            }
+        }
         let text = serde_json::to_string_pretty(&header).map_err(io::Error::other)?;
         std::fs::write(self.dir.join(HEADER_FILE), &text)?;
         io.bytes_written += text.len() as u64;
         io.write_calls += 1;
         // Tie the header to the files: its checksum in both files' headers.
         let crc = crc32fast::hash(text.as_bytes()).to_le_bytes();
-        for name in [BBOX_FILE, GEOMETRY_FILE] {
+        let files: &[&str] = match self.layout {
+            Layout::Split => &[BBOX_FILE, GEOMETRY_FILE],
+            Layout::Basic if self.codec == Codec::None => &[OBJECTS_FILE],
+            // Written compressed: its header cannot be patched in place.
+            Layout::Basic => &[],
+        };
+        for name in files {
             use std::os::unix::fs::FileExt;
             let f = std::fs::OpenOptions::new()
                 .write(true)

@@ -3,7 +3,19 @@
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
-use rtbench_engines::store::{StoreHeader, StoreWriter};
+use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
+
+/// `none`, `gzip` or `gzip:LEVEL` (1–9).
+pub fn parse_codec(s: &str) -> std::result::Result<Codec, String> {
+    match s {
+        "none" => Ok(Codec::None),
+        "gzip" => Ok(Codec::Gzip(6)),
+        _ => match s.strip_prefix("gzip:").map(str::parse::<u32>) {
+            Some(Ok(l)) if (1..=9).contains(&l) => Ok(Codec::Gzip(l)),
+            _ => Err("expected none, gzip or gzip:LEVEL (1-9)".into()),
+        },
+    }
+}
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
@@ -80,7 +92,16 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
 /// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
 /// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
 /// so a failure (bad input, full disk) leaves nothing behind.
-pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
+pub fn store(src: &Source, out: &Path, layout: &str, compress: &str, as_json: bool) -> Result<()> {
+    let layout: Layout = layout
+        .parse()
+        .map_err(|e| input(format!("--layout {layout}: {e}")))?;
+    let codec = parse_codec(compress).map_err(|e| input(format!("--compress {compress}: {e}")))?;
+    if codec != Codec::None && layout != Layout::Basic {
+        return Err(input(format!(
+            "--compress {compress}: a compressed store is read strictly forward, so it needs --layout basic"
+        )));
+    }
     let start = std::time::Instant::now();
     if out.exists()
         && std::fs::read_dir(out)
@@ -108,7 +129,7 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
         let _ = std::fs::remove_dir_all(&tmp);
         input(e)
     };
-    let mut w = StoreWriter::create(&tmp, &src.label())
+    let mut w = StoreWriter::create_with(&tmp, &src.label(), layout, codec)
         .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
     if let Err(e) = src.stream(&mut w) {
         let _ = std::fs::remove_dir_all(&tmp);
@@ -130,6 +151,10 @@ pub fn store(src: &Source, out: &Path, as_json: bool) -> Result<()> {
     let secs = start.elapsed().as_secs_f64();
     let v = json!({
         "store": out.display().to_string(),
+        "layout": layout.name(),
+        "compression": codec.name(),
+        "objects_bytes": header.geometry_bytes + header.bbox_bytes,
+        "stored_bytes": header.stored_bytes + header.bbox_bytes,
         "scene": src.label(),
         "objects": header.objects,
         "primitives": header.primitives,

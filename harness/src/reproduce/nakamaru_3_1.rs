@@ -1,9 +1,15 @@
 //! `nakamaru-3.1`: seed 000's Table 3.1, the breadth-first method against Rayshade on small scenes.
 //!
 //! Configurations, as the thesis ran them: `grid` with `preset=rss` (shadow cache and per-voxel
-//! culling, Rayshade as shipped) and `preset=rss-r` (both off); `breadth-first` with registration
-//! count fixed at 1, traced out of core (scene store written and preprocessed, generations spilled,
-//! shading in object order: the whole of sray). For balls and tree the floor is kept out of the grid in
+//! culling, Rayshade as shipped) and `preset=rss-r` (both off); `breadth-first` as the basic sray
+//! (`layout=basic`: one file of box + object records read whole on every sweep and in shading, no
+//! lazy geometry) with registration count fixed at 1, traced out of core (scene store written and
+//! preprocessed, generations spilled, shading in object order: the whole of sray). Both grids are
+//! sized on objects, as Rayshade counted them (`count=objects`: ⌊n^(1/3) + 0.5⌋ with n objects).
+//!
+//! Rows: the test-count premise (breadth-first's ray–object tests, box tests plus floor tests,
+//! within 10% of rss-r's primitive tests), and per phase the measured ratio beside the thesis's
+//! printed range. For balls and tree the floor is kept out of the grid in
 //! all three (§3.4: "the base plate was excluded, the rest handled the same way"). One thread each:
 //! the thesis's machine had one processor, and the breadth-first engine runs on one. Times are medians
 //! of the repeats; preprocessing includes the scene's preparation (and for breadth-first the store's
@@ -18,7 +24,7 @@ use crate::workload::{self, out_of_core, trace};
 use rtbench_engines::breadth_first::config::BreadthFirstConfig;
 use rtbench_engines::breadth_first::spill::SpillDir;
 use rtbench_engines::breadth_first::BreadthFirst;
-use rtbench_engines::store::StoreWriter;
+use rtbench_engines::store::{Layout, StoreWriter};
 use rtbench_engines::Settings;
 use rtbench_reports::{Document, Table as DocTable};
 use serde::{Deserialize, Serialize};
@@ -35,11 +41,38 @@ pub const TABLE: Table = Table {
         full: "minutes",
     },
     params: &[],
-    claims: &[Claim {
-        key: "overall-overhead",
-        fidelity: Fidelity::Substituted,
-        why: "our breadth-first engine has Chapter 4's split layout and lazy geometry built in (not the basic sray), and its intersection-test count is not held equal to the grid's as the thesis's registration 1 was",
-    }],
+    claims: &[
+        Claim {
+            key: "test-count-premise",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+        Claim {
+            key: "overall-overhead",
+            fidelity: Fidelity::Substituted,
+            why: "the basic method as the thesis ran it, but on this machine: the store and spill files sit in the page cache (the thesis read a 1995 disk), so the I/O share of each phase is smaller",
+        },
+        Claim {
+            key: "preprocess-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "machine substituted (page cache, not a 1995 disk): the thesis attributes this ratio mainly to disk I/O",
+        },
+        Claim {
+            key: "intersect-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "machine substituted; the thesis's 1.2-1.8 is adjusted by profiling counts we do not have, so the printed 0.95-1.87 is the range",
+        },
+        Claim {
+            key: "shade-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "machine substituted (page cache); the thesis attributes shading's ratio to disk I/O and sorting",
+        },
+        Claim {
+            key: "total-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "machine substituted (page cache, not a 1995 disk)",
+        },
+    ],
     run,
 };
 
@@ -50,6 +83,7 @@ const PHASES: [&str; 4] = ["total", "preprocess", "intersect", "shade"];
 struct Published {
     source: Source,
     rows: Vec<PublishedRow>,
+    claims: Vec<published::PublishedClaim>,
 }
 
 /// Seconds per phase for rss, rss-r, sray.
@@ -61,11 +95,12 @@ struct PublishedRow {
     phases: BTreeMap<String, [f64; 3]>,
 }
 
-/// One timed run: seconds per phase, primitive tests, image.
+/// One timed run: seconds per phase, ray–object tests, image, grid resolution.
 struct Timed {
     s: [f64; 4],
     tests: u64,
     image: Vec<u8>,
+    res: f64,
 }
 
 #[derive(Serialize)]
@@ -80,7 +115,10 @@ struct Measured {
     sf: u32,
     floor: &'static str,
     phases: BTreeMap<&'static str, PhaseFigures>,
-    primitive_tests: BTreeMap<&'static str, u64>,
+    /// rss and rss-r: the grid's primitive tests; breadth-first: box tests + floor tests.
+    object_tests: BTreeMap<&'static str, u64>,
+    /// Cells per axis of each engine's grid (the same rule, on objects).
+    resolution: BTreeMap<&'static str, f64>,
     image_equal_to_rss_r: bool,
     repeats: usize,
 }
@@ -107,6 +145,7 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
     let set = vec![
         ("preset".to_string(), preset.to_string()),
         ("floor".to_string(), floor.to_string()),
+        ("count".to_string(), "objects".to_string()),
     ];
     let pool = workload::pool(Some(1))?;
     let (e, build_s) = workload::build("grid", &prepared.input, set)?;
@@ -116,6 +155,7 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
         s: [pre + r.trace_s, pre, r.intersect_s, r.shade_s],
         tests: r.counters.primitive_tests,
         image: r.pixels(),
+        res: e.build_stats().get("res_x").copied().unwrap_or(0.0),
     })
 }
 
@@ -126,10 +166,13 @@ fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed
         vec![
             ("registration".into(), "fixed:1".into()),
             ("floor".into(), floor.into()),
+            ("layout".into(), "basic".into()),
+            ("count".into(), "objects".into()),
+            ("verify".into(), "records".into()),
         ],
     ))?;
     let spill = SpillDir::create(None).map_err(input)?;
-    StoreWriter::create(spill.path(), "x")
+    StoreWriter::create_layout(spill.path(), "x", Layout::Basic)
         .and_then(|w| w.write_scene(&prepared.input.scene))
         .map_err(|e| input(format!("writing the scene store: {e}")))?;
     let engine = BreadthFirst::open(spill.path(), config)?;
@@ -137,10 +180,12 @@ fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed
     let ooc =
         out_of_core::render(&engine, 512).map_err(|e| input(format!("out-of-core render: {e}")))?;
     let r = &ooc.render;
+    let floor_tests = r.counters.extra.get("bf_floor_tests").copied().unwrap_or(0);
     Ok(Timed {
         s: [pre + r.trace_s, pre, r.intersect_s, r.shade_s],
-        tests: r.counters.primitive_tests,
+        tests: r.counters.box_tests + floor_tests,
         image: r.pixels(),
+        res: rtbench_engines::Engine::build_stats(&engine).get("res_x").copied().unwrap_or(0.0),
     })
 }
 
@@ -186,10 +231,14 @@ fn measure(row: &PublishedRow, repeats: usize) -> Result<Measured> {
         sf: row.sf,
         floor,
         phases,
-        primitive_tests: BTreeMap::from([
+        object_tests: BTreeMap::from([
             ("rss", runs[0][0].tests),
             ("rss-r", runs[1][0].tests),
             ("breadth-first", runs[2][0].tests),
+        ]),
+        resolution: BTreeMap::from([
+            ("grid", runs[1][0].res),
+            ("breadth-first", runs[2][0].res),
         ]),
         image_equal_to_rss_r: runs[2][0].image == runs[1][0].image,
         repeats,
@@ -205,12 +254,15 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .filter(|r| !ctx.quick || r.scene == "tetra")
         .map(|r| measure(r, repeats))
         .collect::<Result<Vec<_>>>()?;
-    let rows = rows(&measured);
+    let rows = rows(&p, &measured);
     let doc = document(&p, &measured, ctx.quick, repeats);
     let result = Result_ {
         id: ctx.id,
         published: raw,
-        all_smaller_overhead: rows.iter().all(|r| r.verdict == Verdict::Holds),
+        all_smaller_overhead: rows
+            .iter()
+            .filter(|r| r.claim == "overall-overhead")
+            .all(|r| r.verdict == Verdict::Holds),
         measured,
         quick: ctx.quick,
         environment: environment(1),
@@ -218,30 +270,94 @@ fn run(ctx: &Ctx) -> Result<Output> {
     Ok(Output::new(result, rows, doc))
 }
 
-/// The overall overhead per scene: breadth-first ÷ rss total time beside the thesis's sray ÷ rss; the
-/// goal is a smaller overhead (pure).
-fn rows(measured: &[Measured]) -> Vec<Row> {
-    measured
-        .iter()
-        .map(|m| {
-            let t = &m.phases["total"];
-            let (p, bf) = (t.published["sray/rss"], t.measured["bf/rss"]);
-            Row::new(
-                "overall-overhead",
-                format!("{}{}", m.scene, m.sf),
-                format!("sray/rss {p:.2}"),
-                format!("bf/rss {bf:.2} (bf/rss-r {:.2})", t.measured["bf/rss-r"]),
-                Kind::Ratio,
-                Verdict::of(bf < p),
-            )
-        })
-        .collect()
+/// Why a scene's test counts cannot agree, where we know it (measured, see the report).
+fn count_reason(scene: &str) -> &'static str {
+    match scene {
+        // 144-vertex polygons: the grid registers and tests each of a polygon's triangles, the
+        // breadth-first engine tests the polygon (one object, one box) once.
+        "gears" => "the grid registers each polygon's triangles, Rayshade and breadth-first the polygon: tests are counted in different units",
+        _ => "",
+    }
+}
+
+/// Per scene: the test-count premise, the overall overhead (goal: smaller than the thesis's),
+/// and each phase's ratio against the thesis's printed range (pure).
+fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
+    let range = |id: &str| -> (f64, f64) {
+        let c = published::claim(&p.claims, id);
+        let r = c.extra["range"].as_array().expect("range");
+        (r[0].as_f64().unwrap(), r[1].as_f64().unwrap())
+    };
+    let tol = published::claim(&p.claims, "test-count-premise").extra["tolerance"]
+        .as_f64()
+        .expect("tolerance");
+    let mut rows = Vec::new();
+    for m in measured {
+        let subject = format!("{}{}", m.scene, m.sf);
+        let (g, b) = (m.object_tests["rss-r"], m.object_tests["breadth-first"]);
+        let ratio = b as f64 / g.max(1) as f64;
+        let reason = count_reason(&m.scene);
+        let row = Row::new(
+            "test-count-premise",
+            &subject,
+            "equal (registration 1)",
+            format!("bf {b} / rss-r {g} = {ratio:.3}"),
+            Kind::Count,
+            Verdict::of((ratio - 1.0).abs() <= tol),
+        );
+        rows.push(if reason.is_empty() {
+            row
+        } else {
+            row.with_note(reason)
+        });
+        let t = &m.phases["total"];
+        let (pt, bf) = (t.published["sray/rss"], t.measured["bf/rss"]);
+        rows.push(Row::new(
+            "overall-overhead",
+            &subject,
+            format!("sray/rss {pt:.2}"),
+            format!("bf/rss {bf:.2} (bf/rss-r {:.2})", t.measured["bf/rss-r"]),
+            Kind::Ratio,
+            Verdict::of(bf < pt),
+        ));
+        for (claim, phase, against) in [
+            ("preprocess-ratio", "preprocess", "rss"),
+            ("intersect-ratio", "intersect", "rss-r"),
+            ("shade-ratio", "shade", "rss"),
+            ("total-ratio", "total", "rss"),
+        ] {
+            let (lo, hi) = range(claim);
+            let f = &m.phases[phase];
+            let key_p = format!("sray/{against}");
+            let key_m = format!("bf/{against}");
+            let (pv, mv) = (f.published[key_p.as_str()], f.measured[key_m.as_str()]);
+            let side = if mv < lo {
+                "below the range"
+            } else if mv > hi {
+                "above the range"
+            } else {
+                "inside"
+            };
+            rows.push(
+                Row::new(
+                    claim,
+                    &subject,
+                    format!("{key_p} {pv:.2} (range {lo}-{hi})"),
+                    format!("{key_m} {mv:.2}"),
+                    Kind::Range,
+                    Verdict::of((lo..=hi).contains(&mv)),
+                )
+                .with_note(side),
+            );
+        }
+    }
+    rows
 }
 
 fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -> Document {
     let mut doc = Document::new("nakamaru-3.1: breadth-first vs Rayshade-style grid on small data");
     doc.paragraph(format!(
-        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-3.1{}`, one thread, 512×512, median of {repeats}; `rss`/`rss-r` = `grid` presets, `bf` = `breadth-first` with registration fixed:1, out of core (store, spilled generations, shading in object order). Seconds; ratios are what compare.",
+        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-3.1{}`, one thread, 512×512, median of {repeats}; `rss`/`rss-r` = `grid` presets, `bf` = `breadth-first` with layout=basic (sray's one file read whole per sweep and in shading), registration fixed:1, grids sized on objects, out of core (store, spilled generations, shading in object order). Seconds; ratios are what compare.",
         p.source.cite(),
         p.source.machine.as_deref().unwrap_or(""),
         if quick { " --quick (tetra6 only, 1 repeat)" } else { "" },
@@ -268,15 +384,21 @@ fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -
         }
     }
     doc.table(t);
-    doc.paragraph("Primitive tests and image (breadth-first image equal to rss-r's):");
-    let mut tests = DocTable::new("", &["scene", "rss", "rss-r", "breadth-first", "image equal"]);
+    doc.paragraph("Ray–object tests (grids: primitive tests; breadth-first: box tests + floor tests), grid resolution (both on objects) and image (breadth-first image equal to rss-r's):");
+    let mut tests = DocTable::new(
+        "",
+        &["scene", "rss", "rss-r", "breadth-first", "bf/rss-r", "res grid", "res bf", "image equal"],
+    );
     for m in measured {
-        let t = &m.primitive_tests;
+        let t = &m.object_tests;
         tests.push(vec![
             format!("{}{}", m.scene, m.sf),
             t["rss"].to_string(),
             t["rss-r"].to_string(),
             t["breadth-first"].to_string(),
+            format!("{:.3}", t["breadth-first"] as f64 / t["rss-r"].max(1) as f64),
+            m.resolution["grid"].to_string(),
+            m.resolution["breadth-first"].to_string(),
             m.image_equal_to_rss_r.to_string(),
         ]);
     }

@@ -26,7 +26,7 @@ use super::trace::{shade_hit, GenerationStats, Path, RayStats, Render, MAX_DEPTH
 use glam::Vec3;
 use rtbench_engines::breadth_first::spill::SpillDir;
 use rtbench_engines::breadth_first::BreadthFirst;
-use rtbench_engines::store::{BboxReader, GeometryReader, IoCounters, IoFile, ObjectRecord};
+use rtbench_engines::store::{Codec, IoCounters, IoFile, ObjectRecord, SceneReader};
 use rtbench_engines::{Counters, Hit, Ray};
 use std::io;
 use std::path::{Path as FsPath, PathBuf};
@@ -133,18 +133,20 @@ struct Records {
     path: PathBuf,
     len: u64,
     buffer: usize,
+    codec: Codec,
     writer: Option<IoFile>,
     io: IoCounters,
 }
 
 impl Records {
-    fn create(dir: &FsPath, name: &str, buffer: usize) -> io::Result<Records> {
+    fn create(dir: &FsPath, name: &str, buffer: usize, codec: Codec) -> io::Result<Records> {
         let path = dir.join(name);
         Ok(Records {
-            writer: Some(IoFile::create(&path, buffer)?),
+            writer: Some(IoFile::create_codec(&path, buffer, codec)?),
             path,
             len: 0,
             buffer,
+            codec,
             io: IoCounters::default(),
         })
     }
@@ -167,7 +169,7 @@ impl Records {
 
     fn reader(&mut self) -> io::Result<IoFile> {
         self.close()?;
-        IoFile::open(&self.path, self.buffer)
+        IoFile::open_codec(&self.path, self.buffer, self.codec)
     }
 
     fn remove(mut self) -> io::Result<IoCounters> {
@@ -209,10 +211,12 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     let background = h.background.as_vec3();
     let lights = super::trace::scaled_lights(&h.lights);
     let mut io_total = IoCounters::default();
-    let mut bbox = BboxReader::open(&h.dir, h.objects, buffer)?;
-    let mut geometry = GeometryReader::open(&h.dir, buffer)?;
+    // The engine's layout and `lazy`: the basic layout (or `lazy=off`) reads every object up to
+    // the last one hit (Algorithm 3.6), the split one only the objects hit (§4.2.2).
+    let mut scene = SceneReader::open(h, buffer, config.lazy)?;
 
-    let mut rays = Records::create(spill.path(), "rays-1", buffer)?;
+    let codec = config.spill_codec;
+    let mut rays = Records::create(spill.path(), "rays-1", buffer, codec)?;
     for j in 0..w {
         for i in 0..w {
             let path = Path {
@@ -242,7 +246,14 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
         let t0 = Instant::now();
         let groups = n.div_ceil(GROUP as u64) as usize;
         let mut buckets = (0..groups)
-            .map(|b| Records::create(spill.path(), &format!("hits-{generation}-{b}"), HIT_BUFFER))
+            .map(|b| {
+                Records::create(
+                    spill.path(),
+                    &format!("hits-{generation}-{b}"),
+                    HIT_BUFFER,
+                    codec,
+                )
+            })
             .collect::<io::Result<Vec<_>>>()?;
         let mut file = rays.reader()?;
         let (mut error, mut write_error) = (None, None);
@@ -265,8 +276,18 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
 
         // Shading, group by group, in object order; emitted records put back in ray order.
         let t1 = Instant::now();
-        let mut next = Records::create(spill.path(), &format!("rays-{}", generation + 1), buffer)?;
-        let mut shadows = Records::create(spill.path(), &format!("shadows-{generation}"), buffer)?;
+        let mut next = Records::create(
+            spill.path(),
+            &format!("rays-{}", generation + 1),
+            buffer,
+            codec,
+        )?;
+        let mut shadows = Records::create(
+            spill.path(),
+            &format!("shadows-{generation}"),
+            buffer,
+            codec,
+        )?;
         let mut file = rays.reader()?;
         let mut group: Vec<(Ray, Path)> = Vec::with_capacity(GROUP);
         let mut order: Vec<u32> = Vec::with_capacity(GROUP);
@@ -304,23 +325,27 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
                 }
             }
             order.sort_by_key(|&k| (hits[k as usize].object, k));
-            bbox.rewind()?;
-            geometry.rewind()?;
+            scene.rewind()?;
             let mut loaded = u32::MAX;
             out_next.clear();
             out_shadow.clear();
             for &k in &order {
                 let hit = hits[k as usize];
                 if hit.object != loaded {
-                    // Forward through the bounding-box file to the object's geometry offset.
-                    let offset = loop {
-                        match bbox.next_record()? {
-                            Some((id, b)) if id == hit.object => break b.offset,
+                    // Forward through the store to the object (Algorithm 3.6: "while current
+                    // object ID < hit's object ID: read next object").
+                    loop {
+                        match scene.next(&mut record)? {
+                            Some((id, b, read)) if id == hit.object => {
+                                if !read {
+                                    scene.load(&b, &mut record)?;
+                                }
+                                break;
+                            }
                             Some(_) => continue,
                             None => return Err(io::Error::other("hit names no object")),
                         }
-                    };
-                    geometry.read_at(offset, &mut record)?;
+                    }
                     loaded = hit.object;
                 }
                 let (ray, path) = &group[k as usize];
@@ -358,7 +383,8 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
             for (k, (_, path)) in group.iter().enumerate() {
                 corners[path.corner as usize] += term[k];
             }
-            for (_, r, p) in &out_next {
+            // Eye and shadow rays only (`secondary=off`): no next generation.
+            for (_, r, p) in out_next.iter().filter(|_| config.secondary) {
                 next.push(&encode_path(r, p))?;
             }
             for (_, r, corner, gain) in &out_shadow {
@@ -421,8 +447,7 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
         rays = next;
     }
     io_total.add(&rays.remove()?);
-    io_total.add(&bbox.file.io);
-    io_total.add(&geometry.file.io);
+    io_total.add(&scene.io());
     Ok(OutOfCoreRender {
         render: Render {
             size,
