@@ -38,6 +38,7 @@ pub mod config;
 pub mod framebuffer;
 pub mod machine;
 pub mod queueing;
+pub mod radiosity;
 pub mod sim;
 pub mod trace;
 
