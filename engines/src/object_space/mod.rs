@@ -126,6 +126,11 @@ impl ObjectSpace {
         &self.config
     }
 
+    /// The subspace grid's box and resolution.
+    pub fn lattice(&self) -> &dda::Lattice {
+        &self.subspaces.lattice
+    }
+
     /// The PE of every subspace under the configured machine.
     pub fn owner(&self) -> &[u32] {
         &self.owner
