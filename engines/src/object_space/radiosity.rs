@@ -446,11 +446,26 @@ enum Ev {
     Pick(u32),
     /// PE's FRGU sends root `ray` of shot `shot`.
     Emit { pe: u32, shot: u32, ray: u32 },
-    /// Ray `ray` of shot `shot` reaches the RD of the PE owning its segment `seg`.
-    Arrive { shot: u32, ray: u32, seg: u32 },
-    /// …and its RP block is done with it.
-    Done { shot: u32, ray: u32, seg: u32 },
+    /// Ray `ray` of shot `shot` reaches the RD of PE `pe`, owning its segment `seg`.
+    Arrive {
+        shot: u32,
+        ray: u32,
+        seg: u32,
+        pe: u32,
+    },
+    /// …and its RP block is done with it; `next`: the PE of its next segment ([`NONE`]: it
+    /// ended there). Events carry what the next one needs, so that a packet's step touches the
+    /// shot's record once.
+    Done {
+        shot: u32,
+        ray: u32,
+        seg: u32,
+        pe: u32,
+        next: u32,
+    },
 }
+
+const NONE: u32 = u32::MAX;
 
 /// The radiosity pass on `machine` (subspace owners `owner`) until no delta-radiosity ray
 /// remains and no PE has a patch above `threshold`.
@@ -580,15 +595,17 @@ pub fn simulate(
                         shot,
                         ray,
                         seg: r.seg_start,
+                        pe: to,
                     },
                 );
             }
-            Ev::Arrive { shot, ray, seg } => {
+            Ev::Arrive { shot, ray, seg, pe } => {
                 run.events += 1;
                 let sh = &shots[shot as usize].0;
                 let r = sh.rays[ray as usize];
-                let pe = seg_pe(sh, seg) as usize;
                 let is_last = seg + 1 == r.seg_start + r.seg_count;
+                let next = if is_last { NONE } else { seg_pe(sh, seg + 1) };
+                let pe = pe as usize;
                 let tail = if !is_last {
                     (if seg == r.seg_start {
                         costs.dda_init
@@ -613,18 +630,30 @@ pub fn simulate(
                 let end = t.max(blocks[b]) + cost;
                 blocks[b] = end;
                 busy[pe] += cost;
-                push(&mut heap, end, Ev::Done { shot, ray, seg });
+                push(
+                    &mut heap,
+                    end,
+                    Ev::Done {
+                        shot,
+                        ray,
+                        seg,
+                        pe: pe as u32,
+                        next,
+                    },
+                );
             }
-            Ev::Done { shot, ray, seg } => {
-                let (sh, power, pending) = &mut shots[shot as usize];
-                let r = sh.rays[ray as usize];
-                let pe = seg_pe(sh, seg);
-                if seg + 1 < r.seg_start + r.seg_count {
-                    let to = seg_pe(sh, seg + 1);
-                    let at = if to == pe {
+            Ev::Done {
+                shot,
+                ray,
+                seg,
+                pe,
+                next,
+            } => {
+                if next != NONE {
+                    let at = if next == pe {
                         t
                     } else {
-                        send(machine, costs, &mut link_free, pe, to, t, &mut run)
+                        send(machine, costs, &mut link_free, pe, next, t, &mut run)
                     };
                     push(
                         &mut heap,
@@ -633,10 +662,13 @@ pub fn simulate(
                             shot,
                             ray,
                             seg: seg + 1,
+                            pe: next,
                         },
                     );
                     continue;
                 }
+                let (sh, power, pending) = &mut shots[shot as usize];
+                let r = sh.rays[ray as usize];
                 *pending -= 1;
                 match r.end {
                     End::Deposit { patch, gain } => {
@@ -668,6 +700,7 @@ pub fn simulate(
                                     shot,
                                     ray: ray + 1,
                                     seg: child.seg_start,
+                                    pe: to,
                                 },
                             );
                         }
