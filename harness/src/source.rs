@@ -3,7 +3,7 @@
 use crate::error::{input, Result};
 use rtbench_scenes::spd::{self, MountHash, Options, Program};
 use rtbench_scenes::validate::Validating;
-use rtbench_scenes::{nff, Scene, SceneCollector, Sink};
+use rtbench_scenes::{nff, room, Scene, SceneCollector, Sink};
 use std::path::PathBuf;
 
 /// `<program|FILE.nff> [--sf N] [--tessellate [RES]] [--hash …]`, resolved.
@@ -11,6 +11,9 @@ use std::path::PathBuf;
 pub enum Source {
     Program(Program, Options),
     File(PathBuf),
+    /// Seed 003's room stand-in ([`rtbench_scenes::room`]) at this many patches per metre:
+    /// `room` (8) or `roomN`.
+    Room(u32),
 }
 
 impl Source {
@@ -25,6 +28,22 @@ impl Source {
         tessellate: Option<u32>,
         hash: Option<MountHash>,
     ) -> Result<Source> {
+        if let Some(rest) = scene.strip_prefix("room") {
+            let ppm = if rest.is_empty() {
+                Some(room::DEFAULT_PPM)
+            } else {
+                rest.parse::<u32>().ok()
+            };
+            if let Some(ppm) = ppm {
+                if sf.is_some() || tessellate.is_some() || hash.is_some() {
+                    return Err(input(format!(
+                        "{scene}: --sf, --tessellate and --hash apply to SPD programs (room: roomN, N patches per metre)"
+                    )));
+                }
+                room::patch_count(ppm).map_err(|e| input(e.to_string()))?;
+                return Ok(Source::Room(ppm));
+            }
+        }
         if let Ok(program) = scene.parse::<Program>() {
             let mut opts = Options::standard(program);
             if let Some(sf) = sf {
@@ -91,6 +110,12 @@ impl Source {
                     .map_err(|e| input(format!("{}: {e}", self.label())))
             }
             Source::File(path) => Ok(nff::read_nff_file(path, sink)?),
+            Source::Room(ppm) => {
+                let mut v = Validating::new(sink);
+                room::generate(*ppm, &mut v).map_err(|e| input(e.to_string()))?;
+                v.finish()
+                    .map_err(|e| input(format!("{}: {e}", self.label())))
+            }
         }
     }
 
@@ -115,6 +140,7 @@ impl Source {
                 }
                 s
             }
+            Source::Room(ppm) => format!("room{ppm}"),
             Source::File(p) => p
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
@@ -125,14 +151,14 @@ impl Source {
     pub fn program(&self) -> Option<Program> {
         match self {
             Source::Program(p, _) => Some(*p),
-            Source::File(_) => None,
+            Source::File(_) | Source::Room(_) => None,
         }
     }
 
     pub fn size_factor(&self) -> Option<u32> {
         match self {
             Source::Program(_, o) => Some(o.size_factor),
-            Source::File(_) => None,
+            Source::File(_) | Source::Room(_) => None,
         }
     }
 }

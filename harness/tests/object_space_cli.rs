@@ -161,6 +161,36 @@ fn yamauchi_options_are_checked() {
             "grid",
             "option 'engines' does not apply",
         ),
+        (
+            "yamauchi-radiosity",
+            "--set",
+            "threshold=0",
+            "threshold must be above 0",
+        ),
+        (
+            "yamauchi-radiosity",
+            "--set",
+            "threshold=-1",
+            "threshold must be above 0",
+        ),
+        (
+            "yamauchi-radiosity",
+            "--set",
+            "pes=12",
+            "does not divide the 32x32 subspaces",
+        ),
+        (
+            "yamauchi-radiosity",
+            "--set",
+            "room=0",
+            "0 gives a room of 0 patches",
+        ),
+        (
+            "yamauchi-static-lb",
+            "--set",
+            "threshold=0",
+            "threshold must be above 0",
+        ),
         ("nakamaru-3.2", "--fault-ms", "0", "fault-ms '0'"),
         (
             "nakamaru-3.2",

@@ -15,6 +15,7 @@
 
 pub mod model;
 pub mod nff;
+pub mod room;
 pub mod sink;
 pub mod spd;
 pub mod triangulate;

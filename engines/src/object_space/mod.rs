@@ -10,7 +10,8 @@
 //! rays, intensity packets into the frame buffer) is traced by the harness (`rtbench reproduce
 //! yamauchi-*`) with [`ObjectSpace::execute`] and timed with [`sim::simulate`].
 //!
-//! Files: [`config`] (settings, Table 4 costs), [`machine`] (torus, allocations), [`trace`] (what execution records), [`sim`] (the event simulation),
+//! Files: [`config`] (settings, Table 4 costs), [`machine`] (torus, allocations), [`trace`] (what execution records), [`sim`] (the event simulation of the ray-tracing pass),
+//! [`radiosity`] (003's radiosity pass on the machine, and a single-process reference),
 //! [`framebuffer`] (GFB and the cached frame buffer system), [`queueing`] (003's analytic
 //! model of the CFBS and a random-arrival simulation of it). The walk from subspace to subspace
 //! (003 §2.4: "the next subspace is computed with 3DDDA" [Fujimoto et al., ARTS]) is the shared
@@ -38,6 +39,7 @@ pub mod config;
 pub mod framebuffer;
 pub mod machine;
 pub mod queueing;
+pub mod radiosity;
 pub mod sim;
 pub mod trace;
 
@@ -123,6 +125,11 @@ impl ObjectSpace {
 
     pub fn config(&self) -> &ObjectSpaceConfig {
         &self.config
+    }
+
+    /// The subspace grid's box and resolution.
+    pub fn lattice(&self) -> &dda::Lattice {
+        &self.subspaces.lattice
     }
 
     /// The PE of every subspace under the configured machine.

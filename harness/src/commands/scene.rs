@@ -191,6 +191,7 @@ pub fn stats(src: &Source, as_json: bool) -> Result<()> {
     let program = match src {
         Source::Program(p, _) => json!(p.name()),
         Source::File(f) => json!(f.display().to_string()),
+        Source::Room(ppm) => json!(format!("room{ppm}")),
     };
     let v = json!({
         "program": program,

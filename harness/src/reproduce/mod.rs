@@ -53,6 +53,7 @@ registry! {
     yamauchi_static_lb,
     yamauchi_dynamic_lb,
     yamauchi_cfbs,
+    yamauchi_radiosity,
 }
 
 pub fn find(id: &str) -> Result<&'static Table> {

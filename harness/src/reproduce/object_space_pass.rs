@@ -5,6 +5,7 @@
 //! of a pass and of a simulated run, and their plot helpers.
 
 use super::params::{Param, MAX_PES, SCENES, SIZE, THREADS};
+use super::yamauchi_radiosity::{ROOM, THRESHOLD};
 use super::{Ctx, Image};
 use crate::error::{input, Result};
 use crate::source::Source;
@@ -12,6 +13,7 @@ use crate::workload::{self, pass_003};
 use rayon::prelude::*;
 use rtbench_engines::object_space::config::{Costs, FrameBuffer, ObjectSpaceConfig};
 use rtbench_engines::object_space::machine::{Allocation, Machine};
+use rtbench_engines::object_space::radiosity::{self, Patches};
 use rtbench_engines::object_space::sim::{simulate, SimResult};
 use rtbench_engines::object_space::ObjectSpace;
 use rtbench_reports::plot::{LegendAt, Panel, Point, Series, XyPanel};
@@ -19,23 +21,43 @@ use serde::Serialize;
 use std::time::Instant;
 
 /// The options every `yamauchi-*` table takes.
-pub const PARAMS: &[Param] = &[THREADS, SIZE, MAX_PES, SCENES];
+pub const PARAMS: &[Param] = &[THREADS, SIZE, MAX_PES, SCENES, ROOM, THRESHOLD];
 
-/// One scene, executed once: the engine (its subspaces and primitives) and 003's pass on it.
+/// The radiosity pass of a scene with emitting patches (the room): its patches and threshold.
+/// Its shots are executed as each simulated machine makes them ([`radiosity::simulate`]).
+pub struct RadiosityPass {
+    pub patches: Patches,
+    pub threshold: f32,
+}
+
+/// One scene and one of 003's passes on it: the engine (its subspaces and primitives) and, for the
+/// ray-tracing pass, the pass executed once; for the radiosity pass, its patches (`pass` then holds
+/// no rays).
 pub struct Traced {
     pub label: String,
     pub os: ObjectSpace,
     pub pass: pass_003::Pass,
     pub trace_s: f64,
+    pub radiosity: Option<RadiosityPass>,
 }
 
 impl Traced {
-    /// The pass's image, as `images/<scene>-yamauchi.png`.
-    pub fn image(&self) -> Image {
-        Image {
+    /// The ray-tracing pass's image, as `images/<scene>-yamauchi.png` (none for the radiosity
+    /// pass).
+    pub fn image(&self) -> Option<Image> {
+        self.radiosity.is_none().then(|| Image {
             path: self.image_path(),
             pixels: self.pass.pixels(),
             size: self.pass.size,
+        })
+    }
+
+    /// "radiosity" or "ray tracing".
+    pub fn pass_name(&self) -> &'static str {
+        if self.radiosity.is_some() {
+            "radiosity"
+        } else {
+            "ray tracing"
         }
     }
     fn image_path(&self) -> String {
@@ -44,6 +66,8 @@ impl Traced {
     pub fn record(&self) -> PassRecord {
         PassRecord {
             scene: self.label.clone(),
+            pass: self.pass_name(),
+            threshold: self.radiosity.as_ref().map(|r| r.threshold),
             size: self.pass.size,
             primary: self.pass.primary,
             secondary: self.pass.secondary,
@@ -60,6 +84,9 @@ impl Traced {
 #[derive(Serialize)]
 pub struct PassRecord {
     pub scene: String,
+    pub pass: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<f32>,
     pub size: u32,
     pub primary: u64,
     pub secondary: u64,
@@ -131,8 +158,11 @@ pub fn scenes(ctx: &Ctx, default: &[&str]) -> Result<Vec<String>> {
 }
 
 /// The load-balancing tables' shared setting: image size, largest PE count (256 with `--quick`,
-/// else 1,024) and the SPD scenes (tetra with `--quick`, else balls, rings, tetra), each traced with
-/// 003's pass at default costs. A `max-pes` below `min_pes` is refused before anything is traced.
+/// else 1,024), the room with both passes (003's setting: `room` patches per metre, 2 with
+/// `--quick`, else 8; radiosity `threshold`), then the SPD scenes as a second set (tetra with
+/// `--quick`, else balls, rings, tetra; ray-tracing pass only: they have no emitters), each traced
+/// with 003's pass at default costs. `scenes` replaces the default list (`room`/`roomN` or SPD
+/// names). A `max-pes` below `min_pes` is refused before anything is traced.
 pub fn load_balancing_setting(ctx: &Ctx, min_pes: u32) -> Result<(u32, u32, Vec<Traced>)> {
     let size = size(ctx)?;
     let max_pes = max_pes(ctx, if ctx.quick { 256 } else { 1024 })?;
@@ -142,18 +172,40 @@ pub fn load_balancing_setting(ctx: &Ctx, min_pes: u32) -> Result<(u32, u32, Vec<
             ctx.id
         )));
     }
-    let default: &[&str] = if ctx.quick {
-        &["tetra"]
+    let ppm = ctx
+        .params
+        .number::<u32>(ROOM.key, 0)?
+        .unwrap_or(if ctx.quick { 2 } else { 8 });
+    let threshold = super::yamauchi_radiosity::threshold(ctx)?;
+    let room = format!("room{ppm}");
+    let default: Vec<&str> = if ctx.quick {
+        vec![&room, "tetra"]
     } else {
-        &["balls", "rings", "tetra"]
+        vec![&room, "balls", "rings", "tetra"]
     };
-    let traced = trace_scenes(&scenes(ctx, default)?, size, Costs::default())?;
+    let names = match ctx.params.list(SCENES.key)? {
+        Some(v) => v,
+        None => default.iter().map(|s| s.to_string()).collect(),
+    };
+    for n in &names {
+        if !n.starts_with("room") && n.parse::<rtbench_scenes::spd::Program>().is_err() {
+            return Err(input(format!("{}: unknown scene '{n}'", ctx.id)));
+        }
+    }
+    let traced = trace_scenes(&names, size, Costs::default(), Some(threshold))?;
     Ok((size, max_pes, traced))
 }
 
 /// Builds the engine on each scene (with the given unit costs: the per-test clocks enter the
 /// record) and traces 003's pass at `size`².
-pub fn trace_scenes(scenes: &[String], size: u32, costs: Costs) -> Result<Vec<Traced>> {
+/// A scene of the room also gets its radiosity pass (first) when `radiosity` (the threshold) is
+/// given.
+pub fn trace_scenes(
+    scenes: &[String],
+    size: u32,
+    costs: Costs,
+    radiosity: Option<f32>,
+) -> Result<Vec<Traced>> {
     let mut v = Vec::new();
     for s in scenes {
         let src = Source::resolve(s, None, None, None)?;
@@ -163,16 +215,32 @@ pub fn trace_scenes(scenes: &[String], size: u32, costs: Costs) -> Result<Vec<Tr
             costs,
             ..ObjectSpaceConfig::default()
         };
-        let os = ObjectSpace::build(&prepared.input, config).map_err(|e| input(e.to_string()))?;
+        let os = ObjectSpace::build(&prepared.input, config.clone())
+            .map_err(|e| input(e.to_string()))?;
+        if let (Some(threshold), Source::Room(_)) = (radiosity, &src) {
+            let scene = &prepared.input.scene;
+            let em = rtbench_scenes::room::emission(&scene.materials);
+            let patches = Patches::from_scene(scene, &prepared.input.geometry.prim_object, &em)
+                .map_err(|e| input(format!("{label}: {e}")))?;
+            v.push(Traced {
+                label: format!("{label}-radiosity"),
+                os: ObjectSpace::build(&prepared.input, config)
+                    .map_err(|e| input(e.to_string()))?,
+                pass: pass_003::Pass::empty(size),
+                trace_s: 0.0,
+                radiosity: Some(RadiosityPass { patches, threshold }),
+            });
+        }
         eprintln!("{label}: tracing 003's pass at {size}x{size} …");
         let t = Instant::now();
-        let pass = pass_003::trace_pass(&os, &prepared.input.scene, size);
+        let pass = pass_003::trace_pass(&os, &prepared.input.scene, size, None);
         let trace_s = t.elapsed().as_secs_f64();
         v.push(Traced {
             label,
             os,
             pass,
             trace_s,
+            radiosity: None,
         });
     }
     Ok(v)
@@ -199,14 +267,25 @@ pub fn machine(pes: u32, dims: u8, allocation: Allocation, rp_blocks: u32) -> Ma
     }
 }
 
-/// Simulates each machine on `t` (in parallel over machines) with the given frame buffer:
-/// each run's result and its wall time.
+/// Simulates each machine on `t` (in parallel over machines) with the given frame buffer (the
+/// radiosity pass sends no intensity packets): each run's result and its wall time.
 pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f64)> {
     let s = t.os.config().subspaces;
     machines
         .par_iter()
         .map(|(m, fb)| {
             let start = Instant::now();
+            if let Some(rad) = &t.radiosity {
+                let r = radiosity::simulate(
+                    &t.os,
+                    &rad.patches,
+                    m,
+                    &m.owner_map(s),
+                    &t.os.config().costs,
+                    rad.threshold,
+                );
+                return (as_sim(&r), start.elapsed().as_secs_f64());
+            }
             let r = simulate(
                 &t.pass.trace,
                 m,
@@ -218,6 +297,22 @@ pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResul
             (r, start.elapsed().as_secs_f64())
         })
         .collect()
+}
+
+/// A radiosity run as a simulated run (no frame buffer).
+pub fn as_sim(r: &radiosity::RadiosityRun) -> SimResult {
+    SimResult {
+        clocks: r.clocks,
+        pe_clocks: r.clocks,
+        busy: r.busy,
+        busy_max_pe: r.busy_max_pe,
+        pes: r.pes,
+        rp_blocks: r.rp_blocks,
+        events: r.events,
+        packets: r.packets,
+        hops: r.hops,
+        ..Default::default()
+    }
 }
 
 /// The powers of two up to `max` (at most 4096).
@@ -294,6 +389,8 @@ pub mod tests {
     pub fn pass(scene: &str) -> PassRecord {
         PassRecord {
             scene: scene.into(),
+            pass: "ray tracing",
+            threshold: None,
             size: 8,
             primary: 64,
             secondary: 0,

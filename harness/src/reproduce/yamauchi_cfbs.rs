@@ -359,7 +359,7 @@ fn pmcr_rows(s: &Setup) -> Result<Vec<PmcrRow>> {
     let (pp, pm) = *s.configs.last().unwrap_or(&(256, 16));
     let mut rows = Vec::new();
     for &pmcr in &s.pmcrs {
-        let traced = osp::trace_scenes(&s.scenes[..1.min(s.scenes.len())], s.size, faster(pmcr))?;
+        let traced = osp::trace_scenes(&s.scenes[..1.min(s.scenes.len())], s.size, faster(pmcr), None)?;
         let Some(t) = traced.first() else { break };
         let m = osp::machine(pp, 2, Allocation::Skewed, s.r_pmcr);
         let res = osp::run_all(
@@ -389,7 +389,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let pool = workload::pool(ctx.params.threads()?)?;
     let model = model_rows(&p);
     let (points, knees) = pool.install(|| curve(s.packets));
-    let traced = osp::trace_scenes(&s.scenes, s.size, Costs::default())?;
+    let traced = osp::trace_scenes(&s.scenes, s.size, Costs::default(), None)?;
     let exec: Vec<ExecRun> = traced
         .iter()
         .flat_map(|t| pool.install(|| execution_driven(t, &s)))
@@ -414,7 +414,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let doc = document(ctx, &p, &result, &s);
     let mut out = Output::new(&result, rows, doc);
     out.charts = vec![chart(ctx.id, &result.model_vs_simulation)];
-    out.images = traced.iter().map(Traced::image).collect();
+    out.images = traced.iter().filter_map(Traced::image).collect();
     Ok(out)
 }
 

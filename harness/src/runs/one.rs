@@ -94,7 +94,7 @@ fn plant(
 ) -> Box<dyn rtbench_engines::Engine> {
     let program = match &spec.source {
         Source::Program(p, _) => Some(p.name()),
-        Source::File(_) => None,
+        Source::File(_) | Source::Room(_) => None,
     };
     match crate::nightly::plant::from_env(&spec.engine, program) {
         Some(p) => Box::new(crate::nightly::plant::Planted::new(engine, p)),
@@ -184,7 +184,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             Some(o.size_factor),
             o.tessellate,
         ),
-        Source::File(_) => (None, None, None),
+        Source::File(_) | Source::Room(_) => (None, None, None),
     };
     let pixels = render.pixels();
     use sha2::Digest;

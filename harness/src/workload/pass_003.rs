@@ -4,9 +4,12 @@
 //! into the frame buffer. Nothing flows back along the ray tree: a secondary ray carries its
 //! weight (the product of the reflection coefficients on its way) as its history.
 //!
-//! 003 takes the diffuse term from its radiosity pass; there is none here, so the intensity of
-//! a hit is the NFF ambient and unshadowed diffuse and specular terms, which is what a packet
-//! carries and what the image shows (an image of its own, not the SPD's).
+//! 003 takes the diffuse term G from its radiosity pass: given a radiosity solution (per scene
+//! object, `diffuse`), a hit's intensity is the patch's radiosity (times the image's exposure),
+//! and specular elements add only what their reflections bring (I = G + k_s S). Without one (the
+//! SPD scenes, which have no emitters), the intensity of a hit is the NFF ambient and unshadowed
+//! diffuse and specular terms, which is what a packet carries and what the image shows (an
+//! image of its own, not the SPD's).
 //!
 //! The rays are executed on the engine for real, generation by generation (in parallel, in
 //! fixed chunks, so the record is the same on any number of threads), and recorded as a
@@ -43,6 +46,19 @@ pub struct Pass {
 }
 
 impl Pass {
+    /// A pass of no rays (stands for the radiosity pass, which has no fixed record).
+    pub fn empty(size: u32) -> Pass {
+        Pass {
+            size,
+            trace: Trace::default(),
+            image: Vec::new(),
+            primary: 0,
+            secondary: 0,
+            intensity_packets: 0,
+            counters: Counters::default(),
+        }
+    }
+
     /// 8-bit RGB.
     pub fn pixels(&self) -> Vec<u8> {
         self.image
@@ -61,7 +77,7 @@ struct Path {
     inside: bool,
 }
 
-pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32) -> Pass {
+pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32, diffuse: Option<&[Vec3]>) -> Pass {
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
     let lights = super::trace::scaled_lights(&scene.lights);
@@ -129,6 +145,7 @@ pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32) -> Pass {
                         &surfaces,
                         scene,
                         &lights,
+                        diffuse,
                         &ray,
                         &hit,
                         &path,
@@ -157,6 +174,7 @@ fn shade(
     surfaces: &Surfaces,
     scene: &Scene,
     lights: &[(Vec3, Vec3)],
+    diffuse: Option<&[Vec3]>,
     ray: &Ray,
     hit: &Hit,
     path: &Path,
@@ -177,7 +195,10 @@ fn shade(
         ns = ng;
     }
     let mut intensity = color * 0.1;
-    for (lp, lc) in lights {
+    if let Some(g) = diffuse {
+        intensity = g[hit.object as usize];
+    }
+    for (lp, lc) in lights.iter().filter(|_| diffuse.is_none()) {
         let l = (*lp - p).normalize_or_zero();
         let cos = ns.dot(l);
         if cos <= 0.0 {
