@@ -9,6 +9,7 @@
 //! t, or a primitive id out of range, fails the run (`Engine::failure`) instead of reaching the
 //! results. A plugin that crashes takes its run's child process with it, nothing else.
 
+pub mod export;
 pub mod tess;
 
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
@@ -101,7 +102,11 @@ pub fn resolve(spec: &str) -> Result<PathBuf, String> {
         };
     }
     let dir = plugin_dir();
-    for cand in [spec.to_string(), format!("lib{spec}.so"), format!("{spec}.so")] {
+    for cand in [
+        spec.to_string(),
+        format!("lib{spec}.so"),
+        format!("{spec}.so"),
+    ] {
         let c = dir.join(&cand);
         if c.is_file() {
             return Ok(c);
@@ -365,7 +370,10 @@ fn build(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineE
     let a = arrays(input, kinds, res);
     let n_prims = a.tri_object.len() + a.sphere_object.len() + a.cone_object.len();
     if n_prims >= MISS as usize {
-        return Err(err(&spec, format!("{n_prims} primitives: more than ids hold")));
+        return Err(err(
+            &spec,
+            format!("{n_prims} primitives: more than ids hold"),
+        ));
     }
     let ckeys: Vec<CString> = rest
         .iter()
@@ -400,7 +408,8 @@ fn build(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineE
     let mut msg = vec![0 as c_char; 512];
     let start = Instant::now();
     // SAFETY: `scene` and its arrays live across the call; msg has msg.len() bytes.
-    let engine = unsafe { (t.build.expect("checked in open"))(&scene, msg.as_mut_ptr(), msg.len()) };
+    let engine =
+        unsafe { (t.build.expect("checked in open"))(&scene, msg.as_mut_ptr(), msg.len()) };
     let build_s = start.elapsed().as_secs_f64();
     if engine.is_null() {
         msg[511] = 0;
@@ -472,10 +481,7 @@ impl PluginEngine {
     }
 
     fn failed(&self) -> bool {
-        self.failure
-            .lock()
-            .map(|f| f.is_some())
-            .unwrap_or(true)
+        self.failure.lock().map(|f| f.is_some()).unwrap_or(true)
     }
 
     fn add_counters(&self, raw: &[u64], c: &mut Counters) {

@@ -49,7 +49,12 @@ pub fn sphere(center: Vec3, radius: f32, res: u32, out: &mut Vec<[Vec3; 3]>) -> 
         let theta = PI * i as f32 / bands as f32;
         let phi = 2.0 * PI * (j % sectors) as f32 / sectors as f32;
         center
-            + radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+            + radius
+                * Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                )
     };
     let r = radius as f64;
     let mut err = 0.0f64;
