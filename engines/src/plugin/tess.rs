@@ -149,7 +149,7 @@ mod tests {
         let mut out = Vec::new();
         let e = cone(Vec3::ZERO, 1.0, Vec3::Y, 0.5, 4, &mut out);
         assert_eq!(out.len(), 16);
-        assert!((e.max_abs - (1.0 - (PI as f64 / 8.0).cos())).abs() < 1e-9);
+        assert!((e.max_abs - (1.0 - (std::f64::consts::PI / 8.0).cos())).abs() < 1e-9);
         let mut pointed = Vec::new();
         cone(Vec3::ZERO, 1.0, Vec3::Y, 0.0, 4, &mut pointed);
         assert_eq!(pointed.len(), 8);
