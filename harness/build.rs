@@ -14,6 +14,10 @@ fn output(cmd: &str, args: &[&str]) -> Option<String> {
 }
 
 fn main() {
+    // The target triple, for the tests that compile the example C plugin with the `cc` crate.
+    if let Ok(t) = std::env::var("TARGET") {
+        println!("cargo:rustc-env=RTBENCH_BUILD_TARGET={t}");
+    }
     println!("cargo:rerun-if-env-changed=DEP_RTBENCH_EMBREE_LIB_DIR");
     if let Ok(dir) = std::env::var("DEP_RTBENCH_EMBREE_LIB_DIR") {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");

@@ -122,3 +122,56 @@ EOF
     embree_ok || die "Embree was unpacked into $LIB_DIR but is incomplete"
     say "Embree 4 ready in .embree/lib ($(basename "$embree"))"
 fi
+
+# --- Meshes for the examples and docs (issue 21) -----------------------------------------------------------------
+# Real meshes from Debian packages, into .meshes/ (git-ignored, never committed):
+#   bunny.ply            the Stanford bunny (75,408 triangles, a range scan), from libcgal-demo's
+#                        data/meshes/bunny00.off, converted to ASCII PLY here
+#   wuson.obj            assimp-testmodels' models/OBJ/WusonOBJ.obj
+#   2CylinderEngine.glb  assimp-testmodels' models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+# A failure here is a warning: rtbench builds and tests without them.
+MESH_DIR="$ROOT/.meshes"
+SUDO="${SUDO:-}"
+meshes_ok() { [ -s "$MESH_DIR/bunny.ply" ] && [ -s "$MESH_DIR/wuson.obj" ] && [ -s "$MESH_DIR/2CylinderEngine.glb" ]; }
+fetch_meshes() {
+    command -v apt-get >/dev/null && command -v dpkg-deb >/dev/null || { echo "apt-get/dpkg-deb not available"; return 1; }
+    local t
+    t="$(mktemp -d)"
+    # apt-get download runs as the _apt user when it can: give it a folder it may write.
+    chmod 777 "$t"
+    ( cd "$t" && { apt-get download -qq libcgal-demo assimp-testmodels 2>/dev/null \
+        || { $SUDO apt-get update -qq && apt-get download -qq libcgal-demo assimp-testmodels; }; } ) || return 1
+    dpkg-deb -x "$t"/libcgal-demo_*.deb "$t/cgal" && dpkg-deb -x "$t"/assimp-testmodels_*.deb "$t/assimp" || return 1
+    tar -xzf "$t/cgal/usr/share/doc/libcgal-dev/data.tar.gz" -C "$t" data/meshes/bunny00.off || return 1
+    mkdir -p "$MESH_DIR"
+    python3 - "$t/data/meshes/bunny00.off" "$MESH_DIR/bunny.ply" <<'PY' || return 1
+import sys
+words = open(sys.argv[1]).read().split()
+assert words[0] == "OFF", "not an OFF file"
+nv, nf = int(words[1]), int(words[2])
+v = words[4:4 + 3 * nv]
+rest = words[4 + 3 * nv:]
+faces, i = [], 0
+for _ in range(nf):
+    k = int(rest[i]); faces.append(rest[i + 1:i + 1 + k]); i += 1 + k
+with open(sys.argv[2], "w") as out:
+    out.write("ply\nformat ascii 1.0\ncomment Stanford bunny (bunny00.off of CGAL's data)\n")
+    out.write(f"element vertex {nv}\nproperty float x\nproperty float y\nproperty float z\n")
+    out.write(f"element face {nf}\nproperty list uchar int vertex_indices\nend_header\n")
+    for j in range(nv):
+        out.write(" ".join(v[3 * j:3 * j + 3]) + "\n")
+    for f in faces:
+        out.write(f"{len(f)} " + " ".join(f) + "\n")
+PY
+    cp "$t/assimp/usr/share/assimp/models/OBJ/WusonOBJ.obj" "$MESH_DIR/wuson.obj" || return 1
+    cp "$t/assimp/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb" "$MESH_DIR/" || return 1
+    rm -rf "$t"
+}
+if ! meshes_ok; then
+    say "fetching example meshes into .meshes/ (Debian packages libcgal-demo, assimp-testmodels)"
+    if fetch_meshes && meshes_ok; then
+        say "meshes ready in .meshes/"
+    else
+        say "warning: could not fetch the example meshes; rtbench works without them"
+    fi
+fi

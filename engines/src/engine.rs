@@ -169,6 +169,12 @@ impl Settings {
         }
     }
 
+    /// The pairs no `get` asked for, in order: for an engine that hands unknown keys on (a
+    /// plugin passes them to its library, which rejects what it does not know).
+    pub fn into_rest(self) -> Vec<(String, String)> {
+        self.pairs
+    }
+
     /// Fails on the first key no `get` asked for.
     pub fn finish(self) -> Result<(), EngineError> {
         match self.pairs.into_iter().next() {

@@ -22,6 +22,7 @@ pub mod geometry;
 pub mod grid;
 pub mod object_space;
 pub mod obvhs_engine;
+pub mod plugin;
 pub mod ray;
 pub mod reference;
 pub mod store;
@@ -43,6 +44,7 @@ pub fn registry() -> Vec<EngineInfo> {
         bvh::info8(),
         obvhs_engine::info(),
         object_space::info(),
+        plugin::info(),
     ];
     if testing::enabled() {
         v.extend(test_infos());

@@ -8,15 +8,16 @@ use crate::error::{input, Result};
 pub type Entry = (String, Vec<(String, String)>);
 
 /// Parses an engine list: `all` (or no list) is every engine available here but `reference` (brute
-/// force: hours on the standard scenes) and the test-only ones; otherwise comma-separated entries,
-/// each a registered engine that can run here, with optional `:key=value` settings.
+/// force: hours on the standard scenes), `plugin` and the test-only ones; otherwise comma-separated
+/// entries, each a registered engine that can run here, with optional `:key=value` settings.
+/// `plugin:PATH[:key=value…]` is the engine `plugin` with the setting `path=PATH` first.
 pub fn engines(list: Option<&str>, flag: &str) -> Result<Vec<Entry>> {
     let registry = rtbench_engines::registry();
     let list = list.map(str::trim).filter(|l| *l != "all");
     let Some(list) = list else {
         return Ok(registry
             .iter()
-            .filter(|e| e.name != "reference" && !e.name.starts_with("test-"))
+            .filter(|e| e.name != "reference" && e.name != "plugin" && !e.name.starts_with("test-"))
             .filter(|e| (e.available)().is_ok())
             .map(|e| (e.name.to_string(), Vec::new()))
             .collect());
@@ -25,6 +26,19 @@ pub fn engines(list: Option<&str>, flag: &str) -> Result<Vec<Entry>> {
     for entry in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let mut parts = entry.split(':');
         let name = parts.next().unwrap_or_default().trim();
+        let mut settings = Vec::new();
+        if name == "plugin" {
+            // plugin:PATH[:key=value…]: the library, checked to exist here (its ABI is checked
+            // when the run builds it, so a bad plugin fails its runs, not the whole command).
+            let spec = parts.next().map(str::trim).unwrap_or_default();
+            if spec.is_empty() || spec.contains('=') {
+                return Err(input(format!(
+                    "{flag} '{entry}': expected plugin:PATH[:key=value…]"
+                )));
+            }
+            rtbench_engines::plugin::resolve(spec).map_err(|e| input(format!("{flag}: {e}")))?;
+            settings.push(("path".to_string(), spec.to_string()));
+        }
         let info = registry.iter().find(|e| e.name == name).ok_or_else(|| {
             let known: Vec<&str> = registry.iter().map(|e| e.name).collect();
             input(format!(
@@ -34,7 +48,6 @@ pub fn engines(list: Option<&str>, flag: &str) -> Result<Vec<Entry>> {
         })?;
         (info.available)()
             .map_err(|r| input(format!("{flag}: engine '{name}' is not available: {r}")))?;
-        let mut settings = Vec::new();
         for kv in parts {
             let (k, v) = kv
                 .split_once('=')

@@ -1,4 +1,5 @@
-//! Where a command's scene comes from: an SPD program at a size factor, or an NFF file.
+//! Where a command's scene comes from: an SPD program at a size factor, an NFF file, or a mesh
+//! file (OBJ, PLY, glTF: `rtbench_scenes::mesh`, with a default camera, light and material).
 
 use crate::error::{input, Result};
 use rtbench_scenes::spd::{self, MountHash, Options, Program};
@@ -65,7 +66,7 @@ impl Source {
         if !scene.ends_with(".nff") && !path.exists() {
             // Neither a program nor a file: say both.
             let msg = format!(
-                "{}; nor is '{scene}' an NFF file",
+                "{}; nor is '{scene}' an NFF, OBJ, PLY or glTF file",
                 scene.parse::<Program>().unwrap_err()
             );
             return Err(input(nff::read::shown_upto(&msg, 400)));
@@ -106,6 +107,14 @@ impl Source {
                 // Generated scenes pass the same checks as files (rtbench_scenes::validate).
                 let mut v = Validating::new(sink);
                 spd::generate(*p, o, &mut v)?;
+                v.finish()
+                    .map_err(|e| input(format!("{}: {e}", self.label())))
+            }
+            Source::File(path) if rtbench_scenes::mesh::Format::of(path).is_some() => {
+                // OBJ, PLY, glTF: checked like every other scene.
+                let mut v = Validating::new(sink);
+                rtbench_scenes::mesh::stream_mesh(path, &mut v)
+                    .map_err(|e| input(e.to_string()))?;
                 v.finish()
                     .map_err(|e| input(format!("{}: {e}", self.label())))
             }

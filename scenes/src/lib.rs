@@ -13,6 +13,7 @@
 //! assert_eq!(counter.counts.polygon, 4096);
 //! ```
 
+pub mod mesh;
 pub mod model;
 pub mod nff;
 pub mod room;

@@ -297,10 +297,25 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
             Some(c) => format!("exit status {c}"),
             None => {
                 use std::os::unix::process::ExitStatusExt;
-                format!("killed by signal {}", status.signal().unwrap_or(0))
+                let sig = status.signal().unwrap_or(0);
+                let name = match sig {
+                    4 => " (SIGILL)",
+                    6 => " (SIGABRT)",
+                    7 => " (SIGBUS)",
+                    8 => " (SIGFPE)",
+                    9 => " (SIGKILL)",
+                    11 => " (SIGSEGV)",
+                    _ => "",
+                };
+                format!("killed by signal {sig}{name}")
             }
         };
-        failed(job, common, format!("{how}: {line}"), wall_s)
+        let reason = if line.is_empty() {
+            how
+        } else {
+            format!("{how}: {line}")
+        };
+        failed(job, common, reason, wall_s)
     }
 }
 

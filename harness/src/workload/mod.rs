@@ -72,8 +72,17 @@ pub fn build(
     input: &BuildInput,
     settings: Vec<(String, String)>,
 ) -> Result<(Box<dyn Engine>, f64)> {
+    // `--engine plugin:PATH[:key=value…]` (render, check): the same entry as in `--engines`.
+    let (name, settings) = if name.starts_with("plugin:") {
+        let mut e = crate::select::engines(Some(name), "--engine")?;
+        let (n, mut s) = e.remove(0);
+        s.extend(settings);
+        (n, s)
+    } else {
+        (name.to_string(), settings)
+    };
     let t = Instant::now();
-    let e = build_engine(name, input, settings)?;
+    let e = build_engine(&name, input, settings)?;
     Ok((e, t.elapsed().as_secs_f64()))
 }
 
