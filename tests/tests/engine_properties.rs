@@ -12,7 +12,8 @@ use std::sync::Arc;
 fn engines() -> Vec<&'static str> {
     registry()
         .into_iter()
-        .filter(|e| (e.available)().is_ok() && !e.name.starts_with("test-"))
+        // `plugin` is built from a library named after it (`plugin:PATH`); its examples have their own tests.
+        .filter(|e| (e.available)().is_ok() && !e.name.starts_with("test-") && e.name != "plugin")
         .map(|e| e.name)
         .collect()
 }
