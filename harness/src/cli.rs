@@ -49,6 +49,10 @@ pub enum Command {
     /// The nightly history: list, show, export (CSV, Bencher Metric Format), dashboard.
     #[command(subcommand)]
     History(HistoryCommand),
+    /// Join the results of a plan's shards (`--shard K/N`, `render --tile K/N`) into one set.
+    Merge(MergeArgs),
+    /// A plan's jobs, groups and shards, without running them (for cluster job arrays).
+    Plan(PlanCmdArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -56,9 +60,9 @@ pub struct NightlyArgs {
     /// The suite file (TOML; the default suite is suites/nightly.toml).
     #[arg(long)]
     pub suite: PathBuf,
-    /// The history (SQLite; created if missing).
+    /// The history (SQLite; created if missing). Required but with --shard.
     #[arg(long)]
-    pub db: PathBuf,
+    pub db: Option<PathBuf>,
     /// Also write the runs (results.jsonl), the Markdown summary (nightly.md) and the dashboard here.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -71,6 +75,15 @@ pub struct NightlyArgs {
     /// Skip the suite's criterion benchmarks this time.
     #[arg(long)]
     pub skip_criterion: bool,
+    /// Measure only the K-th of N slices of the suite (whole scenes; criterion in shard 1) into
+    /// --out DIR, without the history; `rtbench merge` joins the shards and
+    /// `rtbench nightly --from MERGED --db F` compares and records them as one night.
+    #[arg(long, value_name = "K/N", conflicts_with_all = ["db", "from"])]
+    pub shard: Option<String>,
+    /// Compare and record a night measured by shards and merged (`rtbench merge`), instead of
+    /// measuring here.
+    #[arg(long, value_name = "DIR")]
+    pub from: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }
@@ -171,6 +184,11 @@ pub struct PlanArgs {
     pub resume: bool,
     #[arg(long)]
     pub out: PathBuf,
+    /// Run only the K-th of N deterministic slices of the plan (a scene's Embree run stays with the
+    /// engines compared with it; a sweep's scene stays whole); `rtbench merge` joins the N results
+    /// directories. For cluster job arrays (scripts/slurm/).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -383,6 +401,46 @@ pub struct RenderArgs {
     pub png: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
+    /// Trace only the K-th of N tile sets (bands of pixel-corner rows) of a scene store's image,
+    /// into --out DIR; `rtbench merge` joins the N tiles (scripts/slurm/).
+    #[arg(long, value_name = "K/N", requires = "out")]
+    pub tile: Option<String>,
+    /// The tile's directory (with --tile).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The shards' results directories (every K of one K/N, once each).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// The merged results set (a new or empty directory).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct PlanCmdArgs {
+    /// How many shards the plan would be split into (default: one per group).
+    #[arg(long)]
+    pub shards: Option<u32>,
+    #[arg(long)]
+    pub json: bool,
+    #[command(subcommand)]
+    pub what: PlanWhat,
+}
+
+#[derive(Subcommand, Debug, Clone)]
+pub enum PlanWhat {
+    /// The plan of `rtbench run` with these arguments.
+    Run(RunArgs),
+    /// The plan of `rtbench sweep` with these arguments.
+    Sweep(SweepArgs),
+    /// The plan of `rtbench nightly` with this suite.
+    Nightly(NightlyArgs),
 }
 
 #[derive(Args, Debug, Clone)]

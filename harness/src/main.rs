@@ -70,6 +70,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Compare(a) => commands::runs::compare(&a),
         Command::Nightly(a) => nightly::run(&a),
         Command::History(c) => nightly::history_cmd(&c),
+        Command::Merge(a) => commands::merge::run(&a),
+        Command::Plan(a) => commands::plan::run(&a),
         Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),
         Command::Reproduce(a) => {
             let out = a

@@ -171,6 +171,10 @@ pub struct RunRecord {
     /// Wall seconds of the whole child process.
     pub wall_s: f64,
     pub finished_at: String,
+    /// The machine (host name) the run was measured on, set by `rtbench merge` when shards run on
+    /// several machines: a run and its Embree anchor always share one. `None` in unsharded results.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
 }
 
 impl RunRecord {

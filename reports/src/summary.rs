@@ -46,6 +46,9 @@ pub struct Row {
     pub structure_bytes: u64,
     pub peak_rss_bytes: u64,
     pub check: Option<CheckResult>,
+    /// The machine the run (and so its ratio to Embree) was measured on, in merged shard results.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
 }
 
 /// A run that did not finish, and why.
@@ -137,6 +140,7 @@ impl Summary {
                 structure_bytes: r.structure_bytes,
                 peak_rss_bytes: r.peak_rss_bytes,
                 check: r.check.clone(),
+                machine: r.machine.clone(),
             })
             .collect();
         rows.sort_by(|a, b| {

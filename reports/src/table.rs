@@ -20,20 +20,42 @@ const HEADER: [(&str, bool); 11] = [
 ];
 
 /// One table per thread count: scene × engine.
+/// In results merged from shards run on more than one machine, a last column names the machine
+/// each row (and its ratio to Embree, always measured on the same machine) comes from.
 pub fn run_tables(summary: &Summary) -> Vec<Table> {
+    let machines: std::collections::BTreeSet<&str> = summary
+        .rows
+        .iter()
+        .filter_map(|r| r.machine.as_deref())
+        .collect();
+    let with_machine = machines.len() > 1;
     summary
         .thread_counts()
         .into_iter()
-        .map(|threads| Table {
-            caption: format!("{threads} thread{}", if threads == 1 { "" } else { "s" }),
-            header: HEADER.iter().map(|h| h.0.to_string()).collect(),
-            numeric: HEADER.iter().map(|h| h.1).collect(),
-            rows: summary
-                .rows
-                .iter()
-                .filter(|r| r.threads == threads)
-                .map(cells)
-                .collect(),
+        .map(|threads| {
+            let mut header: Vec<String> = HEADER.iter().map(|h| h.0.to_string()).collect();
+            let mut numeric: Vec<bool> = HEADER.iter().map(|h| h.1).collect();
+            if with_machine {
+                header.push("machine".to_string());
+                numeric.push(false);
+            }
+            Table {
+                caption: format!("{threads} thread{}", if threads == 1 { "" } else { "s" }),
+                header,
+                numeric,
+                rows: summary
+                    .rows
+                    .iter()
+                    .filter(|r| r.threads == threads)
+                    .map(|r| {
+                        let mut c = cells(r);
+                        if with_machine {
+                            c.push(r.machine.clone().unwrap_or_else(|| "–".to_string()));
+                        }
+                        c
+                    })
+                    .collect(),
+            }
         })
         .collect()
 }

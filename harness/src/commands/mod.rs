@@ -2,6 +2,8 @@
 
 pub mod check;
 pub mod engines;
+pub mod merge;
+pub mod plan;
 pub mod render;
 pub mod runs;
 pub mod scene;

@@ -3,6 +3,7 @@
 use crate::cli::RenderArgs;
 use crate::error::{input, Result};
 use crate::output::{print_json, write_png};
+use crate::runs::shard::{Manifest, ShardSpec};
 use crate::source::Source;
 use crate::workload::{self, trace};
 use serde_json::json;
@@ -15,6 +16,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let store = std::path::Path::new(&a.scene.scene);
     if store.join(rtbench_engines::store::HEADER_FILE).is_file() {
         return run_store(a, store, settings);
+    }
+    if a.tile.is_some() {
+        return Err(input(format!(
+            "--tile: tiles split the out-of-core render of a scene store (breadth-first); {} is not a store",
+            a.scene.scene
+        )));
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     workload::check_scene_fits(&src, a.scene.opts.force)?;
@@ -78,6 +85,38 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The manifest of one tile of a store's render: the plan is the store (its header's SHA-256), the
+/// image size and the engine's settings.
+fn tile_manifest(
+    dir: &std::path::Path,
+    spec: ShardSpec,
+    size: u32,
+    settings: &[(String, String)],
+) -> Result<Manifest> {
+    let header = dir.join(rtbench_engines::store::HEADER_FILE);
+    let bytes = std::fs::read(&header)
+        .map_err(|e| input(format!("{}: cannot read: {e}", header.display())))?;
+    let mut s = settings.to_vec();
+    s.sort();
+    let text = format!(
+        "tile store {} size {size} settings {s:?}",
+        hex(&Sha256::digest(&bytes))
+    );
+    let plan: Vec<String> = (1..=spec.n)
+        .map(|k| format!("tile {k}/{}", spec.n))
+        .collect();
+    let mut m = Manifest::new(
+        "tile",
+        spec,
+        &text,
+        plan,
+        vec![format!("tile {}/{}", spec.k, spec.n)],
+    );
+    m.extra
+        .insert("store".into(), dir.display().to_string().into());
+    Ok(m)
+}
+
 pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
@@ -100,15 +139,66 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
             a.engine
         )));
     }
+    let tile = a
+        .tile
+        .as_deref()
+        .map(|t| ShardSpec::parse(t, "--tile"))
+        .transpose()?;
     let t = std::time::Instant::now();
     let config = BreadthFirstConfig::from_settings(rtbench_engines::Settings::new(
         "breadth-first",
-        settings,
+        settings.clone(),
     ))?;
     let engine = BreadthFirst::open(dir, config)?;
     let build_s = t.elapsed().as_secs_f64();
-    let ooc = workload::out_of_core::render(&engine, a.size)
+    let mut manifest = match (tile, &a.out) {
+        (Some(spec), Some(out)) => {
+            let m = tile_manifest(dir, spec, a.size, &settings)?;
+            m.write(out)?;
+            Some((m, out.clone(), spec))
+        }
+        _ => None,
+    };
+    let ooc = workload::out_of_core::render_tile(&engine, a.size, tile)
         .map_err(|e| input(format!("{}: out-of-core render: {e}", dir.display())))?;
+    if let Some((m, out, spec)) = manifest.as_mut() {
+        let r = &ooc.render;
+        let w = a.size as usize + 1;
+        let corners = workload::tiles::rows(*spec, a.size)
+            .into_iter()
+            .flat_map(|j| r.corners[j as usize * w..(j as usize + 1) * w].to_vec())
+            .collect();
+        let io = serde_json::to_value(ooc.io)
+            .ok()
+            .and_then(|v| serde_json::from_value(v).ok())
+            .unwrap_or_default();
+        let counters = crate::runs::one::flatten_counters(&r.counters);
+        let t = workload::tiles::TileOutput {
+            size: a.size,
+            store: dir.display().to_string(),
+            rays: r.stats.clone(),
+            counters,
+            io,
+            preprocess_s: build_s,
+            trace_s: r.trace_s,
+            intersect_s: r.intersect_s,
+            shade_s: r.shade_s,
+            peak_rss_bytes: workload::peak_rss_bytes(),
+            corners,
+        };
+        t.write(out)?;
+        m.finished_at = Some(crate::runs::env::now_utc());
+        m.write(out)?;
+        eprintln!(
+            "render: tile {}/{} of {}: {} rays in {:.3} s into {}",
+            spec.k,
+            spec.n,
+            dir.display(),
+            r.stats.total,
+            r.trace_s,
+            out.display()
+        );
+    }
     let r = &ooc.render;
     let pixels = r.pixels();
     let sha = hex(&Sha256::digest(&pixels));

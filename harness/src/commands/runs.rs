@@ -5,6 +5,7 @@ use crate::error::{input, Failure, Result};
 use crate::output::print_json;
 use crate::runs::one::{run_one, OneSpec};
 use crate::runs::plan::{self, Common, Job, ResultsDir};
+use crate::runs::shard::{group_count, Manifest, ShardSpec};
 use crate::source::Source;
 use crate::workload;
 use rtbench_scenes::spd::Program;
@@ -94,6 +95,26 @@ fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
     Ok(out)
 }
 
+/// The group a job of `run` is sharded with: its scene (program, SF, tessellation) and threads, so
+/// Embree's run and the engines measured against it land on one machine.
+pub fn run_group(j: &Job) -> (String, u32, Option<u32>, Option<usize>) {
+    (j.program.clone(), j.sf, j.tessellate, j.threads)
+}
+
+/// What identifies a plan across its shards: the command, the shared settings, every job key.
+pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
+    format!(
+        "{kind} repeats={} size={} check={} paired={} max_seconds={:?} max_memory={:?}\n{}",
+        c.repeats,
+        c.size,
+        c.check,
+        c.paired,
+        c.max_seconds,
+        c.max_memory,
+        keys.join("\n")
+    )
+}
+
 fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
     if p.scenes.trim() == "standard" {
         return Ok(Program::STANDARD.to_vec());
@@ -144,7 +165,8 @@ fn common(p: &PlanArgs) -> Result<Common> {
     })
 }
 
-pub fn run(a: &RunArgs) -> Result<()> {
+/// The jobs of `rtbench run` in plan order (scene by scene, Embree where listed), and what they share.
+pub fn run_plan(a: &RunArgs) -> Result<(Vec<Job>, Common)> {
     let engines = plan_engines(&a.plan)?;
     let programs = plan_programs(&a.plan)?;
     let threads = plan_threads(&a.plan)?;
@@ -173,8 +195,49 @@ pub fn run(a: &RunArgs) -> Result<()> {
             }
         }
     }
+    Ok((jobs, common))
+}
+
+pub fn run(a: &RunArgs) -> Result<()> {
+    let (mut jobs, common) = run_plan(a)?;
+    let shard = a
+        .plan
+        .shard
+        .as_deref()
+        .map(|s| ShardSpec::parse(s, "--shard"))
+        .transpose()?;
+    let manifest = match shard {
+        Some(spec) => {
+            let plan_jobs: Vec<String> = jobs.iter().map(Job::key).collect();
+            let groups = group_count(&jobs, run_group);
+            let mine = spec.select(&jobs, run_group);
+            let m = Manifest::new(
+                "run",
+                spec,
+                &plan_text("run", &common, &plan_jobs),
+                plan_jobs,
+                mine.iter().map(Job::key).collect(),
+            );
+            m.write(&a.plan.out)?;
+            eprintln!(
+                "run: shard {}/{}: {} of {} runs, {} of {groups} scene groups",
+                spec.k,
+                spec.n,
+                mine.len(),
+                jobs.len(),
+                group_count(&mine, run_group)
+            );
+            jobs = mine;
+            Some(m)
+        }
+        None => None,
+    };
     let mut out = ResultsDir::open(&a.plan.out, a.plan.resume)?;
     let failures = plan::run(&jobs, &common, &mut out, a.plan.resume)?;
+    if let Some(mut m) = manifest {
+        m.finished_at = Some(crate::runs::env::now_utc());
+        m.write(&a.plan.out)?;
+    }
     eprintln!(
         "{} runs, {failures} failed: {}",
         jobs.len(),
@@ -212,6 +275,61 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             a.sf_start, a.sf_max
         )));
     }
+    // A sweep's unit of work is (engine, scene): its SFs rise until the limit. Shards take whole
+    // scenes, so the stop rule holds per scene.
+    let units = |ps: &[String]| -> Vec<String> {
+        ps.iter()
+            .flat_map(|p| {
+                engines.iter().map(move |(e, s)| {
+                    format!(
+                        "{}/{p}",
+                        rtbench_reports::engine_label(
+                            e,
+                            &s.iter()
+                                .cloned()
+                                .collect::<std::collections::BTreeMap<_, _>>()
+                        )
+                    )
+                })
+            })
+            .collect()
+    };
+    let shard = a
+        .plan
+        .shard
+        .as_deref()
+        .map(|s| ShardSpec::parse(s, "--shard"))
+        .transpose()?;
+    let mut programs = programs;
+    let manifest = match shard {
+        Some(spec) => {
+            let plan_units = units(&programs);
+            let mine = spec.select(&programs, |p| p.clone());
+            let text = format!(
+                "{}\nsf {}..{} threads {:?}",
+                plan_text("sweep", &common, &plan_units),
+                a.sf_start,
+                a.sf_max,
+                threads[0]
+            );
+            let m = Manifest::new("sweep", spec, &text, plan_units, units(&mine));
+            m.write(&a.plan.out)?;
+            eprintln!(
+                "sweep: shard {}/{}: scenes {} of {}",
+                spec.k,
+                spec.n,
+                if mine.is_empty() {
+                    "none".to_string()
+                } else {
+                    mine.join(",")
+                },
+                programs.len()
+            );
+            programs = mine;
+            Some(m)
+        }
+        None => None,
+    };
     let mut out = ResultsDir::open(&a.plan.out, a.plan.resume)?;
     let n = plan::sweep(
         &engines,
@@ -223,6 +341,10 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         &mut out,
         a.plan.resume,
     )?;
+    if let Some(mut m) = manifest {
+        m.finished_at = Some(crate::runs::env::now_utc());
+        m.write(&a.plan.out)?;
+    }
     eprintln!(
         "sweep: {n} runs: {}",
         a.plan.out.join("results.jsonl").display()

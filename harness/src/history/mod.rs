@@ -67,7 +67,7 @@ CREATE INDEX IF NOT EXISTS metrics_name ON metrics(name, run_id);
 ";
 
 /// One metric of a night.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Metric {
     pub name: String,
     /// `counter`, `time_ratio`, `time`, `instructions`, `criterion`.
@@ -79,7 +79,7 @@ pub struct Metric {
 }
 
 /// What the comparison of a night reported about one metric.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Finding {
     pub name: String,
     /// `regression`, `improvement`, `failed`, `change` (an ungated metric moved).

@@ -7,6 +7,7 @@
 pub mod dashboard;
 pub mod detect;
 pub mod plant;
+pub mod shard;
 pub mod suite;
 mod tools;
 
@@ -14,6 +15,7 @@ use crate::cli::NightlyArgs;
 use crate::error::{input, Failure, Result};
 use crate::history::{Finding, History, Metric, Night};
 use crate::runs::plan::{self, Common, Job, ResultsDir};
+use crate::runs::shard::ShardSpec;
 use rtbench_reports::{Environment, RunRecord};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -37,7 +39,7 @@ pub fn fingerprint(env: &Environment) -> String {
 }
 
 /// The jobs of a suite, Embree first within each (scene, SF, threads).
-fn jobs(s: &Suite) -> Vec<Job> {
+pub fn jobs(s: &Suite) -> Vec<Job> {
     let mut out = Vec::new();
     for p in &s.scenes {
         for &sf in &s.sf {
@@ -450,20 +452,37 @@ fn merge(mut a: RunRecord, b: &RunRecord) -> RunRecord {
     a
 }
 
-/// `rtbench nightly`.
-pub fn run(a: &NightlyArgs) -> Result<()> {
-    let suite = suite::load(&a.suite)?;
-    // Open the history before running anything: a bad file is exit 2 at once.
-    let mut history = History::open(&a.db, true)?;
+/// What a night (or a shard of one) measured, before it is compared and recorded.
+pub struct Measured {
+    pub env: Environment,
+    pub fingerprint: String,
+    pub started_at: String,
+    pub metrics: Vec<Metric>,
+    pub findings: Vec<Finding>,
+    /// Wall seconds of the measuring (the slowest shard's, for merged shards).
+    pub wall_s: f64,
+}
+
+/// Runs the suite's jobs (those of `spec`'s shard only, when given), its instruction counts and
+/// its criterion benchmarks (shard 1 only), writing the runs into `out` as they finish.
+fn measure(
+    suite: &Suite,
+    a: &NightlyArgs,
+    spec: Option<ShardSpec>,
+    out: Option<&std::path::Path>,
+) -> Result<Measured> {
     let start = Instant::now();
     let env = crate::runs::env::capture();
     let fp = fingerprint(&env);
     let started_at = crate::runs::env::now_utc();
-    let mut results = match &a.out {
+    let mut results = match out {
         Some(d) => Some(ResultsDir::open(d, false)?),
         None => None,
     };
-    let jobs = jobs(&suite);
+    let mut jobs = jobs(suite);
+    if let Some(spec) = spec {
+        jobs = spec.select(&jobs, crate::commands::runs::run_group);
+    }
     // Rounds: every job once per round, one timed repeat each, so that an engine's i-th sample
     // and Embree's i-th sample are minutes apart at most and a burst of load on a shared machine
     // touches one sample of many metrics rather than every sample of one.
@@ -476,11 +495,13 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         max_memory: None,
     };
     eprintln!(
-        "nightly: suite '{}': {} runs × {} rounds, machine {}",
+        "nightly: suite '{}': {} runs × {} rounds, machine {}{}",
         suite.name,
         jobs.len(),
         suite.repeats,
-        &fp[..12]
+        &fp[..12],
+        spec.map(|s| format!(", shard {}/{}", s.k, s.n))
+            .unwrap_or_default()
     );
     let mut progress = plan::Progress::new(jobs.len() * suite.repeats as usize);
     let mut merged: Vec<Option<RunRecord>> = vec![None; jobs.len()];
@@ -503,7 +524,7 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
             r.put(rec.clone())?;
         }
     }
-    let mut metrics = record_metrics(&suite, &records);
+    let mut metrics = record_metrics(suite, &records);
     let mut findings: Vec<Finding> = records
         .iter()
         .filter(|r| !r.ok())
@@ -520,14 +541,18 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
             ),
         })
         .collect();
-    let scratch = match &a.out {
-        Some(d) => d.clone(),
+    let scratch = match out {
+        Some(d) => d.to_path_buf(),
         None => std::env::temp_dir(),
     };
     if let Some(ins) = &suite.instructions {
         let t = Instant::now();
         for v in &ins.variants {
-            for &p in &ins.scenes {
+            for (i, &p) in ins.scenes.iter().enumerate() {
+                // Shards split the instruction counts by scene, as they split the runs.
+                if spec.is_some_and(|s| !s.owns_group(i)) {
+                    continue;
+                }
                 let subj = format!("{} {}{}", v.label(), p.name(), ins.sf);
                 match tools::instructions(v, p, ins.sf, ins.size, &scratch) {
                     Ok((ir, wall)) => {
@@ -567,7 +592,12 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
             fmt_secs(t.elapsed().as_secs_f64())
         );
     }
-    if let Some(c) = suite.criterion.as_ref().filter(|_| !a.skip_criterion) {
+    let criterion_here = spec.is_none_or(|s| s.k == 1);
+    if let Some(c) = suite
+        .criterion
+        .as_ref()
+        .filter(|_| !a.skip_criterion && criterion_here)
+    {
         let home = scratch.join(format!("criterion-{}", std::process::id()));
         match tools::criterion(c, &home, suite.gates("criterion")) {
             Ok((m, wall)) => {
@@ -587,10 +617,50 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
                 message: e,
             }),
         }
-        if a.out.is_none() {
+        if out.is_none() {
             let _ = std::fs::remove_dir_all(&home);
         }
     }
+    Ok(Measured {
+        env,
+        fingerprint: fp,
+        started_at,
+        metrics,
+        findings,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// `rtbench nightly`.
+pub fn run(a: &NightlyArgs) -> Result<()> {
+    let suite = suite::load(&a.suite)?;
+    let spec = a
+        .shard
+        .as_deref()
+        .map(|s| ShardSpec::parse(s, "--shard"))
+        .transpose()?;
+    if let Some(spec) = spec {
+        return shard::run_shard(a, &suite, spec, |out| {
+            measure(&suite, a, Some(spec), Some(out))
+        });
+    }
+    let db = a.db.as_deref().ok_or_else(|| {
+        input("nightly: --db FILE is required (the history the night is compared with and written to)")
+    })?;
+    // Open the history before running anything: a bad file is exit 2 at once.
+    let mut history = History::open(db, true)?;
+    let start = Instant::now();
+    let Measured {
+        env,
+        fingerprint: fp,
+        started_at,
+        metrics,
+        mut findings,
+        wall_s: measured_s,
+    } = match &a.from {
+        Some(dir) => shard::load_merged(dir, &suite)?,
+        None => measure(&suite, a, None, a.out.as_deref())?,
+    };
     let prev = history.runs(Some(&fp), Some(&suite.name))?;
     let window: Vec<_> = prev
         .iter()
@@ -607,7 +677,10 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         None => Default::default(),
     };
     findings.extend(compare(&suite, &metrics, &baseline, &suspects));
-    let wall_s = start.elapsed().as_secs_f64();
+    let wall_s = match &a.from {
+        Some(_) => measured_s + start.elapsed().as_secs_f64(),
+        None => start.elapsed().as_secs_f64(),
+    };
     let night = Night {
         suite: suite.name.clone(),
         suite_sha256: crate::commands::render::hex(&Sha256::digest(suite.text.as_bytes())),
@@ -633,11 +706,11 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
     if a.no_record {
         eprintln!(
             "nightly: --no-record: the night is not written to {}",
-            a.db.display()
+            db.display()
         );
     } else {
         let id = history.append(&night)?;
-        eprintln!("nightly: night {id} written to {}", a.db.display());
+        eprintln!("nightly: night {id} written to {}", db.display());
     }
     if let Some(d) = &a.out {
         crate::output::write_atomic(&d.join("nightly.md"), |w| {

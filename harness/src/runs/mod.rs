@@ -3,3 +3,4 @@
 pub mod env;
 pub mod one;
 pub mod plan;
+pub mod shard;

@@ -67,7 +67,7 @@ fn paired_ratios(
 }
 
 /// Counters as a flat name → value map (common fields and the engine's own).
-fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String, u64> {
+pub(crate) fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String, u64> {
     let mut m = BTreeMap::new();
     if let Ok(serde_json::Value::Object(o)) = serde_json::to_value(c) {
         for (k, v) in o {
@@ -225,5 +225,6 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(&pixels))),
         wall_s: start.elapsed().as_secs_f64(),
         finished_at: super::env::now_utc(),
+        machine: None,
     })
 }

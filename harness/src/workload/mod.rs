@@ -6,6 +6,7 @@ pub mod out_of_core;
 pub mod paging;
 pub mod pass_003;
 pub mod surface;
+pub mod tiles;
 pub mod trace;
 
 use crate::error::{input, Result};

@@ -198,6 +198,16 @@ fn ray_stream<'a>(
 
 /// Traces the SPD workload of the engine's store at `size`×`size` pixels.
 pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
+    render_tile(engine, size, None)
+}
+
+/// The same for the ray trees of one tile set's pixel corners only ([`super::tiles`]); the
+/// other corners stay black. `None`: the whole image.
+pub fn render_tile(
+    engine: &BreadthFirst,
+    size: u32,
+    tile: Option<crate::runs::shard::ShardSpec>,
+) -> io::Result<OutOfCoreRender> {
     let start = Instant::now();
     let cpu_start = super::thread_cpu_seconds();
     let h = engine.header();
@@ -218,6 +228,9 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
     let codec = config.spill_codec;
     let mut rays = Records::create(spill.path(), "rays-1", buffer, codec)?;
     for j in 0..w {
+        if tile.is_some_and(|t| !super::tiles::owns_row(t, j)) {
+            continue;
+        }
         for i in 0..w {
             let path = Path {
                 corner: j * w + i,

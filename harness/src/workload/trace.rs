@@ -45,7 +45,7 @@ pub(crate) struct Path {
 }
 
 /// Ray counts of one generation.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct GenerationStats {
     pub generation: u32,
     pub rays: u64,
@@ -59,7 +59,7 @@ pub struct GenerationStats {
 }
 
 /// Ray statistics of a whole render (the columns of the SPD table).
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct RayStats {
     pub eye: u64,
     pub eye_hit: u64,
@@ -69,6 +69,39 @@ pub struct RayStats {
     pub refract: u64,
     pub total: u64,
     pub generations: Vec<GenerationStats>,
+}
+
+impl RayStats {
+    /// Adds another part of the same render's (tiles of one image): every count, generation by
+    /// generation.
+    pub fn add(&mut self, o: &RayStats) {
+        self.eye += o.eye;
+        self.eye_hit += o.eye_hit;
+        self.shadow += o.shadow;
+        self.shadow_blocked += o.shadow_blocked;
+        self.reflect += o.reflect;
+        self.refract += o.refract;
+        self.total += o.total;
+        for g in &o.generations {
+            match self
+                .generations
+                .iter_mut()
+                .find(|x| x.generation == g.generation)
+            {
+                Some(x) => {
+                    x.rays += g.rays;
+                    x.hits += g.hits;
+                    x.shadow += g.shadow;
+                    x.shadow_blocked += g.shadow_blocked;
+                    x.reflect += g.reflect;
+                    x.refract += g.refract;
+                    x.total_internal_reflections += g.total_internal_reflections;
+                }
+                None => self.generations.push(g.clone()),
+            }
+        }
+        self.generations.sort_by_key(|g| g.generation);
+    }
 }
 
 /// Every query of a render with its answer, for cross-checking another engine on the same rays.
@@ -97,23 +130,29 @@ pub struct Render {
 impl Render {
     /// The image: each pixel the average of its four corners, 8-bit sRGB-less RGB.
     pub fn pixels(&self) -> Vec<u8> {
-        let n = self.size as usize;
-        let w = n + 1;
-        let mut out = Vec::with_capacity(n * n * 3);
-        for j in 0..n {
-            for i in 0..n {
-                let c = (self.corners[j * w + i]
-                    + self.corners[j * w + i + 1]
-                    + self.corners[(j + 1) * w + i]
-                    + self.corners[(j + 1) * w + i + 1])
-                    * 0.25;
-                for x in [c.x, c.y, c.z] {
-                    out.push((x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
-                }
+        pixels_of(self.size, &self.corners)
+    }
+}
+
+/// The image of `size`² pixels from its (size+1)² corner colours: each pixel the average of its
+/// four corners, 8-bit RGB.
+pub fn pixels_of(size: u32, corners: &[Vec3]) -> Vec<u8> {
+    let n = size as usize;
+    let w = n + 1;
+    let mut out = Vec::with_capacity(n * n * 3);
+    for j in 0..n {
+        for i in 0..n {
+            let c = (corners[j * w + i]
+                + corners[j * w + i + 1]
+                + corners[(j + 1) * w + i]
+                + corners[(j + 1) * w + i + 1])
+                * 0.25;
+            for x in [c.x, c.y, c.z] {
+                out.push((x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
             }
         }
-        out
     }
+    out
 }
 
 /// CPU seconds spent by pool threads other than the render's own (whose time the render
