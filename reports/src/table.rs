@@ -20,15 +20,15 @@ const HEADER: [(&str, bool); 11] = [
 ];
 
 /// One table per thread count: scene × engine.
-/// In results merged from shards run on more than one machine, a last column names the machine
-/// each row (and its ratio to Embree, always measured on the same machine) comes from.
+/// In results merged from shards (`rtbench merge`), a last column names the machine each row (and
+/// its ratio to Embree, always measured on the same machine) comes from.
 pub fn run_tables(summary: &Summary) -> Vec<Table> {
     let machines: std::collections::BTreeSet<&str> = summary
         .rows
         .iter()
         .filter_map(|r| r.machine.as_deref())
         .collect();
-    let with_machine = machines.len() > 1;
+    let with_machine = !machines.is_empty();
     summary
         .thread_counts()
         .into_iter()

@@ -91,6 +91,8 @@ SlurmdLogFile=$DIR/slurmd.log
 SlurmctldPort=6817
 SlurmdPort=6818
 MaxArraySize=10001
+# Without a memory request a job would hold the whole node; a CPU's share lets tasks run side by side.
+DefMemPerCPU=$((mem / cpus))
 NodeName=$node CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=rtbench Nodes=$node Default=YES MaxTime=INFINITE State=UP OverSubscribe=NO
 CONF
