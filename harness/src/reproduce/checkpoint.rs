@@ -1,8 +1,10 @@
 //! Partial progress of a long reproduction (`reproduce <id> --out DIR --resume`): a table saves each
 //! finished step as `DIR/.partial/<id>/<key>.json` and, resumed, loads it instead of measuring it
 //! again, so hours of tracing survive the end of a session. A run without `--resume` starts fresh
-//! (the folder is emptied); a finished run removes it. Keys must name everything the step's
-//! measurement depends on (scene, size factor, image size …).
+//! (the folder is emptied); the steps stay after a finished run, so that runs over parts of a
+//! table (`scenes=`, `max-sf`) add up and a last `--resume` run writes the whole table from
+//! them. Keys must name everything the step's measurement depends on (scene, size factor, image
+//! size …).
 
 use crate::error::{input, Result};
 use serde::de::DeserializeOwned;
@@ -58,14 +60,6 @@ impl Checkpoint {
             .and_then(|_| std::fs::rename(&tmp, &f))
             .map_err(|e| input(format!("{}: {e}", f.display())))
     }
-
-    /// Removes the saved steps once the table's outputs are written.
-    pub fn finish(&self) {
-        let _ = std::fs::remove_dir_all(&self.dir);
-        if let Some(parent) = self.dir.parent() {
-            let _ = std::fs::remove_dir(parent);
-        }
-    }
 }
 
 #[cfg(test)]
@@ -89,7 +83,6 @@ mod tests {
         assert!(r.load::<Vec<u32>>("bad").is_err());
         let fresh = Checkpoint::open(&out, "t", false).unwrap();
         assert!(!out.join(".partial/t/a.json").exists());
-        fresh.finish();
         let _ = std::fs::remove_dir_all(&out);
     }
 }

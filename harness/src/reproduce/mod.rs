@@ -134,9 +134,7 @@ pub fn run(
         checkpoint: &checkpoint,
     };
     let output = (table.run)(&ctx)?;
-    writer::write(table, out, output, as_json)?;
-    checkpoint.finish();
-    Ok(())
+    writer::write(table, out, output, as_json)
 }
 
 #[cfg(test)]

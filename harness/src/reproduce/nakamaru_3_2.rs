@@ -55,6 +55,10 @@ pub const FAULT_MS: Param = Param {
     key: "fault-ms",
     help: "one more modelled disk: ms per page fault or seek (100 MB/s)",
 };
+const PAGING: Param = Param {
+    key: "paging",
+    help: "on (default): trace and model every SF; off: the memory account only (minutes); or scene=N,… the largest SF traced per scene (the account for all)",
+};
 const VALIDATE: Param = Param {
     key: "validate",
     help: "the case the model is checked on by direct simulation, sceneSF (default tetra7; tetra6 with --quick; off)",
@@ -72,7 +76,7 @@ pub const TABLE: Table = Table {
         quick: "minutes",
         full: "an hour",
     },
-    params: &[MAX_SF, FAULT_MS, VALIDATE],
+    params: &[MAX_SF, FAULT_MS, PAGING, VALIDATE],
     claims: &[
         Claim {
             key: "table-3.2-memory",
@@ -153,6 +157,8 @@ struct Disk {
 #[derive(Serialize, Deserialize, Clone)]
 struct Point {
     sf: u32,
+    /// Traced and paged (else the memory account only).
+    paged: bool,
     objects: usize,
     rays: u64,
     account: Account,
@@ -313,6 +319,7 @@ fn grid_point(prepared: &workload::Prepared, floor: &str, frames: u64) -> Result
     replay(&grid, &image, prims, &r, &rec, &mut |p| m.access(p));
     Ok(Point {
         sf: 0,
+        paged: true,
         objects: prepared.input.scene.objects.len(),
         rays: r.stats.total,
         account: image.account,
@@ -325,6 +332,34 @@ fn grid_point(prepared: &workload::Prepared, floor: &str, frames: u64) -> Result
         trace_faults: m.faults(frames) - m.cold() - pre_faults,
         grid_build_s,
         grid_trace_s: r.trace_s,
+        bf_build_s: 0.0,
+        bf_trace_s: 0.0,
+        bf_pre_io_bytes: 0,
+        bf_trace_io_bytes: 0,
+        bf_seeks: 0,
+        bf_passes: 0,
+    })
+}
+
+/// The memory account alone: the scene and its grid, nothing traced.
+fn account_point(prepared: &workload::Prepared, floor: &str) -> Result<Point> {
+    let grid = Grid::build(&prepared.input, grid_config(floor)?)?;
+    let image = RayshadeImage::new(&prepared.input.scene, &prepared.input.geometry, &grid);
+    Ok(Point {
+        sf: 0,
+        paged: false,
+        objects: prepared.input.scene.objects.len(),
+        rays: 0,
+        account: image.account,
+        grid_res: grid.cells().lattice.res,
+        pre_accesses: 0,
+        pre_touched: 0,
+        pre_faults: 0,
+        trace_accesses: 0,
+        trace_touched: 0,
+        trace_faults: 0,
+        grid_build_s: 0.0,
+        grid_trace_s: 0.0,
         bf_build_s: 0.0,
         bf_trace_s: 0.0,
         bf_pre_io_bytes: 0,
@@ -491,10 +526,17 @@ fn analyse(p: &Published, scene: &str, pts: &[Point], disks: &[Disk], factor: Op
                 table_3_2_mb: t.map(|r| r.mb),
                 table_3_2_objects: t.map(|r| r.objects),
                 account_mib: pt.account.total as f64 / 1048576.0,
-                model: disks.iter().map(|d| (d.name.clone(), pt.model(d, f))).collect(),
+                model: if pt.paged {
+                    disks.iter().map(|d| (d.name.clone(), pt.model(d, f))).collect()
+                } else {
+                    Vec::new()
+                },
             }
         })
         .collect();
+    let all = pts;
+    let paged: Vec<Point> = pts.iter().filter(|p| p.paged).cloned().collect();
+    let pts = &paged[..];
     let onsets = disks
         .iter()
         .map(|d| Onset {
@@ -518,7 +560,7 @@ fn analyse(p: &Published, scene: &str, pts: &[Point], disks: &[Disk], factor: Op
         sfs: pts.iter().map(|p| p.sf).collect(),
         floor: floor(scene),
         machine_factor: factor,
-        size_onset_sf: first(pts, |pt| pt.account.total > memory),
+        size_onset_sf: first(all, |pt| pt.account.total > memory),
         rows,
         onsets,
     }
@@ -560,6 +602,19 @@ fn run(ctx: &Ctx) -> Result<Output> {
         }
         None => Some(("tetra".to_string(), if ctx.quick { 6 } else { 7 })),
     };
+    // Which SFs are traced: all, none, or up to a per-scene cap.
+    let paging: Vec<Cap> = match ctx.params.raw(PAGING.key) {
+        None | Some("on") => Vec::new(),
+        Some("off") => vec![(None, None, 0)],
+        Some(v) => parse_caps(ctx.id, Some(v))
+            .map_err(|_| input(format!("{}: paging '{v}': on, off or scene=N,…", ctx.id)))?,
+    };
+    let traced = |scene: &str, sf: u32| {
+        paging
+            .iter()
+            .find(|c| c.0.is_none() || c.0.as_deref() == Some(scene))
+            .is_none_or(|c| sf <= c.2)
+    };
     let planned: Vec<(String, Vec<u32>)> = scenes
         .iter()
         .map(|(s, sfs)| (s.clone(), sf_list(s, sfs, &caps, ctx.quick)))
@@ -578,16 +633,22 @@ fn run(ctx: &Ctx) -> Result<Output> {
     for (scene, sfs) in planned {
         let mut pts = Vec::new();
         for sf in sfs {
-            let key = format!("{scene}{sf}");
+            let paged = traced(&scene, sf);
+            let key = format!("{scene}{sf}{}", if paged { "" } else { "-account" });
             let pt = match ctx.checkpoint.load::<Point>(&key)? {
                 Some(pt) => pt,
                 None => {
-                    eprintln!("nakamaru-3.2: {scene}{sf} …");
+                    eprintln!("nakamaru-3.2: {scene}{sf}{} …", if paged { "" } else { " (account)" });
                     let src = SceneSource::resolve(&scene, Some(sf), None, None)?;
                     let prepared = workload::prepare(&src)?;
-                    let mut pt = grid_point(&prepared, floor(&scene), frames)?;
+                    let mut pt = if paged {
+                        let mut pt = grid_point(&prepared, floor(&scene), frames)?;
+                        breadth_first_point(&prepared, floor(&scene), &mut pt)?;
+                        pt
+                    } else {
+                        account_point(&prepared, floor(&scene))?
+                    };
                     pt.sf = sf;
-                    breadth_first_point(&prepared, floor(&scene), &mut pt)?;
                     ctx.checkpoint.save(&key, &pt)?;
                     pt
                 }
@@ -596,11 +657,11 @@ fn run(ctx: &Ctx) -> Result<Output> {
         }
         // Pentium 90 seconds per our second: Table 3.1's rss-r total at its SF over our grid's.
         let factor = t31.rows.iter().find(|r| r.scene == scene).and_then(|r| {
-            let ours = pts.iter().find(|p| p.sf == r.sf)?;
+            let ours = pts.iter().find(|p| p.sf == r.sf && p.paged)?;
             Some(r.total[rss_r] / (ours.grid_build_s + ours.grid_trace_s).max(1e-9))
         });
         let s = analyse(&p, &scene, &pts, &disks, factor, memory);
-        if pts.len() >= 2 {
+        if s.sfs.len() >= 2 {
             svgs.push((format!("{}-{scene}", ctx.id), plot(&s, &disks[0])));
         }
         measured.push(s);
@@ -693,7 +754,7 @@ fn rows(p: &Published, r: &Result_) -> Vec<Row> {
             }
         }
         let last = s.sfs.last();
-        for o in &s.onsets {
+        for o in s.onsets.iter().filter(|_| !s.sfs.is_empty()) {
             rows.push(Row::new(
                 "onset",
                 format!("{} ({})", s.scene, o.disk),
@@ -710,8 +771,11 @@ fn rows(p: &Published, r: &Result_) -> Vec<Row> {
             ));
         }
         // Judged on the first disk (HDD-like, the thesis's kind of disk).
-        let d = &s.rows;
-        let fits: Vec<&SfRow> = d.iter().filter(|x| x.point.account.total <= r.memory_bytes).collect();
+        let d: Vec<&SfRow> = s.rows.iter().filter(|x| x.point.paged).collect();
+        if d.is_empty() {
+            continue;
+        }
+        let fits: Vec<&SfRow> = d.iter().filter(|x| x.point.account.total <= r.memory_bytes).copied().collect();
         let faster_in = fits.iter().all(|x| {
             let m = &x.model[0].1;
             m.grid_p + m.grid_t < m.bf_p + m.bf_t
@@ -740,7 +804,7 @@ fn rows(p: &Published, r: &Result_) -> Vec<Row> {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
-        let after: Vec<&SfRow> = d.iter().filter(|x| onset.is_some_and(|t| x.point.sf >= t)).collect();
+        let after: Vec<&&SfRow> = d.iter().filter(|x| onset.is_some_and(|t| x.point.sf >= t)).collect();
         let bf_wins = after.iter().filter(|x| {
             let m = &x.model[0].1;
             m.bf_p + m.bf_t < m.grid_p + m.grid_t
@@ -822,7 +886,7 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
         }
     }
     doc.table(t);
-    for s in &r.measured {
+    for s in r.measured.iter().filter(|s| !s.sfs.is_empty()) {
         doc.heading(format!(
             "{} (machine factor {})",
             s.scene,
@@ -873,7 +937,7 @@ fn scene_table(s: &SceneResult, disks: &[Disk]) -> DocTable {
         }
     }
     let mut t = DocTable::new("", &header.iter().map(String::as_str).collect::<Vec<_>>());
-    for x in &s.rows {
+    for x in s.rows.iter().filter(|x| x.point.paged) {
         let pt = &x.point;
         let mut cells = vec![
             pt.sf.to_string(),
@@ -902,12 +966,13 @@ fn scene_table(s: &SceneResult, disks: &[Disk]) -> DocTable {
 /// (Figs. 3.5–3.7's axes), physical memory marked.
 fn plot(s: &SceneResult, d: &Disk) -> String {
     let (w, h, m) = (560.0, 340.0, 56.0);
-    let xs: Vec<f64> = s.rows.iter().map(|x| x.account_mib.max(1e-3).log10()).collect();
+    let rows: Vec<&SfRow> = s.rows.iter().filter(|x| x.point.paged).collect();
+    let xs: Vec<f64> = rows.iter().map(|x| x.account_mib.max(1e-3).log10()).collect();
     let series: Vec<(&str, &str, Vec<f64>)> = vec![
-        ("rss p/", "#e59866", s.rows.iter().map(|x| x.model[0].1.grid_p).collect()),
-        ("rss t/", "#c0392b", s.rows.iter().map(|x| x.model[0].1.grid_t).collect()),
-        ("sray p/", "#85c1e9", s.rows.iter().map(|x| x.model[0].1.bf_p).collect()),
-        ("sray t/", "#2471a3", s.rows.iter().map(|x| x.model[0].1.bf_t).collect()),
+        ("rss p/", "#e59866", rows.iter().map(|x| x.model[0].1.grid_p).collect()),
+        ("rss t/", "#c0392b", rows.iter().map(|x| x.model[0].1.grid_t).collect()),
+        ("sray p/", "#85c1e9", rows.iter().map(|x| x.model[0].1.bf_p).collect()),
+        ("sray t/", "#2471a3", rows.iter().map(|x| x.model[0].1.bf_t).collect()),
     ];
     let ys: Vec<f64> = series.iter().flat_map(|(_, _, v)| v.iter().map(|y| y.max(1e-3).log10())).collect();
     let (x0, x1) = (
@@ -936,7 +1001,7 @@ fn plot(s: &SceneResult, d: &Disk) -> String {
         let _ = writeln!(out, "<polyline fill=\"none\" stroke=\"{colour}\" stroke-width=\"2\" points=\"{}\"/>", pts.join(" "));
         let _ = writeln!(out, "<text x=\"{}\" y=\"{}\" fill=\"{colour}\">{name}</text>", w - 110.0, 40.0 + 14.0 * k as f64);
     }
-    for (i, x) in s.rows.iter().enumerate() {
+    for (i, x) in rows.iter().enumerate() {
         let _ = writeln!(out, "<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#555\">{}</text>", sx(xs[i]) - 4.0, h - m + 14.0, x.point.sf);
     }
     out.push_str("</svg>\n");
@@ -985,6 +1050,7 @@ mod tests {
     fn pt(sf: u32, mib: u64, pre_faults: u64, trace_faults: u64) -> Point {
         Point {
             sf,
+            paged: true,
             objects: 1,
             rays: 1,
             account: Account {
