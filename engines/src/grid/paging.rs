@@ -31,6 +31,40 @@ fn pages(bytes: u64) -> u64 {
     bytes.div_ceil(PAGE) * PAGE
 }
 
+/// Where a query's reads land, as page numbers: in the grid's own arrays ([`Layout`]), or in
+/// another program's memory image of the same grid (seed 000's rayshade-ss, whose objects, voxel
+/// pointers and list nodes the harness lays out as Rayshade allocates them).
+pub trait PageMap {
+    /// Cell `cell`'s entry (c = x + res_x·(y + res_y·z)).
+    fn cell(&self, cell: usize) -> u64;
+    /// Entry `index` of the cells' reference list.
+    fn reference(&self, index: u64) -> u64;
+    /// Primitive `prim`'s mailbox stamp.
+    fn mailbox(&self, prim: u32) -> u64;
+    /// Primitive `prim`'s geometry, read by the intersection test.
+    fn prim(&self, prim: u32) -> u64;
+    /// Primitive `prim`'s scene object, read on a hit.
+    fn object(&self, prim: u32) -> u64;
+}
+
+impl PageMap for Layout {
+    fn cell(&self, cell: usize) -> u64 {
+        (self.offsets + cell as u64 * 4) / PAGE
+    }
+    fn reference(&self, index: u64) -> u64 {
+        (self.refs + index * 4) / PAGE
+    }
+    fn mailbox(&self, prim: u32) -> u64 {
+        (self.mailbox + prim as u64 * 4) / PAGE
+    }
+    fn prim(&self, prim: u32) -> u64 {
+        (self.prims + prim as u64 * std::mem::size_of::<Prim>() as u64) / PAGE
+    }
+    fn object(&self, prim: u32) -> u64 {
+        (self.prim_object + prim as u64 * 4) / PAGE
+    }
+}
+
 impl Grid {
     /// The model's memory layout of this grid.
     pub fn layout(&self) -> Layout {
@@ -56,7 +90,7 @@ impl Grid {
         &self,
         ray: &Ray,
         any: bool,
-        layout: &Layout,
+        layout: &dyn PageMap,
         stamps: &mut [u32],
         ray_no: u32,
         out: &mut dyn FnMut(u64),
@@ -64,17 +98,16 @@ impl Grid {
         let prims = &self.geometry.prims;
         let test = self.config.triangle;
         let wt = WatertightRay::new(ray.dir);
-        let psize = std::mem::size_of::<Prim>() as u64;
         let mut r = *ray;
         let mut hit = false;
         let visit_prim = |p: u32, r: &mut Ray, out: &mut dyn FnMut(u64)| -> bool {
-            out((layout.prims + p as u64 * psize) / PAGE);
+            out(layout.prim(p));
             match prims[p as usize].intersect(r, test, &wt) {
                 Some((t, _, _)) => {
                     if !any {
                         r.tmax = t;
                     }
-                    out((layout.prim_object + p as u64 * 4) / PAGE);
+                    out(layout.object(p));
                     true
                 }
                 None => false,
@@ -94,13 +127,13 @@ impl Grid {
         let g = &self.cells;
         let segment = r;
         self.walk(&segment, |cell, _, t_exit| {
-            out((layout.offsets + cell as u64 * 4) / PAGE);
+            out(layout.cell(cell));
             let (a, b) = (g.offsets[cell] as u64, g.offsets[cell + 1] as u64);
             for i in a..b {
-                out((layout.refs + i * 4) / PAGE);
+                out(layout.reference(i));
                 let p = g.refs[i as usize];
                 if self.config.mailbox {
-                    out((layout.mailbox + p as u64 * 4) / PAGE);
+                    out(layout.mailbox(p));
                     if stamps[p as usize] == ray_no {
                         continue;
                     }

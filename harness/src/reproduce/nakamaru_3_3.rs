@@ -37,6 +37,10 @@ const TRACE: Param = Param {
     key: "trace",
     help: "on (default): trace both stores; off: write the compressed store only, for its sizes",
 };
+const SCENES: Param = Param {
+    key: "scenes",
+    help: "the table's scenes to run, comma-separated (default mount,rings,tetra)",
+};
 const SIZE: Param = Param {
     key: "size",
     help: "image size (default 512, 64 with --quick)",
@@ -51,7 +55,7 @@ pub const TABLE: Table = Table {
         quick: "seconds",
         full: "hours (the table's sizes); minutes with smaller sf",
     },
-    params: &[SF, TRACE, SIZE],
+    params: &[SF, TRACE, SIZE, SCENES],
     claims: &[
         Claim {
             key: "compression-ratio",
@@ -99,7 +103,7 @@ struct PublishedRow {
     secondary: bool,
 }
 
-#[derive(Serialize, Default)]
+#[derive(Serialize, Deserialize, Default)]
 struct Run {
     trace_s: f64,
     preprocess_s: f64,
@@ -110,7 +114,7 @@ struct Run {
     peak_rss_bytes: u64,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct Measured {
     scene: String,
     sf: u32,
@@ -223,42 +227,82 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .number::<u32>(SIZE.key, 1)?
         .unwrap_or(if ctx.quick { 64 } else { 512 });
     workload::check_size(size)?;
+    let chosen: Vec<String> = match ctx.params.list(SCENES.key)? {
+        Some(list) => list,
+        None => p.rows.iter().map(|r| r.scene.clone()).collect(),
+    };
+    if let Some(bad) = chosen.iter().find(|s| !p.rows.iter().any(|r| &r.scene == *s)) {
+        return Err(input(format!("{}: scene '{bad}': the table's scenes are mount, rings, tetra", ctx.id)));
+    }
+    let rows_run: Vec<PublishedRow> = p.rows.iter().filter(|r| chosen.contains(&r.scene)).cloned().collect();
     let mut measured = Vec::new();
-    for row in &p.rows {
+    for row in &rows_run {
         let sf = sfs[&row.scene];
         let src = SceneSource::resolve(&row.scene, Some(sf), None, None)?;
-        eprintln!("{}: {}{sf} …", ctx.id, row.scene);
+        // Each finished step is saved (`--resume` keeps it): the table's sizes trace for hours.
+        let key = format!("{}{sf}-{size}", row.scene);
         let spill = SpillDir::create(None).map_err(input)?;
-        let gz_dir = spill.path().join("gzip");
-        let (hg, write_gzip_s) = write_store(&src, &gz_dir, Codec::Gzip(6))?;
-        let mut m = Measured {
-            scene: row.scene.clone(),
-            sf,
-            thesis_sf: sf == row.sf,
-            objects: hg.objects,
-            plain_bytes: hg.geometry_bytes,
-            compressed_bytes: hg.stored_bytes,
-            write_plain_s: 0.0,
-            write_gzip_s,
-            plain: None,
-            gzip: None,
+        let gz_key = format!("{key}-gzip{}", if traced { "" } else { "-sizes" });
+        let mut m: Measured = match ctx.checkpoint.load(&gz_key)? {
+            Some(m) => {
+                eprintln!("{}: {}{sf} compressed: resumed", ctx.id, row.scene);
+                m
+            }
+            None => {
+                eprintln!("{}: {}{sf} compressed …", ctx.id, row.scene);
+                workload::reset_peak_rss();
+                let gz_dir = spill.path().join("gzip");
+                let (hg, write_gzip_s) = write_store(&src, &gz_dir, Codec::Gzip(6))?;
+                let mut m = Measured {
+                    scene: row.scene.clone(),
+                    sf,
+                    thesis_sf: sf == row.sf,
+                    objects: hg.objects,
+                    plain_bytes: hg.geometry_bytes,
+                    compressed_bytes: hg.stored_bytes,
+                    write_plain_s: 0.0,
+                    write_gzip_s,
+                    plain: None,
+                    gzip: None,
+                };
+                if traced {
+                    m.gzip = Some(trace(&gz_dir, size, row.secondary, Codec::Gzip(1))?);
+                }
+                std::fs::remove_dir_all(&gz_dir).map_err(|e| input(e.to_string()))?;
+                ctx.checkpoint.save(&gz_key, &m)?;
+                m
+            }
         };
         if traced {
-            m.gzip = Some(trace(&gz_dir, size, row.secondary, Codec::Gzip(1))?);
-            std::fs::remove_dir_all(&gz_dir).map_err(|e| input(e.to_string()))?;
-            let plain_dir = spill.path().join("plain");
-            let (hp, s) = write_store(&src, &plain_dir, Codec::None)?;
-            m.write_plain_s = s;
-            if hp.geometry_bytes != m.plain_bytes {
-                return Err(input(format!(
-                    "{}: plain store has {} bytes, the compressed one {} uncompressed",
-                    ctx.id, hp.geometry_bytes, m.plain_bytes
-                )));
-            }
-            m.plain = Some(trace(&plain_dir, size, row.secondary, Codec::None)?);
+            let plain_key = format!("{key}-plain");
+            let (write_plain_s, run): (f64, Run) = match ctx.checkpoint.load(&plain_key)? {
+                Some(step) => {
+                    eprintln!("{}: {}{sf} plain: resumed", ctx.id, row.scene);
+                    step
+                }
+                None => {
+                    eprintln!("{}: {}{sf} plain …", ctx.id, row.scene);
+                    workload::reset_peak_rss();
+                    let plain_dir = spill.path().join("plain");
+                    let (hp, s) = write_store(&src, &plain_dir, Codec::None)?;
+                    if hp.geometry_bytes != m.plain_bytes {
+                        return Err(input(format!(
+                            "{}: plain store has {} bytes, the compressed one {} uncompressed",
+                            ctx.id, hp.geometry_bytes, m.plain_bytes
+                        )));
+                    }
+                    let step = (s, trace(&plain_dir, size, row.secondary, Codec::None)?);
+                    std::fs::remove_dir_all(&plain_dir).map_err(|e| input(e.to_string()))?;
+                    ctx.checkpoint.save(&plain_key, &step)?;
+                    step
+                }
+            };
+            m.write_plain_s = write_plain_s;
+            m.plain = Some(run);
         }
         measured.push(m);
     }
+    let p = Published { rows: rows_run, ..p };
     let rows = rows(&p, &measured);
     let doc = document(&p, &measured, size, traced, ctx.quick);
     Ok(Output::new(
