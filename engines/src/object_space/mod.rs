@@ -137,6 +137,15 @@ impl ObjectSpace {
         &self.owner
     }
 
+    /// Clocks of testing every primitive of subspace `s` (Table 4's per-test costs): the work
+    /// of any ray's visit that does not stop at its first blocker.
+    pub fn subspace_work(&self, s: usize) -> u32 {
+        self.subspaces
+            .prims_in(s)
+            .iter()
+            .fold(0u32, |w, &p| w.saturating_add(self.test_cost[p as usize]))
+    }
+
     /// Whether `p` lies inside the subspace grid's box.
     pub fn inside(&self, p: glam::Vec3) -> bool {
         let g = &self.subspaces;
