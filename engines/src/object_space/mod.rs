@@ -36,6 +36,7 @@
 //! `sim_events`, `sim_packets`, `sim_hops`, `sim_waves`.
 
 pub mod config;
+pub mod fbpath;
 pub mod framebuffer;
 pub mod machine;
 pub mod queueing;

@@ -369,7 +369,10 @@ fn execute_shot(
                 // A subspace's work is all its primitives' tests (no shadow rays here), which
                 // the simulation reads from the subspace ([`ObjectSpace::subspace_work`]).
                 debug_assert_eq!(sg.work, os.subspace_work(sg.subspace as usize));
-                assert!(sg.subspace <= SUBSPACE, "too many subspaces for a segment word");
+                assert!(
+                    sg.subspace <= SUBSPACE,
+                    "too many subspaces for a segment word"
+                );
                 let mut w = sg.subspace;
                 if k == 0 {
                     w |= FIRST;
@@ -604,7 +607,11 @@ impl Router {
                 continue;
             }
             let n = self.pes[i];
-            let up = if b[i] > a[i] { b[i] - a[i] } else { b[i] + n - a[i] };
+            let up = if b[i] > a[i] {
+                b[i] - a[i]
+            } else {
+                b[i] + n - a[i]
+            };
             let down = n - up;
             let (d, dir) = if up <= down { (up, 0) } else { (down, 1) };
             hops += d;
@@ -767,7 +774,11 @@ pub fn simulate(
                     continue;
                 }
                 let to = sub[(sh.segs[r.seg_start as usize] & SUBSPACE) as usize].0;
-                let at = if to == pe { t } else { send(pe, to, t, &mut run) };
+                let at = if to == pe {
+                    t
+                } else {
+                    send(pe, to, t, &mut run)
+                };
                 arrive(
                     at,
                     Ev::Arrive {
@@ -831,7 +842,11 @@ pub fn simulate(
                 next,
             } => {
                 if next != NONE {
-                    let at = if next == pe { t } else { send(pe, next, t, &mut run) };
+                    let at = if next == pe {
+                        t
+                    } else {
+                        send(pe, next, t, &mut run)
+                    };
                     arrive(
                         at,
                         Ev::Arrive {
@@ -865,7 +880,11 @@ pub fn simulate(
                             *pending -= 1;
                         } else {
                             let to = sub[(sh.segs[child.seg_start as usize] & SUBSPACE) as usize].0;
-                            let at = if to == pe { t } else { send(pe, to, t, &mut run) };
+                            let at = if to == pe {
+                                t
+                            } else {
+                                send(pe, to, t, &mut run)
+                            };
                             arrive(
                                 at,
                                 Ev::Arrive {
