@@ -25,7 +25,7 @@
 //! | `pes` | `N`, `NxM`, `NxMxK` | `16` | PEs per axis of a 1D, 2D or 3D torus; each must divide the subspaces on its axis |
 //! | `allocation` | `block`, `distributed`, `skewed` | `skewed` | subspace → PE (003 eqs. 7–10; skewed on 1D and 2D only) |
 //! | `rp_blocks` | 1–4096 | 1 | ray-processing blocks per PE (dynamic load balancing) |
-//! | `frame_buffer` | `direct`, `cfbs:M` | `direct` | intensity packets straight to the GFB, or through an M-ary cache tree |
+//! | `frame_buffer` | `direct`, `cfbs:M`, `wb:M` | `direct` | intensity packets straight to the GFB, or through an M-ary tree of caches or of write buffers |
 //! | `cost.<name>` | clocks > 0 | Table 4/5 | `primary` 4379, `triangle` 1028, `sphere` 1737, `cone` 2446, `intensity` 349, `dda_init` 3151, `dda` 1106, `secondary` 1818, `packet` 164, `hop` 164, `fb_hit` 12, `fb_miss` 7, `fb_dirty` 4, `gfb` 14, `fb_link` 8, `fb_block_link` 64 |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //!
