@@ -70,6 +70,9 @@ pub enum FrameBuffer {
     Direct,
     /// The cached frame buffer system: an m-ary tree of frame-buffer caches.
     Cached { m: u32 },
+    /// The same tree with write buffers in place of the caches (003 §4.3.2's third case): they
+    /// queue packets and pass each on, adding nothing up ([`super::fbpath`]).
+    WriteBuffer { m: u32 },
 }
 
 impl std::str::FromStr for FrameBuffer {
@@ -77,9 +80,13 @@ impl std::str::FromStr for FrameBuffer {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "direct" => Ok(FrameBuffer::Direct),
-            _ => match s.strip_prefix("cfbs:").map(str::parse::<u32>) {
-                Some(Ok(m)) if m >= 2 => Ok(FrameBuffer::Cached { m }),
-                _ => Err("expected direct or cfbs:M (an m-ary cache tree, M at least 2)".into()),
+            _ => match (
+                s.strip_prefix("cfbs:").map(str::parse::<u32>),
+                s.strip_prefix("wb:").map(str::parse::<u32>),
+            ) {
+                (Some(Ok(m)), _) if m >= 2 => Ok(FrameBuffer::Cached { m }),
+                (_, Some(Ok(m))) if m >= 2 => Ok(FrameBuffer::WriteBuffer { m }),
+                _ => Err("expected direct, cfbs:M or wb:M (an m-ary tree of caches or write buffers, M at least 2)".into()),
             },
         }
     }

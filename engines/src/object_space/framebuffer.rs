@@ -104,7 +104,9 @@ pub fn simulate(
     // The first links (C_1), one per PE.
     through_links(&mut items, pes as usize, costs.fb_link as u64);
     let stages = match fb {
-        FrameBuffer::Direct => 1,
+        // Unbounded write buffers add nothing up and never hold a PE: every packet reaches the
+        // GFB as if direct (with finite queues they are simulated in [`super::fbpath`]).
+        FrameBuffer::Direct | FrameBuffer::WriteBuffer { .. } => 1,
         FrameBuffer::Cached { m } => {
             let mut n = 1u32;
             let mut reach = m as u64;
@@ -118,7 +120,7 @@ pub fn simulate(
     let mut latency = vec![0u64; em.len()];
     let m = match fb {
         FrameBuffer::Cached { m } => m,
-        FrameBuffer::Direct => pes.max(1),
+        FrameBuffer::Direct | FrameBuffer::WriteBuffer { .. } => pes.max(1),
     };
     let total_blocks = bw as u64 * width.div_ceil(4) as u64;
     let sets = ((total_blocks / 128 / 2).max(1)) as usize;

@@ -25,7 +25,7 @@
 //! | `pes` | `N`, `NxM`, `NxMxK` | `16` | PEs per axis of a 1D, 2D or 3D torus; each must divide the subspaces on its axis |
 //! | `allocation` | `block`, `distributed`, `skewed` | `skewed` | subspace → PE (003 eqs. 7–10; skewed on 1D and 2D only) |
 //! | `rp_blocks` | 1–4096 | 1 | ray-processing blocks per PE (dynamic load balancing) |
-//! | `frame_buffer` | `direct`, `cfbs:M` | `direct` | intensity packets straight to the GFB, or through an M-ary cache tree |
+//! | `frame_buffer` | `direct`, `cfbs:M`, `wb:M` | `direct` | intensity packets straight to the GFB, or through an M-ary tree of caches or of write buffers |
 //! | `cost.<name>` | clocks > 0 | Table 4/5 | `primary` 4379, `triangle` 1028, `sphere` 1737, `cone` 2446, `intensity` 349, `dda_init` 3151, `dda` 1106, `secondary` 1818, `packet` 164, `hop` 164, `fb_hit` 12, `fb_miss` 7, `fb_dirty` 4, `gfb` 14, `fb_link` 8, `fb_block_link` 64 |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //!
@@ -36,6 +36,7 @@
 //! `sim_events`, `sim_packets`, `sim_hops`, `sim_waves`.
 
 pub mod config;
+pub mod fbpath;
 pub mod framebuffer;
 pub mod machine;
 pub mod queueing;
@@ -135,6 +136,15 @@ impl ObjectSpace {
     /// The PE of every subspace under the configured machine.
     pub fn owner(&self) -> &[u32] {
         &self.owner
+    }
+
+    /// Clocks of testing every primitive of subspace `s` (Table 4's per-test costs): the work
+    /// of any ray's visit that does not stop at its first blocker.
+    pub fn subspace_work(&self, s: usize) -> u32 {
+        self.subspaces
+            .prims_in(s)
+            .iter()
+            .fold(0u32, |w, &p| w.saturating_add(self.test_cost[p as usize]))
     }
 
     /// Whether `p` lies inside the subspace grid's box.

@@ -69,6 +69,8 @@ pub struct Patches {
     pub ks: Vec<f32>,
     /// First primitive of each object (for the normals of specular elements).
     pub first_prim: Vec<u32>,
+    /// Each patch's shot, executed once and kept ([`ShotCache`]).
+    pub shots: ShotCache,
 }
 
 impl Patches {
@@ -89,6 +91,7 @@ impl Patches {
             emission: vec![Vec3::ZERO; n],
             ks: vec![0.0; n],
             first_prim: vec![u32::MAX; n],
+            shots: ShotCache::new(n),
         };
         for (i, &o) in prim_object.iter().enumerate().rev() {
             p.first_prim[o as usize] = i as u32;
@@ -195,11 +198,100 @@ struct ShotRay {
     root: bool,
 }
 
-/// A shot's rays executed: roots in pixel order, each followed by its reflections.
+/// A shot's rays executed: roots in pixel order, each followed by its reflections; per subspace
+/// visit one word: the subspace and what the RP block does after its tests ([`FIRST`], [`LAST`],
+/// [`TAIL`]), so that a packet's step reads one word of the shot.
 #[derive(Default)]
-struct Shot {
+pub struct Shot {
     rays: Vec<ShotRay>,
-    segs: Vec<Segment>,
+    segs: Vec<u32>,
+}
+
+/// Segment word: the ray's first subspace (3D-DDA with initialisation).
+const FIRST: u32 = 1 << 31;
+/// Segment word: the ray's last subspace; bits 28-29 then say what follows the tests.
+const LAST: u32 = 1 << 30;
+const TAIL_SHIFT: u32 = 28;
+/// Segment word, last subspace: the hit's intensity (ICU), a reflection (SRGU), or the DDA
+/// finding no next subspace.
+const TAIL: u32 = 3 << TAIL_SHIFT;
+const TAIL_ICU: u32 = 0;
+const TAIL_SRGU: u32 = 1;
+const TAIL_DDA: u32 = 2;
+/// Segment word: the subspace (below 2^28).
+const SUBSPACE: u32 = (1 << TAIL_SHIFT) - 1;
+
+impl Shot {
+    /// Bytes held.
+    fn bytes(&self) -> u64 {
+        (self.rays.capacity() * std::mem::size_of::<ShotRay>() + self.segs.capacity() * 4) as u64
+    }
+}
+
+/// Every patch's shot, executed when first needed and kept: a shot's rays go where they go
+/// whatever the machine and whenever it is made (only their power differs), so the reference
+/// and every simulated machine on the same subspaces share one execution per patch (the
+/// machines may run on several threads). Up to a budget of bytes; past it shots are executed
+/// each time and not kept.
+pub struct ShotCache {
+    shots: Vec<std::sync::OnceLock<std::sync::Arc<Shot>>>,
+    bytes: std::sync::atomic::AtomicU64,
+}
+
+/// What the cache may hold (the full room's shots need about 1.5 GB at 32³ subspaces).
+const CACHE_BYTES: u64 = 4 << 30;
+
+impl ShotCache {
+    fn new(n: usize) -> ShotCache {
+        ShotCache {
+            shots: (0..n).map(|_| std::sync::OnceLock::new()).collect(),
+            bytes: Default::default(),
+        }
+    }
+
+    /// Bytes of the shots kept.
+    pub fn bytes(&self) -> u64 {
+        self.bytes.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Patch `i`'s shot.
+    fn get(
+        &self,
+        os: &ObjectSpace,
+        patches: &Patches,
+        cube: &[(Vec3, f32)],
+        i: usize,
+        c: &mut Counters,
+    ) -> std::sync::Arc<Shot> {
+        use std::sync::atomic::Ordering;
+        if let Some(s) = self.shots[i].get() {
+            return s.clone();
+        }
+        let mut shot = Shot::default();
+        execute_shot(os, patches, cube, i, &mut shot, c);
+        shot.rays.shrink_to_fit();
+        shot.segs.shrink_to_fit();
+        let shot = std::sync::Arc::new(shot);
+        if self.bytes.load(Ordering::Relaxed) + shot.bytes() <= CACHE_BYTES
+            && self.shots[i].set(shot.clone()).is_ok()
+        {
+            self.bytes.fetch_add(shot.bytes(), Ordering::Relaxed);
+        }
+        shot
+    }
+}
+
+impl Clone for ShotCache {
+    /// A clone starts empty (the shots are a cache).
+    fn clone(&self) -> Self {
+        ShotCache::new(self.shots.len())
+    }
+}
+
+impl std::fmt::Debug for ShotCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ShotCache({} bytes)", self.bytes())
+    }
 }
 
 /// The outward normal of specular element `o` at `p`.
@@ -231,15 +323,15 @@ fn execute_shot(
     let t = patches.tangent[i];
     let b = n.cross(t);
     let o = patches.origin(i);
+    let mut segs: Vec<Segment> = Vec::new();
     for &(d, ff) in cube {
         let dir = (t * d.x + b * d.y + n * d.z).normalize();
         let mut ray = Ray::new(o, dir, 0.0, f32::INFINITY);
         let mut fraction = ff;
         let mut root = true;
         for depth in 0..=MAX_REFLECTIONS {
-            let start = shot.segs.len() as u32;
-            let h = os.execute(&ray, false, &mut shot.segs, c);
-            let seg_count = shot.segs.len() as u32 - start;
+            segs.clear();
+            let h = os.execute(&ray, false, &mut segs, c);
             let mut next = None;
             let end = if !h.is_hit() {
                 End::Lost { hit: false }
@@ -267,9 +359,32 @@ fn execute_shot(
                     End::Lost { hit: true }
                 }
             };
+            let tail = match end {
+                End::Deposit { .. } | End::Lost { hit: true } => TAIL_ICU,
+                End::Reflect => TAIL_SRGU,
+                End::Lost { hit: false } => TAIL_DDA,
+            };
+            let start = shot.segs.len() as u32;
+            for (k, sg) in segs.iter().enumerate() {
+                // A subspace's work is all its primitives' tests (no shadow rays here), which
+                // the simulation reads from the subspace ([`ObjectSpace::subspace_work`]).
+                debug_assert_eq!(sg.work, os.subspace_work(sg.subspace as usize));
+                assert!(
+                    sg.subspace <= SUBSPACE,
+                    "too many subspaces for a segment word"
+                );
+                let mut w = sg.subspace;
+                if k == 0 {
+                    w |= FIRST;
+                }
+                if k + 1 == segs.len() {
+                    w |= LAST | (tail << TAIL_SHIFT);
+                }
+                shot.segs.push(w);
+            }
             shot.rays.push(ShotRay {
                 seg_start: start,
-                seg_count,
+                seg_count: segs.len() as u32,
                 end,
                 fraction,
                 root,
@@ -394,7 +509,6 @@ pub fn check_threshold(threshold: f32) -> Result<(), String> {
 pub fn reference(os: &ObjectSpace, patches: &Patches, threshold: f32) -> Solution {
     let cube = hemicube();
     let mut s = Solution::start(patches);
-    let mut shot = Shot::default();
     let mut c = Counters::default();
     loop {
         let mut best = None;
@@ -408,7 +522,7 @@ pub fn reference(os: &ObjectSpace, patches: &Patches, threshold: f32) -> Solutio
         let Some(i) = best else { break };
         let power = s.unshot[i] * patches.area[i];
         s.unshot[i] = Vec3::ZERO;
-        execute_shot(os, patches, &cube, i, &mut shot, &mut c);
+        let shot = patches.shots.get(os, patches, &cube, i, &mut c);
         s.apply(&shot, power);
     }
     s
@@ -467,6 +581,48 @@ enum Ev {
 
 const NONE: u32 = u32::MAX;
 
+/// The torus's PE coordinates, for routing without divisions per packet.
+struct Router {
+    pes: [u32; 3],
+    coords: Vec<[u32; 3]>,
+}
+
+impl Router {
+    fn new(machine: &Machine) -> Router {
+        Router {
+            pes: machine.pes,
+            coords: (0..machine.pe_count() as u32)
+                .map(|p| machine.pe_coords(p))
+                .collect(),
+        }
+    }
+
+    /// [`Machine::route`]: hops, and the first hop's outgoing link.
+    fn route(&self, from: u32, to: u32) -> (u32, usize) {
+        let (a, b) = (self.coords[from as usize], self.coords[to as usize]);
+        let mut hops = 0;
+        let mut link = usize::MAX;
+        for i in 0..3 {
+            if a[i] == b[i] {
+                continue;
+            }
+            let n = self.pes[i];
+            let up = if b[i] > a[i] {
+                b[i] - a[i]
+            } else {
+                b[i] + n - a[i]
+            };
+            let down = n - up;
+            let (d, dir) = if up <= down { (up, 0) } else { (down, 1) };
+            hops += d;
+            if link == usize::MAX {
+                link = 2 * i + dir;
+            }
+        }
+        (hops, if link == usize::MAX { 0 } else { link })
+    }
+}
+
 /// The radiosity pass on `machine` (subspace owners `owner`) until no delta-radiosity ray
 /// remains and no PE has a patch above `threshold`.
 pub fn simulate(
@@ -480,6 +636,13 @@ pub fn simulate(
     let cube = hemicube();
     let pes = machine.pe_count();
     let rpb = machine.rp_blocks as usize;
+    let router = Router::new(machine);
+    // Per subspace: its PE and its tests' clocks (one load per packet step).
+    let sub: Vec<(u32, u32)> = owner
+        .iter()
+        .enumerate()
+        .map(|(s, &pe)| (pe, os.subspace_work(s)))
+        .collect();
     let mut sol = Solution::start(patches);
     // Each patch's PE: the owner of the subspace holding its ray origin.
     let lattice = &os.subspaces.lattice;
@@ -499,22 +662,47 @@ pub fn simulate(
         ..Default::default()
     };
     let mut heap = RadixHeap::default();
-    let push = |heap: &mut RadixHeap<Ev>, t: u64, e: Ev| heap.push(t, e);
     let mut frgu_idle = vec![false; pes];
     for pe in 0..pes {
-        push(&mut heap, 0, Ev::Pick(pe as u32));
+        heap.push(0, Ev::Pick(pe as u32));
     }
-    // Shots in flight: (executed rays, power, rays not yet finished); freed slots are reused.
-    let mut shots: Vec<(Shot, Vec3, u32)> = Vec::new();
+    // Shots in flight: (the shot, power, rays not yet finished); freed slots are reused.
+    let mut shots: Vec<(std::sync::Arc<Shot>, Vec3, u32)> = Vec::new();
     let mut free: Vec<u32> = Vec::new();
     let mut rp_free = vec![0u64; pes * rpb];
     let mut busy = vec![0u64; pes];
     let mut link_free = vec![0u64; pes * 6];
     let mut c = Counters::default();
-    let seg_pe = |sh: &Shot, k: u32| owner[sh.segs[k as usize].subspace as usize];
+    let mut send = |from: u32, to: u32, t: u64, run: &mut RadiosityRun| -> u64 {
+        let (hops, link) = router.route(from, to);
+        let lf = &mut link_free[from as usize * 6 + link];
+        let start = t.max(*lf);
+        *lf = start + costs.hop as u64;
+        run.packets += 1;
+        run.hops += hops as u64;
+        start + hops as u64 * costs.hop as u64
+    };
     let mut last = 0u64;
-    while let Some((t, ev)) = heap.pop() {
+    // An arrival at the current time is handled next without going through the heap: the heap
+    // pops events of one time last-pushed first, so it would have come out next all the same.
+    let mut now: Option<Ev> = None;
+    loop {
+        let (t, ev) = match now.take() {
+            Some(e) => (last, e),
+            None => match heap.pop() {
+                Some(x) => x,
+                None => break,
+            },
+        };
         last = t;
+        let mut arrive = |at: u64, e: Ev, heap: &mut RadixHeap<Ev>| {
+            if at == t {
+                debug_assert!(now.is_none());
+                now = Some(e);
+            } else {
+                heap.push(at, e);
+            }
+        };
         match ev {
             Ev::Pick(pe) => {
                 let mut best = None;
@@ -531,20 +719,24 @@ pub fn simulate(
                 };
                 let power = sol.unshot[i] * patches.area[i];
                 sol.unshot[i] = Vec3::ZERO;
-                let slot = free.pop().unwrap_or_else(|| {
-                    shots.push((Shot::default(), Vec3::ZERO, 0));
-                    shots.len() as u32 - 1
-                });
-                let (shot, p, pending) = &mut shots[slot as usize];
-                execute_shot(os, patches, &cube, i, shot, &mut c);
-                *p = power;
-                *pending = shot.rays.len() as u32;
+                let shot = patches.shots.get(os, patches, &cube, i, &mut c);
                 sol.shots += 1;
                 sol.rays += shot.rays.len() as u64;
                 sol.subspace_visits += shot.segs.len() as u64;
-                let first = next_root(shot, 0);
-                push(
-                    &mut heap,
+                let first = next_root(&shot, 0);
+                let slot = match free.pop() {
+                    Some(k) => {
+                        shots[k as usize] = (shot, power, 0);
+                        k
+                    }
+                    None => {
+                        shots.push((shot, power, 0));
+                        shots.len() as u32 - 1
+                    }
+                };
+                let entry = &mut shots[slot as usize];
+                entry.2 = entry.0.rays.len() as u32;
+                heap.push(
                     t + HEMICUBE_SETUP,
                     Ev::Emit {
                         pe,
@@ -561,8 +753,7 @@ pub fn simulate(
                     // than one of its PE's RP blocks is free.
                     let p = pe as usize;
                     let rp_ready = rp_free[p * rpb..p * rpb + rpb].iter().copied().min();
-                    push(
-                        &mut heap,
+                    heap.push(
                         (t + costs.primary as u64).max(rp_ready.unwrap_or(0)),
                         Ev::Emit {
                             pe,
@@ -571,7 +762,7 @@ pub fn simulate(
                         },
                     );
                 } else {
-                    push(&mut heap, t, Ev::Pick(pe));
+                    heap.push(t, Ev::Pick(pe));
                 }
                 let r = sh.rays[ray as usize];
                 if r.seg_count == 0 {
@@ -582,14 +773,13 @@ pub fn simulate(
                     }
                     continue;
                 }
-                let to = seg_pe(sh, r.seg_start);
+                let to = sub[(sh.segs[r.seg_start as usize] & SUBSPACE) as usize].0;
                 let at = if to == pe {
                     t
                 } else {
-                    send(machine, costs, &mut link_free, pe, to, t, &mut run)
+                    send(pe, to, t, &mut run)
                 };
-                push(
-                    &mut heap,
+                arrive(
                     at,
                     Ev::Arrive {
                         shot,
@@ -597,30 +787,33 @@ pub fn simulate(
                         seg: r.seg_start,
                         pe: to,
                     },
+                    &mut heap,
                 );
             }
             Ev::Arrive { shot, ray, seg, pe } => {
                 run.events += 1;
-                let sh = &shots[shot as usize].0;
-                let r = sh.rays[ray as usize];
-                let is_last = seg + 1 == r.seg_start + r.seg_count;
-                let next = if is_last { NONE } else { seg_pe(sh, seg + 1) };
-                let pe = pe as usize;
-                let tail = if !is_last {
-                    (if seg == r.seg_start {
+                let segs = &shots[shot as usize].0.segs;
+                let w = segs[seg as usize];
+                let work = sub[(w & SUBSPACE) as usize].1;
+                let (next, tail) = if w & LAST == 0 {
+                    let next = sub[(segs[seg as usize + 1] & SUBSPACE) as usize].0;
+                    let dda = if w & FIRST != 0 {
                         costs.dda_init
                     } else {
                         costs.dda
-                    }) + costs.packet
+                    };
+                    (next, dda + costs.packet)
                 } else {
-                    match r.end {
-                        End::Deposit { .. } | End::Lost { hit: true } => costs.intensity,
-                        End::Reflect => costs.secondary,
-                        End::Lost { hit: false } => costs.dda,
-                    }
+                    let tail = match (w & TAIL) >> TAIL_SHIFT {
+                        TAIL_ICU => costs.intensity,
+                        TAIL_SRGU => costs.secondary,
+                        _ => costs.dda,
+                    };
+                    (NONE, tail)
                 };
-                let cost = sh.segs[seg as usize].work.saturating_add(tail) as u64;
-                let blocks = &mut rp_free[pe * rpb..pe * rpb + rpb];
+                let cost = work.saturating_add(tail) as u64;
+                let p = pe as usize;
+                let blocks = &mut rp_free[p * rpb..p * rpb + rpb];
                 let mut b = 0;
                 for (j, &f) in blocks.iter().enumerate().skip(1) {
                     if f < blocks[b] {
@@ -629,15 +822,14 @@ pub fn simulate(
                 }
                 let end = t.max(blocks[b]) + cost;
                 blocks[b] = end;
-                busy[pe] += cost;
-                push(
-                    &mut heap,
+                busy[p] += cost;
+                heap.push(
                     end,
                     Ev::Done {
                         shot,
                         ray,
                         seg,
-                        pe: pe as u32,
+                        pe,
                         next,
                     },
                 );
@@ -653,10 +845,9 @@ pub fn simulate(
                     let at = if next == pe {
                         t
                     } else {
-                        send(machine, costs, &mut link_free, pe, next, t, &mut run)
+                        send(pe, next, t, &mut run)
                     };
-                    push(
-                        &mut heap,
+                    arrive(
                         at,
                         Ev::Arrive {
                             shot,
@@ -664,6 +855,7 @@ pub fn simulate(
                             seg: seg + 1,
                             pe: next,
                         },
+                        &mut heap,
                     );
                     continue;
                 }
@@ -679,7 +871,7 @@ pub fn simulate(
                         let q = patch_pe[j] as usize;
                         if frgu_idle[q] && sol.unshot[j].max_element() > threshold {
                             frgu_idle[q] = false;
-                            push(&mut heap, t, Ev::Pick(q as u32));
+                            heap.push(t, Ev::Pick(q as u32));
                         }
                     }
                     End::Reflect => {
@@ -687,14 +879,13 @@ pub fn simulate(
                         if child.seg_count == 0 {
                             *pending -= 1;
                         } else {
-                            let to = seg_pe(sh, child.seg_start);
+                            let to = sub[(sh.segs[child.seg_start as usize] & SUBSPACE) as usize].0;
                             let at = if to == pe {
                                 t
                             } else {
-                                send(machine, costs, &mut link_free, pe, to, t, &mut run)
+                                send(pe, to, t, &mut run)
                             };
-                            push(
-                                &mut heap,
+                            arrive(
                                 at,
                                 Ev::Arrive {
                                     shot,
@@ -702,6 +893,7 @@ pub fn simulate(
                                     seg: child.seg_start,
                                     pe: to,
                                 },
+                                &mut heap,
                             );
                         }
                     }
@@ -726,26 +918,6 @@ fn next_root(shot: &Shot, mut k: u32) -> u32 {
         k += 1;
     }
     k
-}
-
-/// Sends a packet from `from` to `to` on the torus: the first hop's link sends one packet at a
-/// time; returns the arrival time.
-fn send(
-    machine: &Machine,
-    costs: &Costs,
-    link_free: &mut [u64],
-    from: u32,
-    to: u32,
-    t: u64,
-    run: &mut RadiosityRun,
-) -> u64 {
-    let (hops, link) = machine.route(from, to);
-    let lf = &mut link_free[from as usize * 6 + link];
-    let start = t.max(*lf);
-    *lf = start + costs.hop as u64;
-    run.packets += 1;
-    run.hops += hops as u64;
-    start + hops as u64 * costs.hop as u64
 }
 
 /// A monotone priority queue on clocks (a radix heap): pops in time order, events of the same
@@ -778,11 +950,15 @@ impl<T> RadixHeap<T> {
     fn pop(&mut self) -> Option<(u64, T)> {
         if self.buckets[0].is_empty() {
             let i = self.buckets.iter().position(|b| !b.is_empty())?;
-            let b = std::mem::take(&mut self.buckets[i]);
+            // Every entry of bucket i goes to a lower bucket: its allocation is kept for reuse
+            // (taking it would reallocate the buckets on every redistribution).
+            let mut b = std::mem::take(&mut self.buckets[i]);
             self.last = b.iter().map(|e| e.0).min()?;
-            for (k, v) in b {
+            for (k, v) in b.drain(..) {
                 self.buckets[Self::bucket(self.last, k)].push((k, v));
             }
+            debug_assert!(self.buckets[i].is_empty());
+            self.buckets[i] = b;
         }
         self.buckets[0].pop()
     }

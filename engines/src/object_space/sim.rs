@@ -15,12 +15,16 @@
 //! - NIU and links: a packet for a subspace of another PE goes out on the link towards it,
 //!   each link sending one packet at a time (164 clocks a hop); a subspace of the same PE goes
 //!   back to its RD at no transmission cost.
-//! - Intensity packets go to the frame buffer ([`super::framebuffer`]); the PEs do not wait.
+//! - Intensity packets go to the frame buffer: with unbounded queues ([`simulate`]) the PEs do
+//!   not wait and the frame buffer is simulated after them ([`super::framebuffer`]); with finite
+//!   queues ([`simulate_path`], [`super::fbpath`]) an RP block whose packet finds its PE's queue
+//!   full waits until it is taken, and its queued work with it.
 //!
 //! The image time is when the last RP block and the frame buffer are both done. Events are
 //! ordered by (time, ray, segment, kind), which is unique, so a run is deterministic.
 
 use super::config::{Costs, FrameBuffer};
+use super::fbpath::{FbPath, Path};
 use super::framebuffer::{self, Emission, FrameBufferStats};
 use super::machine::Machine;
 use super::trace::{Trace, NO_PIXEL};
@@ -37,6 +41,10 @@ pub struct SimResult {
     pub pe_clocks: u64,
     /// When the busiest FRGU had made its last initial ray.
     pub frgu_clocks: u64,
+    /// Clocks RP blocks waited for room in their PE's frame-buffer queue, in all and on the
+    /// block that waited longest (finite queues only).
+    pub fb_stall: u64,
+    pub fb_stall_max: u64,
     /// Clocks the RP blocks were busy, in all and on the busiest PE.
     pub busy: u64,
     pub busy_max_pe: u64,
@@ -74,6 +82,8 @@ enum Source {
     Done(u32),
     /// The next initial ray of PE `p`'s FRGU.
     Frgu(u32),
+    /// Frame-buffer station `s` finishes a service ([`super::fbpath`]).
+    Fb(u32),
 }
 
 type Event = (u64, u32, u32, Source);
@@ -138,7 +148,40 @@ pub fn simulate(
     frame_buffer: FrameBuffer,
     width: u32,
 ) -> SimResult {
+    let queue = match frame_buffer {
+        FrameBuffer::WriteBuffer { .. } => u32::MAX,
+        _ => 0,
+    };
+    simulate_path(
+        trace,
+        machine,
+        owner,
+        costs,
+        FbPath {
+            kind: frame_buffer,
+            queue,
+        },
+        width,
+    )
+}
+
+/// [`simulate`] with the frame-buffer path's queues of `path.queue` entries (0: unbounded, the
+/// frame buffer simulated after the PEs).
+pub fn simulate_path(
+    trace: &Trace,
+    machine: &Machine,
+    owner: &[u32],
+    costs: &Costs,
+    path: FbPath,
+    width: u32,
+) -> SimResult {
     let pes = machine.pe_count();
+    let queue = path.queue;
+    let mut fb = (queue > 0).then(|| Path::new(path, pes as u32, costs, width));
+    // Per RP block: waiting since (for room for its head's packet), and whether the head's
+    // packet has been taken.
+    let mut stalled_at = vec![u64::MAX; pes * machine.rp_blocks as usize];
+    let mut emitted = vec![false; pes * machine.rp_blocks as usize];
     let rpb = machine.rp_blocks as usize;
     let steps = steps(trace, owner, costs);
     let mut rp_free = vec![0u64; pes * rpb];
@@ -205,8 +248,49 @@ pub fn simulate(
                     heap.push(Reverse((frgu_time[p], next, kn, Source::Frgu(p as u32))));
                 }
             }
+            Source::Fb(st) => {
+                let f = fb.as_mut().expect("frame-buffer events need the path");
+                f.done(st, t, queue);
+                drain(
+                    f,
+                    &mut heap,
+                    &mut fifo,
+                    &mut rp_free,
+                    &mut stalled_at,
+                    &mut emitted,
+                    &mut r,
+                );
+                continue;
+            }
             Source::Done(b) => {
-                let q = &mut fifo[b as usize];
+                let ray = &trace.rays[ri as usize];
+                let bu = b as usize;
+                // An intensity packet must find room in its PE's queue, else the block waits.
+                if let Some(f) = fb.as_mut() {
+                    let last = fifo[bu].front().expect("a FIFO head is in the heap").3 == NONE;
+                    if last && ray.hit && ray.pixel != NO_PIXEL && !emitted[bu] {
+                        let pe = b / rpb as u32;
+                        if f.emit(pe, b, ray.pixel, t, queue) {
+                            emitted[bu] = true;
+                        } else {
+                            stalled_at[bu] = t;
+                        }
+                        drain(
+                            f,
+                            &mut heap,
+                            &mut fifo,
+                            &mut rp_free,
+                            &mut stalled_at,
+                            &mut emitted,
+                            &mut r,
+                        );
+                        if !emitted[bu] {
+                            continue;
+                        }
+                    }
+                }
+                emitted[bu] = false;
+                let q = &mut fifo[bu];
                 let (_, _, _, next) = q.pop_front().expect("a FIFO head is in the heap");
                 if let Some(&(te, rn, kn, _)) = q.front() {
                     heap.push(Reverse((te, rn, kn, Source::Done(b))));
@@ -222,11 +306,10 @@ pub fn simulate(
                     arrive((at, ri, k + 1, Source::Arrival), &mut heap, &mut next_event);
                     continue;
                 }
-                let ray = &trace.rays[ri as usize];
                 if !ray.hit {
                     continue;
                 }
-                if ray.pixel != NO_PIXEL {
+                if ray.pixel != NO_PIXEL && fb.is_none() {
                     emissions.push(Emission {
                         time: t,
                         pe,
@@ -283,7 +366,41 @@ pub fn simulate(
     r.frgu_clocks = frgu_time.iter().copied().max().unwrap_or(0);
     r.busy = busy.iter().sum();
     r.busy_max_pe = busy.iter().copied().max().unwrap_or(0);
-    r.frame_buffer = framebuffer::simulate(&mut emissions, pes as u32, costs, frame_buffer, width);
+    r.pe_clocks = r.pe_clocks.max(rp_free.iter().copied().max().unwrap_or(0));
+    r.frame_buffer = match fb {
+        Some(f) => f.finish(),
+        None => framebuffer::simulate(&mut emissions, pes as u32, costs, path.kind, width),
+    };
     r.clocks = r.pe_clocks.max(r.frame_buffer.finish);
     r
+}
+
+/// After a call into the frame-buffer path: schedules its stations' events and resumes the RP
+/// blocks whose packets it took, their queued work shifted by the wait.
+fn drain(
+    f: &mut Path,
+    heap: &mut BinaryHeap<Reverse<Event>>,
+    fifo: &mut [VecDeque<(u64, u32, u32, u32)>],
+    rp_free: &mut [u64],
+    stalled_at: &mut [u64],
+    emitted: &mut [bool],
+    r: &mut SimResult,
+) {
+    for (t, s) in f.due.drain(..) {
+        heap.push(Reverse((t, u32::MAX, s, Source::Fb(s))));
+    }
+    for (t, b) in f.resumed.drain(..) {
+        let bu = b as usize;
+        let d = t - stalled_at[bu];
+        stalled_at[bu] = u64::MAX;
+        emitted[bu] = true;
+        r.fb_stall += d;
+        r.fb_stall_max = r.fb_stall_max.max(d);
+        for e in fifo[bu].iter_mut() {
+            e.0 += d;
+        }
+        rp_free[bu] += d;
+        let &(te, rn, kn, _) = fifo[bu].front().expect("a waiting block has its head");
+        heap.push(Reverse((te, rn, kn, Source::Done(b))));
+    }
 }

@@ -272,6 +272,55 @@ fn frame_buffer_caches_accumulate() {
     assert_eq!(s.latency_max, 8 + 14);
 }
 
+/// Finite frame-buffer queues (003 §4.3.2): with room enough nothing waits and the PEs' clocks
+/// are the unbounded run's; with one-entry queues and a GFB made slow (so the path saturates)
+/// RP blocks wait, the image takes longer, and the caches, which add packets up, beat write
+/// buffers, which pass every packet on to the GFB. Repeats are bit-identical.
+#[test]
+fn frame_buffer_back_pressure_stalls_the_pes() {
+    use super::fbpath::FbPath;
+    use super::sim::simulate_path;
+    let input = spd(Program::Balls, 2);
+    let os = ObjectSpace::build(&input, config(&[]).unwrap()).unwrap();
+    let rs = rays(&input, 4000);
+    let trace = root_trace(&os, &rs);
+    let m = Machine {
+        pes: [8, 8, 1],
+        dims: 2,
+        allocation: Allocation::Skewed,
+        rp_blocks: 8,
+    };
+    let owner = m.owner_map([32; 3]);
+    let run = |costs: &Costs, kind, queue| {
+        simulate_path(&trace, &m, &owner, costs, FbPath { kind, queue }, 64)
+    };
+    let costs = Costs::default();
+    let free = simulate(&trace, &m, &owner, &costs, FrameBuffer::Direct, 64);
+    let roomy = run(&costs, FrameBuffer::Direct, 1 << 20);
+    assert_eq!(roomy.fb_stall, 0);
+    assert_eq!(roomy.pe_clocks, free.pe_clocks);
+    assert_eq!(roomy.frame_buffer.packets, free.frame_buffer.packets);
+    let slow = Costs {
+        gfb: 20_000,
+        fb_hit: 2_000,
+        ..costs
+    };
+    let direct = run(&slow, FrameBuffer::Direct, 1);
+    assert!(direct.fb_stall > 0 && direct.pe_clocks > free.pe_clocks);
+    assert_eq!(direct.frame_buffer.packets, free.frame_buffer.packets);
+    let cfbs = run(&slow, FrameBuffer::Cached { m: 8 }, 1);
+    let wb = run(&slow, FrameBuffer::WriteBuffer { m: 8 }, 1);
+    assert!(cfbs.frame_buffer.hits > 0);
+    assert!(
+        cfbs.clocks < wb.clocks,
+        "cfbs {} wb {}",
+        cfbs.clocks,
+        wb.clocks
+    );
+    assert_eq!(cfbs, run(&slow, FrameBuffer::Cached { m: 8 }, 1));
+    assert_eq!(direct.busy, free.busy);
+}
+
 #[test]
 fn queueing_model_matches_the_digests_derived_checks() {
     // Derived in ../shared/seeds/003-digest.md §1.8 from eqs. 11-21 with Table 3.

@@ -12,9 +12,10 @@ use crate::source::Source;
 use crate::workload::{self, pass_003};
 use rayon::prelude::*;
 use rtbench_engines::object_space::config::{Costs, FrameBuffer, ObjectSpaceConfig};
+use rtbench_engines::object_space::fbpath::FbPath;
 use rtbench_engines::object_space::machine::{Allocation, Machine};
 use rtbench_engines::object_space::radiosity::{self, Patches};
-use rtbench_engines::object_space::sim::{simulate, SimResult};
+use rtbench_engines::object_space::sim::{simulate_path, SimResult};
 use rtbench_engines::object_space::ObjectSpace;
 use rtbench_reports::plot::{LegendAt, Panel, Point, Series, XyPanel};
 use serde::Serialize;
@@ -270,6 +271,21 @@ pub fn machine(pes: u32, dims: u8, allocation: Allocation, rp_blocks: u32) -> Ma
 /// Simulates each machine on `t` (in parallel over machines) with the given frame buffer (the
 /// radiosity pass sends no intensity packets): each run's result and its wall time.
 pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f64)> {
+    let paths: Vec<(Machine, FbPath)> = machines
+        .iter()
+        .map(|&(m, kind)| {
+            let queue = match kind {
+                FrameBuffer::WriteBuffer { .. } => u32::MAX,
+                _ => 0,
+            };
+            (m, FbPath { kind, queue })
+        })
+        .collect();
+    run_all_path(t, &paths)
+}
+
+/// [`run_all`] with the frame-buffer path's queue capacities ([`FbPath`]; 0: unbounded).
+pub fn run_all_path(t: &Traced, machines: &[(Machine, FbPath)]) -> Vec<(SimResult, f64)> {
     let s = t.os.config().subspaces;
     machines
         .par_iter()
@@ -286,7 +302,7 @@ pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResul
                 );
                 return (as_sim(&r), start.elapsed().as_secs_f64());
             }
-            let r = simulate(
+            let r = simulate_path(
                 &t.pass.trace,
                 m,
                 &m.owner_map(s),
