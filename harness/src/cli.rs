@@ -249,6 +249,10 @@ pub struct ReproduceArgs {
     /// Output folder (DIR/<id>.md, DIR/<id>.json).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Keep the steps a previous run of this id finished in DIR/.partial/<id>/ (nakamaru-3.3,
+    /// nakamaru-3.2 save them) and measure only the rest.
+    #[arg(long)]
+    pub resume: bool,
     /// Engines, comma-separated (default: every available engine but `reference`).
     #[arg(long)]
     pub engines: Option<String>,

@@ -78,7 +78,7 @@ fn run(cli: Cli) -> Result<()> {
                 .out
                 .as_deref()
                 .ok_or_else(|| error::input("reproduce: --out DIR is required"))?;
-            reproduce::run(&a.id, a.quick, out, reproduce_pairs(&a)?, a.json)
+            reproduce::run(&a.id, a.quick, out, a.resume, reproduce_pairs(&a)?, a.json)
         }
     }
 }

@@ -10,6 +10,7 @@
 //!
 //! Adding a table: a file here, one line in [`TABLES`], its `data/published/<id>.json`.
 
+mod checkpoint;
 mod claims;
 mod params;
 mod published;
@@ -19,6 +20,7 @@ mod writer;
 mod engine_timing;
 mod object_space_pass;
 
+pub use checkpoint::Checkpoint;
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
 pub use params::{parse_set, Param, Params};
 pub use table::{environment, Ctx, Image, Output, Runtime, Table};
@@ -48,6 +50,7 @@ registry! {
     nakamaru_3_1,
     nakamaru_3_2,
     nakamaru_3_3,
+    nakamaru_4_1,
     nakamaru_fig3_2,
     nakamaru_fig3_3,
     yamauchi_static_lb,
@@ -113,23 +116,28 @@ pub fn list(as_json: bool) -> Result<()> {
     Ok(())
 }
 
-/// `rtbench reproduce <id> [--quick] --out DIR [options]`.
+/// `rtbench reproduce <id> [--quick] --out DIR [--resume] [options]`.
 pub fn run(
     id: &str,
     quick: bool,
     out: &Path,
+    resume: bool,
     pairs: Vec<(String, String)>,
     as_json: bool,
 ) -> Result<()> {
     let table = find(id)?;
     let params = Params::new(table.id, pairs, table.params)?;
+    let checkpoint = Checkpoint::open(out, table.id, resume)?;
     let ctx = Ctx {
         id: table.id,
         quick,
         params: &params,
+        checkpoint: &checkpoint,
     };
     let output = (table.run)(&ctx)?;
-    writer::write(table, out, output, as_json)
+    writer::write(table, out, output, as_json)?;
+    checkpoint.finish();
+    Ok(())
 }
 
 #[cfg(test)]

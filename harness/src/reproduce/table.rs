@@ -1,7 +1,7 @@
 //! What a reproduction is, as the registry and the writer see it: a [`Table`] (id, source, claims,
 //! options, `run`), the context its run gets, and the [`Output`] it returns.
 
-use super::{Claim, Param, Params, Row};
+use super::{Checkpoint, Claim, Param, Params, Row};
 use crate::error::Result;
 use rtbench_reports::plot::Chart;
 use rtbench_reports::Document;
@@ -35,6 +35,8 @@ pub struct Ctx<'a> {
     pub id: &'static str,
     pub quick: bool,
     pub params: &'a Params,
+    /// Finished steps of a long run (`--resume`); tables that take minutes ignore it.
+    pub checkpoint: &'a Checkpoint,
 }
 
 /// A PNG to write: path relative to the output folder, RGB8 pixels, square size.

@@ -1,0 +1,95 @@
+//! Partial progress of a long reproduction (`reproduce <id> --out DIR --resume`): a table saves each
+//! finished step as `DIR/.partial/<id>/<key>.json` and, resumed, loads it instead of measuring it
+//! again, so hours of tracing survive the end of a session. A run without `--resume` starts fresh
+//! (the folder is emptied); a finished run removes it. Keys must name everything the step's
+//! measurement depends on (scene, size factor, image size …).
+
+use crate::error::{input, Result};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+pub struct Checkpoint {
+    dir: PathBuf,
+    resume: bool,
+}
+
+impl Checkpoint {
+    /// Opens `out/.partial/<id>`; without `resume` anything saved there before is removed.
+    pub fn open(out: &Path, id: &str, resume: bool) -> Result<Checkpoint> {
+        let dir = out.join(".partial").join(id);
+        if !resume && dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(|e| input(format!("{}: {e}", dir.display())))?;
+        }
+        Ok(Checkpoint { dir, resume })
+    }
+
+    fn file(&self, key: &str) -> PathBuf {
+        self.dir.join(format!("{key}.json"))
+    }
+
+    /// The step saved under `key`, when resuming and it was saved; a file that does not parse is
+    /// refused (exit 2) rather than silently measured again.
+    pub fn load<T: DeserializeOwned>(&self, key: &str) -> Result<Option<T>> {
+        if !self.resume {
+            return Ok(None);
+        }
+        let f = self.file(key);
+        match std::fs::read(&f) {
+            Ok(bytes) => serde_json::from_slice(&bytes).map(Some).map_err(|e| {
+                input(format!(
+                    "{}: not a saved step ({e}); remove it to measure again",
+                    f.display()
+                ))
+            }),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(e) => Err(input(format!("{}: {e}", f.display()))),
+        }
+    }
+
+    /// Saves a finished step (written to a temporary file and renamed: never half a step).
+    pub fn save<T: Serialize>(&self, key: &str, step: &T) -> Result<()> {
+        std::fs::create_dir_all(&self.dir)
+            .map_err(|e| input(format!("{}: {e}", self.dir.display())))?;
+        let f = self.file(key);
+        let tmp = self.dir.join(format!(".{key}.json.tmp"));
+        let text = serde_json::to_vec_pretty(step).expect("steps serialise");
+        std::fs::write(&tmp, text)
+            .and_then(|_| std::fs::rename(&tmp, &f))
+            .map_err(|e| input(format!("{}: {e}", f.display())))
+    }
+
+    /// Removes the saved steps once the table's outputs are written.
+    pub fn finish(&self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+        if let Some(parent) = self.dir.parent() {
+            let _ = std::fs::remove_dir(parent);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_step_survives_only_a_resumed_run() {
+        let out = std::env::temp_dir().join(format!("rtbench-checkpoint-{}", std::process::id()));
+        let c = Checkpoint::open(&out, "t", false).unwrap();
+        c.save("a", &vec![1u32, 2]).unwrap();
+        assert_eq!(
+            c.load::<Vec<u32>>("a").unwrap(),
+            None,
+            "not resuming: measure again"
+        );
+        let r = Checkpoint::open(&out, "t", true).unwrap();
+        assert_eq!(r.load::<Vec<u32>>("a").unwrap(), Some(vec![1, 2]));
+        assert_eq!(r.load::<Vec<u32>>("b").unwrap(), None);
+        std::fs::write(out.join(".partial/t/bad.json"), "{").unwrap();
+        assert!(r.load::<Vec<u32>>("bad").is_err());
+        let fresh = Checkpoint::open(&out, "t", false).unwrap();
+        assert!(!out.join(".partial/t/a.json").exists());
+        fresh.finish();
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
