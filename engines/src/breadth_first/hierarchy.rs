@@ -260,7 +260,12 @@ pub fn prepare(
     if let Some(info) = Hierarchy::open(h, Some(constants))? {
         return Ok((info, None));
     }
-    let stats = Hierarchy::build(h, constants, buffer)?;
+    let stats = Hierarchy::build(h, constants, buffer).map_err(|e| {
+        io::Error::new(
+            e.kind(),
+            format!("cannot build the bounding-box hierarchy: {e}"),
+        )
+    })?;
     let info = Hierarchy::open(h, Some(constants))?.ok_or_else(|| {
         io::Error::other(format!(
             "{}: hierarchy built but not found",
