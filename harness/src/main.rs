@@ -48,12 +48,14 @@ fn run(cli: Cli) -> Result<()> {
             output,
             layout,
             compress,
+            hierarchy,
             json,
         }) => commands::scene::store(
             &Source::from_args(&scene.scene, &scene.opts)?,
             &output,
             &layout,
             &compress,
+            hierarchy,
             json,
         ),
         Command::Scene(SceneCommand::Stats { scene, json }) => {

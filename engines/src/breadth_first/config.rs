@@ -131,6 +131,36 @@ pub struct BreadthFirstConfig {
     /// The out-of-core workload traces reflection and refraction rays (`secondary=on`), or
     /// eye and shadow rays only (`off`; seed 000 ran rings80 so, Fig. 3.9).
     pub secondary: bool,
+    /// Sweep through the store's bounding-box hierarchy, built at preprocessing when the store
+    /// has none of these constants (`hierarchy=on`; Ch.4's "B").
+    pub hierarchy: bool,
+    /// The hierarchy's constants given (`bh_s`, `bh_m`, `bh_l`, `bh_t`); the rest the thesis's.
+    pub bh: BhConstants,
+    /// Drop the store's files from the page cache after preprocessing and after every sweep
+    /// (`cache=cold`), so that each sweep reads the disk as on the thesis's 256 MB machine.
+    pub cold: bool,
+}
+
+/// Hierarchy constants set by the user (`None`: the thesis's for the scene).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BhConstants {
+    pub s: Option<f64>,
+    pub m: Option<u64>,
+    pub l: Option<u32>,
+    pub t: Option<f64>,
+}
+
+impl BhConstants {
+    /// The constants for a store of the scene `name`.
+    pub fn resolve(&self, name: &str) -> crate::store::Constants {
+        let d = crate::store::Constants::thesis(name);
+        crate::store::Constants {
+            s: self.s.unwrap_or(d.s),
+            m: self.m.unwrap_or(d.m),
+            l: self.l.unwrap_or(d.l),
+            t: self.t.unwrap_or(d.t),
+        }
+    }
 }
 
 pub use crate::store::Codec;
@@ -149,6 +179,22 @@ fn on_off(s: &mut Settings, key: &'static str) -> Result<bool, EngineError> {
 
 pub use crate::grid::config::Floor;
 
+/// An optional number: absent → `None`; present, it must parse and pass `ok`.
+fn opt_num<T: FromStr>(
+    s: &mut Settings,
+    key: &'static str,
+    ok: impl Fn(&T) -> bool,
+    what: &str,
+) -> Result<Option<T>, EngineError> {
+    let v: String = s.get(key, String::new())?;
+    if v.is_empty() {
+        return Ok(None);
+    }
+    match v.parse::<T>() {
+        Ok(x) if ok(&x) => Ok(Some(x)),
+        _ => Err(bad(key, &v, what)),
+    }
+}
 pub const DEFAULT_MEMORY: u64 = 1 << 30;
 pub const DEFAULT_BUFFER: u64 = 1 << 16;
 
@@ -221,6 +267,45 @@ impl BreadthFirstConfig {
             v => return Err(bad("spill_codec", v, "none or gzip")),
         };
         let secondary = on_off(&mut s, "secondary")?;
+        let hierarchy: String = s.get("hierarchy", "off".to_string())?;
+        let hierarchy =
+            match (hierarchy.as_str(), layout) {
+                ("off", _) => false,
+                ("on", Layout::Split) => true,
+                ("on", Layout::Basic) => return Err(bad(
+                    "hierarchy",
+                    "on",
+                    "the bounding-box hierarchy skips records of bbox.bin; it needs layout=split",
+                )),
+                (v, _) => return Err(bad("hierarchy", v, "on or off")),
+            };
+        let bh = BhConstants {
+            s: opt_num(
+                &mut s,
+                "bh_s",
+                |v: &f64| *v > 0.0 && v.is_finite(),
+                "a positive number",
+            )?,
+            m: opt_num(&mut s, "bh_m", |_: &u64| true, "a count")?,
+            l: opt_num(
+                &mut s,
+                "bh_l",
+                |v: &u32| (1..=crate::store::hierarchy::MAX_LEVELS).contains(v),
+                "levels, 1 to 16",
+            )?,
+            t: opt_num(
+                &mut s,
+                "bh_t",
+                |v: &f64| *v > 0.0 && v.is_finite(),
+                "a positive number",
+            )?,
+        };
+        let cache: String = s.get("cache", "warm".to_string())?;
+        let cold = match cache.as_str() {
+            "warm" => false,
+            "cold" => true,
+            v => return Err(bad("cache", v, "warm or cold")),
+        };
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -259,6 +344,9 @@ impl BreadthFirstConfig {
             max_rays: (max_rays > 0).then_some(max_rays),
             spill_codec,
             secondary,
+            hierarchy,
+            bh,
+            cold,
         })
     }
 }

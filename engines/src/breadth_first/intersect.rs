@@ -28,7 +28,7 @@ use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
-use crate::store::{IoCounters, ObjectRecord, SceneReader};
+use crate::store::{BboxRecord, IoCounters, ObjectRecord, SceneReader};
 use std::io;
 
 #[inline]
@@ -59,28 +59,53 @@ pub struct Work {
     pub(super) floor: Vec<(u32, ObjectRecord)>,
     /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
     pub(super) extent: f32,
+    /// The bounding-box hierarchy's level files (`hierarchy=on`; §4.2.2 "B").
+    pub(super) tree: Option<super::hierarchy::Tree>,
+    /// Drop the store from the page cache after every sweep (`cache=cold`).
+    pub(super) cold: bool,
 }
 
 impl Work {
     pub(super) fn io(&self) -> IoCounters {
-        self.scene.io()
+        let mut io = self.scene.io();
+        if let Some(t) = &self.tree {
+            io.add(&t.io());
+        }
+        io
+    }
+
+    /// Drops every file this engine reads from the page cache.
+    pub(super) fn drop_cache(&self) {
+        self.scene.drop_cache();
+        if let Some(t) = &self.tree {
+            t.drop_cache();
+        }
     }
 }
 
 /// No registration: the end of a voxel's list.
-const NONE: u32 = u32::MAX;
+pub(super) const NONE: u32 = u32::MAX;
+
+/// What one sweep counted.
+#[derive(Default)]
+pub struct Tally {
+    pub prev_skips: u64,
+    pub loads: u64,
+    /// Geometry records read with their boxes (`lazy=off`, basic layout).
+    pub records: u64,
+}
 
 /// One ray in memory (seed 000 §1.3's per-ray data).
 #[derive(Clone, Copy)]
 pub struct Slot {
     id: u32,
-    ray: Ray,
-    slab: SlabRay,
+    pub(super) ray: Ray,
+    pub(super) slab: SlabRay,
     wt: WatertightRay,
     dda: Dda,
     /// Nearest hit so far; `t` also ends the segment still searched.
-    best: Hit,
-    best_t: f32,
+    pub(super) best: Hit,
+    pub(super) best_t: f32,
     /// Last object tested (the mailbox, on the ray's side).
     mailbox: u32,
     /// The last voxel registered in the previous pass, and in this one (`[u32::MAX; 3]`: none).
@@ -95,9 +120,9 @@ pub struct Slot {
 /// One registration of a ray in a voxel: a link of that voxel's list.
 #[derive(Clone, Copy)]
 pub struct Reg {
-    voxel: u32,
-    slot: u32,
-    next: u32,
+    pub(super) voxel: u32,
+    pub(super) slot: u32,
+    pub(super) next: u32,
 }
 
 /// Bytes one ray in memory takes (slot and its registrations), for the memory budget.
@@ -267,68 +292,108 @@ impl Work {
         *c.extra.entry("bf_registrations".into()).or_insert(0) += self.regs.len() as u64;
     }
 
-    /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects").
+    /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects"), or of
+    /// the bounding-box hierarchy when the store has one and `hierarchy=on` (§4.2.2, "B").
     fn sweep(&mut self, any: bool, test: TriangleTest, c: &mut Counters) -> io::Result<()> {
+        self.scene.rewind()?;
+        let mut t = Tally::default();
+        if self.tree.is_some() {
+            self.sweep_tree(any, test, c, &mut t)?;
+        } else {
+            // The floor group's ids, in stream order.
+            let mut next_floor = 0;
+            while let Some((id, b, read)) = self.scene.next(&mut self.record)? {
+                t.records += read as u64;
+                if self.floor.get(next_floor).is_some_and(|f| f.0 == id) {
+                    next_floor += 1;
+                    continue;
+                }
+                self.object(id, &b, read, any, test, c, &mut t)?;
+            }
+        }
+        for reg in &self.regs {
+            self.head[reg.voxel as usize] = NONE;
+        }
+        self.regs.clear();
+        if self.cold {
+            self.drop_cache();
+        }
+        *c.extra.entry("bf_prev_voxel_skips".into()).or_insert(0) += t.prev_skips;
+        *c.extra.entry("bf_geometry_loads".into()).or_insert(0) += t.loads;
+        *c.extra
+            .entry("bf_geometry_records_read".into())
+            .or_insert(0) += t.records + t.loads;
+        Ok(())
+    }
+
+    /// The sweep's work on one object (not of the floor group): each ray registered in the
+    /// voxels its box reaches, past the mailbox and previous-voxel skips, is tested against the
+    /// box, and only then is the geometry read (forward only) and intersected.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn object(
+        &mut self,
+        id: u32,
+        b: &BboxRecord,
+        read: bool,
+        any: bool,
+        test: TriangleTest,
+        c: &mut Counters,
+        t: &mut Tally,
+    ) -> io::Result<()> {
+        if !(b.lo.is_finite() && b.hi.is_finite()) {
+            return Ok(());
+        }
         let g = &self.voxels;
         let prev_skip = self.prev_skip;
-        self.scene.rewind()?;
-        let (mut prev_skips, mut loads, mut records) = (0u64, 0u64, 0u64);
-        let mut next_floor = self.floor.iter().map(|f| f.0).peekable();
-        while let Some((id, b, read)) = self.scene.next(&mut self.record)? {
-            records += read as u64;
-            if next_floor.next_if_eq(&id).is_some() || !(b.lo.is_finite() && b.hi.is_finite()) {
-                continue;
-            }
-            let (a, z) = g.range(b.lo, b.hi);
-            let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
-            let mut loaded = read;
-            for cz in a[2]..=z[2] {
-                for cy in a[1]..=z[1] {
-                    let row = g.lattice.index([0, cy, cz]);
-                    for cx in a[0]..=z[0] {
-                        let mut r = self.head[row + cx as usize];
-                        while r != NONE {
-                            let reg = self.regs[r as usize];
-                            r = reg.next;
-                            let s = &mut self.slots[reg.slot as usize];
-                            if any && s.best.is_hit() {
-                                continue;
-                            }
-                            if s.mailbox == id {
-                                c.mailbox_skips += 1;
-                                continue;
-                            }
-                            s.mailbox = id;
-                            let p = s.prev;
-                            if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
-                                prev_skips += 1;
-                                continue;
-                            }
-                            c.box_tests += 1;
-                            if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
-                                continue;
-                            }
-                            if !loaded {
-                                self.scene.load(&b, &mut self.record)?;
-                                loaded = true;
-                                loads += 1;
-                            }
-                            let mut seg = s.ray;
-                            for prim in &self.record.prims {
-                                seg.tmax = s.best_t;
-                                c.primitive_tests += 1;
-                                if let Some((t, u, v)) = prim.intersect(&seg, test, &s.wt) {
-                                    c.primitive_hits += 1;
-                                    s.best_t = t;
-                                    s.best = Hit {
-                                        t,
-                                        object: id,
-                                        u,
-                                        v,
-                                    };
-                                    if any {
-                                        break;
-                                    }
+        let (a, z) = g.range(b.lo, b.hi);
+        let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
+        let mut loaded = read;
+        for cz in a[2]..=z[2] {
+            for cy in a[1]..=z[1] {
+                let row = g.lattice.index([0, cy, cz]);
+                for cx in a[0]..=z[0] {
+                    let mut r = self.head[row + cx as usize];
+                    while r != NONE {
+                        let reg = self.regs[r as usize];
+                        r = reg.next;
+                        let s = &mut self.slots[reg.slot as usize];
+                        if any && s.best.is_hit() {
+                            continue;
+                        }
+                        if s.mailbox == id {
+                            c.mailbox_skips += 1;
+                            continue;
+                        }
+                        s.mailbox = id;
+                        let p = s.prev;
+                        if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
+                            t.prev_skips += 1;
+                            continue;
+                        }
+                        c.box_tests += 1;
+                        if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
+                            continue;
+                        }
+                        if !loaded {
+                            self.scene.load(b, &mut self.record)?;
+                            loaded = true;
+                            t.loads += 1;
+                        }
+                        let mut seg = s.ray;
+                        for prim in &self.record.prims {
+                            seg.tmax = s.best_t;
+                            c.primitive_tests += 1;
+                            if let Some((th, u, v)) = prim.intersect(&seg, test, &s.wt) {
+                                c.primitive_hits += 1;
+                                s.best_t = th;
+                                s.best = Hit {
+                                    t: th,
+                                    object: id,
+                                    u,
+                                    v,
+                                };
+                                if any {
+                                    break;
                                 }
                             }
                         }
@@ -336,15 +401,6 @@ impl Work {
                 }
             }
         }
-        for reg in &self.regs {
-            self.head[reg.voxel as usize] = NONE;
-        }
-        self.regs.clear();
-        *c.extra.entry("bf_prev_voxel_skips".into()).or_insert(0) += prev_skips;
-        *c.extra.entry("bf_geometry_loads".into()).or_insert(0) += loads;
-        *c.extra
-            .entry("bf_geometry_records_read".into())
-            .or_insert(0) += records + loads;
         Ok(())
     }
 

@@ -33,6 +33,9 @@
 //! | `rays` | a count | what the budget holds | at most this many rays in memory |
 //! | `spill_codec` | `none`, `gzip` | `none` | the out-of-core workload's spill files (rays, hit records, shadow rays) gzip-compressed (level 1) |
 //! | `secondary` | `on`, `off` | `on` | the out-of-core workload traces reflection and refraction rays, or eye and shadow rays only (`off`; seed 000's rings80) |
+//! | `hierarchy` | `on`, `off` | `off` | sweep through the store's bounding-box hierarchy, skipping whole subtrees no ray needs (Ch.4 "B", §4.2.2; [`hierarchy`]); built at preprocessing (and counted in it) when the store has none of these constants. Needs `split` |
+//! | `bh_s`, `bh_m`, `bh_l`, `bh_t` | numbers | the thesis's: 3, 1000, 4, t = 0.5 for balls/gears/tree, else 1.0 | the hierarchy's constants ([`crate::store::hierarchy`]) |
+//! | `cache` | `warm`, `cold` | `warm` | `cold`: the store's files are dropped from the page cache (`posix_fadvise DONTNEED`) after preprocessing and after every sweep, so each sweep reads the disk |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -43,13 +46,19 @@
 //! surviving rays per pass), `bf_registrations`, `bf_prev_voxel_skips`, `bf_geometry_loads`,
 //! and the exact I/O of the calls: `io_bytes_read` (on disk: compressed bytes for a compressed
 //! store), `io_codec_bytes` (uncompressed bytes out of the codec; 0 for a plain store),
-//! `io_read_calls`, `io_seeks`.
+//! `io_read_calls`, `io_seeks`. With `hierarchy=on`, per level K (0: the objects' boxes)
+//! `bh_level_K_read`, and for K ≥ 1 `bh_level_K_skipped` (boxes whose subtree was passed),
+//! `bh_level_K_objects_skipped`, `bh_level_K_ray_tests`; `bh_objects_skipped` in all; in the
+//! build stats `bh_levels`, `bh_level_K_boxes`, `bh_build_s` (0 when the store had it).
 
 pub mod config;
+pub mod hierarchy;
 pub mod intersect;
 pub mod spill;
 pub mod voxels;
 
+#[cfg(test)]
+mod hierarchy_tests;
 #[cfg(test)]
 mod tests;
 
@@ -164,6 +173,38 @@ impl BreadthFirst {
         } else {
             None
         };
+        // Ch.4's "B": the hierarchy, built now (inside preprocessing) when the store lacks it.
+        let mut bh_stats = BTreeMap::new();
+        let tree = if config.hierarchy {
+            let constants = config.bh.resolve(&header.name);
+            let (info, built) =
+                hierarchy::prepare(&header, constants, config.buffer as usize).map_err(open_err)?;
+            bh_stats.insert(
+                "bh_build_s".into(),
+                built.as_ref().map_or(0.0, |b| b.seconds),
+            );
+            if let Some(b) = &built {
+                bh_stats.insert("bh_build_bytes_read".into(), b.io.bytes_read as f64);
+                bh_stats.insert("bh_build_bytes_written".into(), b.io.bytes_written as f64);
+            }
+            if config.verify {
+                let t = Instant::now();
+                let bytes = info.verify(config.buffer as usize).map_err(open_err)?;
+                bh_stats.insert("bh_verify_bytes_read".into(), bytes as f64);
+                bh_stats.insert("bh_verify_s".into(), t.elapsed().as_secs_f64());
+            }
+            bh_stats.insert("bh_levels".into(), info.height() as f64);
+            for (k, n) in info.levels.iter().enumerate() {
+                bh_stats.insert(format!("bh_level_{}_boxes", k + 1), *n as f64);
+            }
+            bh_stats.insert("bh_s".into(), constants.s);
+            bh_stats.insert("bh_m".into(), constants.m as f64);
+            bh_stats.insert("bh_l".into(), constants.l as f64);
+            bh_stats.insert("bh_t".into(), constants.t);
+            Some(hierarchy::Tree::open(info, config.buffer as usize).map_err(open_err)?)
+        } else {
+            None
+        };
         let mut scene =
             SceneReader::open(&header, config.buffer as usize, config.lazy).map_err(open_err)?;
         // The floor group, and the box and primitive count of the rest (one sweep).
@@ -204,7 +245,9 @@ impl BreadthFirst {
         let buffers = match config.layout {
             config::Layout::Split => 2 * config.buffer,
             config::Layout::Basic => config.buffer,
-        };
+        } + tree
+            .as_ref()
+            .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
         let per_ray = intersect::slot_bytes() + initial as u64 * intersect::reg_bytes();
         let left = config.memory.saturating_sub(grid_bytes + buffers);
@@ -227,9 +270,15 @@ impl BreadthFirst {
             }
         }
         let pre_io = scene.take_io();
+        if config.cold {
+            scene.drop_cache();
+            if let Some(t) = &tree {
+                t.drop_cache();
+            }
+        }
         let preprocess_s = t.elapsed().as_secs_f64();
 
-        let mut stats = BTreeMap::new();
+        let mut stats = bh_stats;
         stats.insert("preprocess_s".into(), preprocess_s);
         stats.insert("res_x".into(), voxels.lattice.res[0] as f64);
         stats.insert("res_y".into(), voxels.lattice.res[1] as f64);
@@ -282,6 +331,8 @@ impl BreadthFirst {
             scene,
             record: ObjectRecord::default(),
             floor,
+            tree,
+            cold: config.cold,
         };
         Ok(BreadthFirst {
             config,
@@ -314,6 +365,9 @@ impl BreadthFirst {
         let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
         let before = w.io();
         let r = w.trace(rays, any, self.config.triangle, out, c);
+        if let Some(t) = w.tree.as_mut() {
+            hierarchy::report(t, c);
+        }
         // Rays left in memory by an error are dropped: their answers are MISS.
         w.slots.clear();
         let after = w.io();

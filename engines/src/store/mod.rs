@@ -28,6 +28,9 @@
 //! before the header is known); gzip's own CRC-32 and the records' checksums guard its bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
+//! A split store may carry a bounding-box hierarchy (`bbox-K.bin`, `hierarchy.json`; seed 000
+//! §4.2.2 "B"): see [`hierarchy`].
+//!
 //! All numbers little-endian; CRC-32 is IEEE's (crate `crc32fast`). Reading checks what it can
 //! before trusting it: [`StoreHeader::read`] the header's checksum, the files' sizes against the
 //! header and the object count against the size of `bbox.bin`, and every value against the scene
@@ -41,11 +44,13 @@
 //! [`crate::geometry::prims_of`] makes (same triangulation), so the breadth-first engine tests
 //! the same `f32` triangles as every other engine.
 
+pub mod hierarchy;
 mod io;
 mod read;
 mod surface;
 mod write;
 
+pub use hierarchy::{Constants, Hierarchy, LevelReader, NodeRecord};
 pub use io::{Codec, IoCounters, IoFile};
 pub use read::{
     BasicReader, BboxReader, BboxRecord, GeometryReader, ObjectRecord, SceneReader, StoreHeader,

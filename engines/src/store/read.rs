@@ -378,6 +378,20 @@ impl BboxReader {
         Ok(())
     }
 
+    /// Moves forward to object `id` (one seek at most): the bounding-box hierarchy skips a
+    /// subtree so (seed 000 §4.2.2, "B"), and shading reaches a hit object so (Algorithm 4.4).
+    pub fn seek_record(&mut self, id: u64) -> io::Result<()> {
+        if id > self.objects {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("bbox record {id} past the last ({})", self.objects),
+            ));
+        }
+        self.file.seek_to(FILE_HEADER + id * BBOX_RECORD as u64)?;
+        self.next_id = id;
+        Ok(())
+    }
+
     /// The next (object id, record), or `None` after the last.
     pub fn next_record(&mut self) -> io::Result<Option<(u32, BboxRecord)>> {
         if self.next_id == self.objects {
@@ -628,6 +642,42 @@ impl SceneReader {
                 Ok(Some((id, b, !*lazy)))
             }
             SceneReader::Basic(r) => Ok(r.next_record(out)?.map(|(id, b)| (id, b, true))),
+        }
+    }
+
+    /// Moves the stream to object `id` (not behind the stream): in the split layout one seek in
+    /// the bounding-box file, in the basic layout the records before it are read and passed
+    /// (a store of the basic layout has no index).
+    pub fn skip_to(&mut self, id: u32, out: &mut ObjectRecord) -> io::Result<()> {
+        match self {
+            SceneReader::Split { bbox, .. } => {
+                if (id as u64) < bbox.next_id {
+                    return Err(io::Error::other(format!(
+                        "object {id} behind the stream (at {})",
+                        bbox.next_id
+                    )));
+                }
+                bbox.seek_record(id as u64)
+            }
+            SceneReader::Basic(r) => {
+                while r.next_id < id as u64 {
+                    if r.next_record(out)?.is_none() {
+                        break;
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Drops the store's files from the page cache (`cache=cold`).
+    pub fn drop_cache(&self) {
+        match self {
+            SceneReader::Split { bbox, geometry, .. } => {
+                bbox.file.drop_cache();
+                geometry.file.drop_cache();
+            }
+            SceneReader::Basic(b) => b.file.drop_cache(),
         }
     }
 

@@ -92,7 +92,14 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
 /// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
 /// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
 /// so a failure (bad input, full disk) leaves nothing behind.
-pub fn store(src: &Source, out: &Path, layout: &str, compress: &str, as_json: bool) -> Result<()> {
+pub fn store(
+    src: &Source,
+    out: &Path,
+    layout: &str,
+    compress: &str,
+    hierarchy: bool,
+    as_json: bool,
+) -> Result<()> {
     let layout: Layout = layout
         .parse()
         .map_err(|e| input(format!("--layout {layout}: {e}")))?;
@@ -101,6 +108,11 @@ pub fn store(src: &Source, out: &Path, layout: &str, compress: &str, as_json: bo
         return Err(input(format!(
             "--compress {compress}: a compressed store is read strictly forward, so it needs --layout basic"
         )));
+    }
+    if hierarchy && layout != Layout::Split {
+        return Err(input(
+            "--hierarchy: the bounding-box hierarchy indexes bbox.bin, so it needs --layout split",
+        ));
     }
     let start = std::time::Instant::now();
     if out.exists()
@@ -135,9 +147,25 @@ pub fn store(src: &Source, out: &Path, layout: &str, compress: &str, as_json: bo
         let _ = std::fs::remove_dir_all(&tmp);
         return Err(e);
     }
-    let io = w
+    let mut io = w
         .finish()
         .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
+    let mut levels = Vec::new();
+    if hierarchy {
+        let built = StoreHeader::read(&tmp)
+            .and_then(|h| {
+                let c = rtbench_engines::store::Constants::thesis(&h.name);
+                rtbench_engines::store::Hierarchy::build(&h, c, 1 << 16)
+            })
+            .map_err(|e| {
+                cleanup(format!(
+                    "{}: cannot build the hierarchy: {e}",
+                    out.display()
+                ))
+            })?;
+        io.add(&built.io);
+        levels = built.levels;
+    }
     if out.exists() {
         let _ = std::fs::remove_dir(out);
     }
@@ -158,6 +186,7 @@ pub fn store(src: &Source, out: &Path, layout: &str, compress: &str, as_json: bo
         "scene": src.label(),
         "objects": header.objects,
         "primitives": header.primitives,
+        "hierarchy_levels": levels,
         "bytes_written": io.bytes_written,
         "write_calls": io.write_calls,
         "time_s": secs,

@@ -50,6 +50,7 @@ registry! {
     nakamaru_3_1,
     nakamaru_3_2,
     nakamaru_3_3,
+    nakamaru_4_1,
     nakamaru_fig3_2,
     nakamaru_fig3_3,
     yamauchi_static_lb,
@@ -134,7 +135,8 @@ pub fn run(
         checkpoint: &checkpoint,
     };
     let output = (table.run)(&ctx)?;
-    writer::write(table, out, output, as_json)
+    writer::write(table, out, output, as_json)?;
+    Ok(())
 }
 
 #[cfg(test)]

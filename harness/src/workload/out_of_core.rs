@@ -10,8 +10,8 @@
 //!    order rays finish; they are spilled into one file per group of [`GROUP`] ray ids (a
 //!    one-pass bucket sort: the thesis's sort by ray id), each group's then filed by id.
 //! 3. Shading takes the rays in groups of [`GROUP`] ids, read sequentially; each group's hits
-//!    are sorted by object id and the bounding-box and geometry files read forward only,
-//!    loading just the objects hit (Algorithm 3.6, "join" of hit records and scene). What
+//!    are sorted by object id and the bounding-box and geometry files read forward only (the
+//!    split layout seeks to each object hit, Algorithm 4.4), loading just the objects hit (Algorithm 3.6, "join" of hit records and scene). What
 //!    shading emits is put back in ray order before it is written (the thesis's second sort),
 //!    so the next generation's file, the shadow rays and the image's sums come in the same order
 //!    as in memory, and the image is the in-memory tracer's to the bit.
@@ -345,19 +345,17 @@ pub fn render_tile(
             for &k in &order {
                 let hit = hits[k as usize];
                 if hit.object != loaded {
-                    // Forward through the store to the object (Algorithm 3.6: "while current
-                    // object ID < hit's object ID: read next object").
-                    loop {
-                        match scene.next(&mut record)? {
-                            Some((id, b, read)) if id == hit.object => {
-                                if !read {
-                                    scene.load(&b, &mut record)?;
-                                }
-                                break;
+                    // Forward through the store to the object: the basic layout reads the
+                    // objects before it (Algorithm 3.6: "while current object ID < hit's object
+                    // ID: read next object"), the split one seeks to its box (Algorithm 4.4).
+                    scene.skip_to(hit.object, &mut record)?;
+                    match scene.next(&mut record)? {
+                        Some((id, b, read)) if id == hit.object => {
+                            if !read {
+                                scene.load(&b, &mut record)?;
                             }
-                            Some(_) => continue,
-                            None => return Err(io::Error::other("hit names no object")),
                         }
+                        _ => return Err(io::Error::other("hit names no object")),
                     }
                     loaded = hit.object;
                 }

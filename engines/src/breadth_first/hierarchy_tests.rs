@@ -1,0 +1,275 @@
+//! The bounding-box hierarchy (seed 000 §4.2.2, "B") changes which boxes are read, never the
+//! answers; it skips subtrees; a hierarchy that disagrees with its level below, a truncated level
+//! file or one built for another header is refused in one line; a failed build leaves nothing.
+
+use super::*;
+use crate::geometry::Geometry;
+use crate::store::hierarchy::{
+    encode, level_file, Constants, Hierarchy, HIERARCHY_FILE, NODE_RECORD,
+};
+use crate::store::tests::TempDir;
+use crate::store::FILE_HEADER;
+use crate::{build_engine, Counters, Engine, Hit, Ray};
+use rtbench_scenes::generate_scene;
+use rtbench_scenes::spd::{Options, Program};
+use std::sync::Arc;
+
+fn spd(program: Program, sf: u32) -> BuildInput {
+    let scene = generate_scene(
+        program,
+        &Options {
+            size_factor: sf,
+            ..Options::standard(program)
+        },
+    )
+    .unwrap();
+    BuildInput {
+        geometry: Arc::new(Geometry::from_scene(&scene)),
+        scene: Arc::new(scene),
+    }
+}
+
+fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+/// Rays from the camera's eye through a jittered lattice of directions, and from points around
+/// the scene to points in it (closest and any hit).
+fn rays(g: &Geometry, n: usize) -> (Vec<Ray>, Vec<Ray>) {
+    let (lo, hi) = (g.bounds_min, g.bounds_max);
+    let mut s = 12345u64;
+    let mut unit = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut pt = |a: Vec3, b: Vec3| a + (b - a) * Vec3::new(unit(), unit(), unit());
+    let c = (lo + hi) * 0.5;
+    let h = (hi - lo) * 0.5;
+    let (mut closest, mut any) = (Vec::new(), Vec::new());
+    for _ in 0..n {
+        let o = pt(c - h * 1.5, c + h * 1.5);
+        let t = pt(lo, hi);
+        closest.push(Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY));
+        let a = pt(lo, hi);
+        let d = pt(lo, hi) - a;
+        any.push(Ray::new(a, d / d.length(), 0.0, d.length()));
+    }
+    (closest, any)
+}
+
+fn answers(e: &dyn Engine, r: &(Vec<Ray>, Vec<Ray>), c: &mut Counters) -> (Vec<Hit>, Vec<bool>) {
+    let mut hits = vec![Hit::MISS; r.0.len()];
+    let mut occ = vec![false; r.1.len()];
+    e.intersect(&r.0, &mut hits, c);
+    e.occluded(&r.1, &mut occ, c);
+    (hits, occ)
+}
+
+#[test]
+fn the_hierarchy_skips_subtrees_and_changes_no_answer() {
+    let mut skipped_somewhere = false;
+    for (program, sf) in [
+        (Program::Tetra, 4),
+        (Program::Balls, 2),
+        (Program::Mount, 4),
+        (Program::Rings, 2),
+        (Program::Tree, 6),
+    ] {
+        let input = spd(program, sf);
+        let r = rays(&input.geometry, 1200);
+        let base = build_engine("breadth-first", &input, vec![]).unwrap();
+        let want = answers(base.as_ref(), &r, &mut Counters::default());
+        for settings in [
+            vec![("hierarchy", "on")],
+            vec![
+                ("hierarchy", "on"),
+                ("bh_s", "1.5"),
+                ("bh_m", "4"),
+                ("bh_t", "0.5"),
+            ],
+            vec![
+                ("hierarchy", "on"),
+                ("bh_l", "1"),
+                ("memory", "300KiB"),
+                ("lazy", "off"),
+            ],
+        ] {
+            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
+            let mut c = Counters::default();
+            let got = answers(e.as_ref(), &r, &mut c);
+            assert!(e.failure().is_none(), "{:?}", e.failure());
+            let same = got
+                .0
+                .iter()
+                .zip(&want.0)
+                .all(|(a, b)| a.object == b.object && a.t == b.t);
+            assert!(same && got.1 == want.1, "{program:?} {settings:?}");
+            let s = e.build_stats();
+            assert!(s["bh_levels"] >= 1.0);
+            let objects = input.scene.objects.len() as u64;
+            // Each object's box read at most once per pass; what is skipped is not read.
+            let passes = c.extra["bf_passes"];
+            assert!(c.extra["bh_level_0_read"] + c.extra["bh_objects_skipped"] <= objects * passes);
+            skipped_somewhere |= c.extra["bh_objects_skipped"] > 0;
+        }
+    }
+    assert!(skipped_somewhere, "no subtree was ever skipped");
+}
+
+#[test]
+fn levels_follow_the_constants() {
+    let input = spd(Program::Mount, 5);
+    let dir = TempDir::new("bh-levels");
+    StoreWriter::create(&dir.0, "mount5")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let h = StoreHeader::read(&dir.0).unwrap();
+    let c = Constants::thesis("mount5");
+    assert_eq!((c.s, c.m, c.l, c.t), (3.0, 1000, 4, 1.0));
+    assert_eq!(Constants::thesis("balls6").t, 0.5);
+    let b = Hierarchy::build(&h, c, 4096).unwrap();
+    // t = 1.0 merges everything on top: one group; below, fewer boxes at every level.
+    assert_eq!(*b.levels.last().unwrap(), 1);
+    assert!(b.levels.windows(2).all(|w| w[1] < w[0]) && b.levels[0] < h.objects);
+    let info = Hierarchy::open(&h, Some(c)).unwrap().unwrap();
+    info.verify(4096).unwrap();
+    // Other constants: not this hierarchy.
+    assert!(Hierarchy::open(&h, Some(Constants { s: 2.0, ..c }))
+        .unwrap()
+        .is_none());
+    let deep = Hierarchy::build(
+        &h,
+        Constants {
+            s: 1.0,
+            m: 1,
+            l: 3,
+            t: 0.5,
+        },
+        4096,
+    )
+    .unwrap();
+    assert_eq!(deep.levels.len(), 3);
+}
+
+fn open_bh(dir: &std::path::Path, verify: &str) -> Result<BreadthFirst, EngineError> {
+    let s = Settings::new(
+        "breadth-first",
+        kv(&[("hierarchy", "on"), ("verify", verify), ("bh_s", "2")]),
+    );
+    BreadthFirst::open(dir, BreadthFirstConfig::from_settings(s).unwrap())
+}
+
+#[test]
+fn a_disagreeing_truncated_or_foreign_hierarchy_is_refused() {
+    let input = spd(Program::Tetra, 4);
+    let dir = TempDir::new("bh-bad");
+    StoreWriter::create(&dir.0, "tetra4")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let e = open_bh(&dir.0, "full").unwrap();
+    let r = rays(&input.geometry, 300);
+    drop(e);
+    let l1 = dir.0.join(level_file(1));
+    let good = std::fs::read(&l1).unwrap();
+    // Shrink the box of level-1 node 0 (checksum kept right): it no longer holds its children.
+    let mut bad = good.clone();
+    let at = FILE_HEADER as usize;
+    let rec: [u8; NODE_RECORD] = bad[at..at + NODE_RECORD].try_into().unwrap();
+    let f = |i: usize| f32::from_le_bytes(rec[i * 4..i * 4 + 4].try_into().unwrap());
+    let node = crate::store::NodeRecord {
+        lo: Vec3::new(f(0), f(1), f(2)),
+        hi: Vec3::new(f(0), f(1), f(2)),
+        end: u64::from_le_bytes(rec[24..32].try_into().unwrap()),
+        children: u32::from_le_bytes(rec[32..36].try_into().unwrap()),
+        objects: u32::from_le_bytes(rec[36..40].try_into().unwrap()),
+    };
+    bad[at..at + NODE_RECORD].copy_from_slice(&encode(1, 0, &node));
+    std::fs::write(&l1, &bad).unwrap();
+    let err = open_bh(&dir.0, "full").err().unwrap().to_string();
+    assert!(
+        err.contains("disagrees with the level below") && !err.contains('\n'),
+        "{err}"
+    );
+    // Unverified (`verify=records`) a node whose box shrank is skipped when no ray needs it,
+    // and its objects with it: only the full check (the default) reads what is skipped.
+    let e = open_bh(&dir.0, "records").unwrap();
+    let _ = answers(&e, &r, &mut Counters::default());
+    drop(e);
+    // A flipped byte: the record's checksum.
+    let mut flipped = good.clone();
+    flipped[at + 3] ^= 1;
+    std::fs::write(&l1, &flipped).unwrap();
+    let err = open_bh(&dir.0, "full").err().unwrap().to_string();
+    assert!(
+        err.contains("checksum") || err.contains("disagrees"),
+        "{err}"
+    );
+    // Truncated.
+    std::fs::write(&l1, &good[..good.len() - 7]).unwrap();
+    let err = open_bh(&dir.0, "records").err().unwrap().to_string();
+    assert!(err.contains("bytes") && !err.contains('\n'), "{err}");
+    // Another header: the hierarchy belongs to the store it was built for.
+    std::fs::write(&l1, &good).unwrap();
+    assert!(open_bh(&dir.0, "full").is_ok());
+    let hp = dir.0.join(crate::store::HEADER_FILE);
+    let text = std::fs::read_to_string(&hp).unwrap();
+    let other = dir.0.with_extension("other");
+    let _ = std::fs::remove_dir_all(&other);
+    StoreWriter::create(&other, "tetra4b")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    std::fs::copy(dir.0.join(HIERARCHY_FILE), other.join(HIERARCHY_FILE)).unwrap();
+    let err = Hierarchy::open(&StoreHeader::read(&other).unwrap(), None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("another header.json"), "{err}");
+    let _ = std::fs::remove_dir_all(&other);
+    assert!(!text.is_empty());
+}
+
+#[test]
+fn a_failed_build_leaves_nothing_behind() {
+    let input = spd(Program::Tetra, 4);
+    let dir = TempDir::new("bh-fail");
+    StoreWriter::create(&dir.0, "tetra4")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let h = StoreHeader::read(&dir.0).unwrap();
+    // Level 2's temporary file cannot be made (a directory is in its place): level 1, already
+    // renamed into place, must go too, and no hierarchy.json is written.
+    let blocker = dir
+        .0
+        .join(format!(".{}.tmp-{}", level_file(2), std::process::id()));
+    std::fs::create_dir(&blocker).unwrap();
+    let c = Constants {
+        s: 1.0,
+        m: 1,
+        l: 4,
+        t: 1.0,
+    };
+    assert!(Hierarchy::build(&h, c, 4096).is_err());
+    std::fs::remove_dir(&blocker).unwrap();
+    let left: Vec<_> = std::fs::read_dir(&dir.0)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("bbox-") || n.starts_with('.') || n == HIERARCHY_FILE)
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(Hierarchy::open(&h, None).unwrap().is_none());
+    // hierarchy=on on a split layout only.
+    let s = Settings::new(
+        "breadth-first",
+        kv(&[("layout", "basic"), ("hierarchy", "on")]),
+    );
+    assert!(BreadthFirstConfig::from_settings(s).is_err());
+}

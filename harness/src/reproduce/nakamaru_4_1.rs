@@ -1,0 +1,622 @@
+//! `nakamaru-4.1`: seed 000's Table 4.1, the basic breadth-first method against the improved one
+//! with S+G (separate box and geometry files, geometry read lazily) and S+G+B (and the
+//! bounding-box hierarchy), 27 rows of seven SPD scenes up to 50,000,000 objects.
+//!
+//! Per row: the scene is streamed from its generator into a basic store (one `objects.bin`) and
+//! traced by the basic method (`layout=basic`); the store is removed and the scene streamed into a
+//! split store (the row's "generation": SPD plus conversion, as the thesis times it), traced with
+//! S+G (`layout=split`, lazy) and S+G+B (`hierarchy=on`: the hierarchy is built at preprocessing
+//! and its build counted there, as the thesis's S+G+B preprocessing includes it). Every run:
+//! 512×512 SPD workload out of core, engine budget 256 MiB (the thesis's machine), page cache
+//! dropped after preprocessing and every sweep (`cache=cold`: this machine could cache the
+//! scene), peak RSS of the run (reset before it). Rows are saved as they finish (`--resume`).
+//!
+//! `--quick` traces one small row per scene at 64×64; `--set rows=balls6,mount9` picks rows.
+
+use super::published::{self, Source};
+use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
+use crate::commands::render::hex;
+use crate::error::{input, Result};
+use crate::source::Source as SceneSource;
+use crate::workload::{self, out_of_core};
+use rtbench_engines::breadth_first::config::BreadthFirstConfig;
+use rtbench_engines::breadth_first::spill::SpillDir;
+use rtbench_engines::breadth_first::BreadthFirst;
+use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
+use rtbench_engines::{Engine, Settings};
+use rtbench_reports::{Document, Table as DocTable};
+use rtbench_scenes::spd::MountHash;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const ROWS: Param = Param {
+    key: "rows",
+    help: "rows to measure, e.g. balls6,mount9 (default: all 27; --quick: one small row per scene)",
+};
+const SIZE: Param = Param {
+    key: "size",
+    help: "image size (default 512, 64 with --quick)",
+};
+const MEMORY: Param = Param {
+    key: "memory",
+    help: "engine memory budget (default 256MiB, the thesis's machine)",
+};
+const CACHE: Param = Param {
+    key: "cache",
+    help: "cold (default: page cache dropped after preprocessing and every sweep) or warm",
+};
+const SPILL: Param = Param {
+    key: "spill",
+    help: "directory for the scene stores and spill files (default the system temp dir)",
+};
+
+pub const TABLE: Table = Table {
+    id: "nakamaru-4.1",
+    seed: "000",
+    source: "Table 4.1",
+    about: "000 (Nakamaru 2002) Table 4.1: basic breadth-first method vs S+G and S+G+B (bounding-box hierarchy), 27 rows up to 5e7 objects",
+    runtime: Runtime {
+        quick: "minutes",
+        full: "days (27 rows × 3 methods out of core); resumable",
+    },
+    params: &[ROWS, SIZE, MEMORY, CACHE, SPILL],
+    claims: &[
+        Claim {
+            key: "sg-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "another machine (2 cores, NVMe-backed virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine) and our record format (f32, prepared primitives, checksums); time ratios only",
+        },
+        Claim {
+            key: "sgb-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "as sg-ratio; the test on a hierarchy node is ours (the thesis does not give it), and groups share one grid here",
+        },
+        Claim {
+            key: "sgb-over-sg",
+            fidelity: Fidelity::Substituted,
+            why: "as sgb-ratio",
+        },
+        Claim {
+            key: "image-equal",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+        Claim {
+            key: "memory",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+    ],
+    run,
+};
+
+const PUBLISHED: &str = include_str!("../../../data/published/nakamaru-4.1.json");
+
+#[derive(Deserialize)]
+struct Published {
+    source: Source,
+    memory_mib: u64,
+    rows: Vec<PublishedRow>,
+}
+
+#[derive(Deserialize, Serialize, Clone)]
+struct PublishedRow {
+    scene: String,
+    sf: u32,
+    objects: u64,
+    size_mb: u64,
+    generation_s: u64,
+    basic_s: u64,
+    sg: f64,
+    sgb: f64,
+    sgb_over_sg: f64,
+}
+
+/// One method's run of one row.
+#[derive(Serialize, Deserialize, Default, Clone)]
+struct Run {
+    preprocess_s: f64,
+    trace_s: f64,
+    intersect_s: f64,
+    shade_s: f64,
+    passes: u64,
+    sha256: String,
+    peak_rss_bytes: u64,
+    /// The engine's reads in preprocessing, and in intersection (all calls).
+    preprocess_bytes_read: u64,
+    intersect_bytes_read: u64,
+    intersect_read_calls: u64,
+    intersect_seeks: u64,
+    /// The workload's reads in shading and spill files.
+    workload_bytes_read: u64,
+    workload_seeks: u64,
+    geometry_loads: u64,
+    /// Bounding-box records read by sweeps (S+G+B; others: objects × passes).
+    boxes_read: u64,
+    objects_skipped: u64,
+    bh_build_s: f64,
+    bh_levels: Vec<u64>,
+    /// `bh_level_K_skipped` per level K ≥ 1.
+    bh_skipped: Vec<u64>,
+    load_average: String,
+}
+
+impl Run {
+    fn total_s(&self) -> f64 {
+        self.preprocess_s + self.trace_s
+    }
+}
+
+#[derive(Serialize, Deserialize, Clone)]
+struct Measured {
+    scene: String,
+    sf: u32,
+    /// A row of the table (false: a `--quick` stand-in).
+    thesis_row: bool,
+    objects: u64,
+    basic_bytes: u64,
+    split_bytes: u64,
+    /// Split store written from the generator (the thesis's "generation").
+    generation_s: f64,
+    basic: Run,
+    sg: Run,
+    sgb: Run,
+}
+
+impl Measured {
+    fn label(&self) -> String {
+        format!("{}{}", self.scene, self.sf)
+    }
+}
+
+#[derive(Serialize)]
+struct Result_ {
+    id: &'static str,
+    published: serde_json::Value,
+    measured: Vec<Measured>,
+    size: u32,
+    memory: String,
+    cache: String,
+    environment: serde_json::Value,
+}
+
+/// The small rows of `--quick`: one per scene, seconds each.
+const QUICK: &[(&str, u32)] = &[
+    ("balls", 3),
+    ("gears", 3),
+    ("mount", 5),
+    ("rings", 4),
+    ("teapot", 12),
+    ("tetra", 5),
+    ("tree", 9),
+];
+
+fn resolve(scene: &str, sf: u32) -> Result<SceneSource> {
+    let hash = (scene == "mount").then_some(MountHash::Jenkins);
+    SceneSource::resolve(scene, Some(sf), None, hash)
+}
+
+/// Starts the peak RSS afresh (Linux `clear_refs` 5), so that each run reports its own.
+fn reset_peak_rss() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_default()
+}
+
+/// Streams the scene into a store of `layout` at `dir`; returns (header, seconds).
+fn write_store(src: &SceneSource, dir: &Path, layout: Layout) -> Result<(StoreHeader, f64)> {
+    let t = std::time::Instant::now();
+    let mut w = StoreWriter::create_with(dir, &src.label(), layout, Codec::None)
+        .map_err(|e| input(format!("{}: {e}", dir.display())))?;
+    src.stream(&mut w)?;
+    w.finish()
+        .map_err(|e| input(format!("{}: cannot write: {e}", dir.display())))?;
+    let h = StoreHeader::read(dir).map_err(|e| input(e.to_string()))?;
+    Ok((h, t.elapsed().as_secs_f64()))
+}
+
+struct Setup<'a> {
+    size: u32,
+    memory: &'a str,
+    cache: &'a str,
+    spill: Option<&'a str>,
+}
+
+fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
+    reset_peak_rss();
+    let load_average = load_average();
+    let mut pairs: Vec<(String, String)> = vec![
+        ("memory".into(), s.memory.into()),
+        ("verify".into(), "records".into()),
+        ("cache".into(), s.cache.into()),
+    ];
+    if let Some(sp) = s.spill {
+        pairs.push(("spill".into(), sp.into()));
+    }
+    pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
+    let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    let t = std::time::Instant::now();
+    let engine = BreadthFirst::open(dir, config)?;
+    let preprocess_s = t.elapsed().as_secs_f64();
+    let ooc = out_of_core::render(&engine, s.size)
+        .map_err(|e| input(format!("{}: out-of-core render: {e}", dir.display())))?;
+    let r = &ooc.render;
+    let x = |k: &str| r.counters.extra.get(k).copied().unwrap_or(0);
+    let b = engine.build_stats();
+    let levels = b.get("bh_levels").copied().unwrap_or(0.0) as usize;
+    Ok(Run {
+        preprocess_s,
+        trace_s: r.trace_s,
+        intersect_s: r.intersect_s,
+        shade_s: r.shade_s,
+        passes: x("bf_passes"),
+        sha256: hex(&Sha256::digest(r.pixels())),
+        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        preprocess_bytes_read: b.get("preprocess_bytes_read").copied().unwrap_or(0.0) as u64
+            + b.get("bh_build_bytes_read").copied().unwrap_or(0.0) as u64,
+        intersect_bytes_read: x("io_bytes_read"),
+        intersect_read_calls: x("io_read_calls"),
+        intersect_seeks: x("io_seeks"),
+        workload_bytes_read: ooc.io.bytes_read,
+        workload_seeks: ooc.io.seeks,
+        geometry_loads: x("bf_geometry_loads"),
+        boxes_read: if levels > 0 {
+            x("bh_level_0_read")
+        } else {
+            engine.header().objects * x("bf_passes")
+        },
+        objects_skipped: x("bh_objects_skipped"),
+        bh_build_s: b.get("bh_build_s").copied().unwrap_or(0.0),
+        bh_levels: (1..=levels)
+            .map(|k| b.get(&format!("bh_level_{k}_boxes")).copied().unwrap_or(0.0) as u64)
+            .collect(),
+        bh_skipped: (1..=levels)
+            .map(|k| x(&format!("bh_level_{k}_skipped")))
+            .collect(),
+        load_average,
+    })
+}
+
+fn measure_row(scene: &str, sf: u32, thesis_row: bool, s: &Setup) -> Result<Measured> {
+    let src = resolve(scene, sf)?;
+    let spill = SpillDir::create(s.spill.map(Path::new)).map_err(input)?;
+    let basic_dir = spill.path().join("basic");
+    eprintln!("nakamaru-4.1: {scene}{sf}: basic store …");
+    let (hb, _) = write_store(&src, &basic_dir, Layout::Basic)?;
+    eprintln!("nakamaru-4.1: {scene}{sf}: basic ({} objects) …", hb.objects);
+    let basic = trace(&basic_dir, s, &[("layout", "basic")])?;
+    std::fs::remove_dir_all(&basic_dir).map_err(|e| input(e.to_string()))?;
+    let split_dir = spill.path().join("split");
+    let (hs, generation_s) = write_store(&src, &split_dir, Layout::Split)?;
+    eprintln!("nakamaru-4.1: {scene}{sf}: S+G …");
+    let sg = trace(&split_dir, s, &[("layout", "split")])?;
+    eprintln!("nakamaru-4.1: {scene}{sf}: S+G+B …");
+    let sgb = trace(&split_dir, s, &[("layout", "split"), ("hierarchy", "on")])?;
+    Ok(Measured {
+        scene: scene.to_string(),
+        sf,
+        thesis_row,
+        objects: hs.objects,
+        basic_bytes: hb.geometry_bytes,
+        split_bytes: hs.bbox_bytes + hs.geometry_bytes,
+        generation_s,
+        basic,
+        sg,
+        sgb,
+    })
+}
+
+fn run(ctx: &Ctx) -> Result<Output> {
+    let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
+    let size = ctx
+        .params
+        .number::<u32>(SIZE.key, 1)?
+        .unwrap_or(if ctx.quick { 64 } else { 512 });
+    workload::check_size(size)?;
+    let memory = ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string();
+    let cache = ctx.params.raw(CACHE.key).unwrap_or("cold").to_string();
+    let setup = Setup {
+        size,
+        memory: &memory,
+        cache: &cache,
+        spill: ctx.params.raw(SPILL.key),
+    };
+    let mut todo: Vec<(String, u32, bool)> = if ctx.quick {
+        QUICK.iter().map(|&(s, sf)| (s.to_string(), sf, false)).collect()
+    } else {
+        p.rows.iter().map(|r| (r.scene.clone(), r.sf, true)).collect()
+    };
+    if let Some(list) = ctx.params.list(ROWS.key)? {
+        let mut picked = Vec::new();
+        for item in list {
+            let split = item
+                .find(|c: char| c.is_ascii_digit())
+                .ok_or_else(|| input(format!("{}: rows '{item}': expected scene and SF, e.g. balls6", ctx.id)))?;
+            let (scene, sf) = item.split_at(split);
+            let sf: u32 = sf
+                .parse()
+                .ok()
+                .filter(|&n| n >= 1)
+                .ok_or_else(|| input(format!("{}: rows '{item}': bad size factor", ctx.id)))?;
+            if !p.rows.iter().any(|r| r.scene == scene) {
+                return Err(input(format!(
+                    "{}: rows '{item}': the table's scenes are balls, gears, mount, rings, teapot, tetra, tree",
+                    ctx.id
+                )));
+            }
+            let thesis = p.rows.iter().any(|r| r.scene == scene && r.sf == sf);
+            picked.push((scene.to_string(), sf, thesis));
+        }
+        todo = picked;
+    }
+    let mut measured = Vec::new();
+    for (scene, sf, thesis) in todo {
+        let key = format!("{scene}{sf}-{size}-{memory}-{cache}");
+        let m = match ctx.checkpoint.load::<Measured>(&key)? {
+            Some(m) => {
+                eprintln!("{}: {scene}{sf}: saved by an earlier run", ctx.id);
+                m
+            }
+            None => {
+                let m = measure_row(&scene, sf, thesis, &setup)?;
+                ctx.checkpoint.save(&key, &m)?;
+                m
+            }
+        };
+        measured.push(m);
+    }
+    let rows = rows(&p, &measured);
+    let doc = document(&p, &measured, &setup, ctx.quick);
+    Ok(Output::new(
+        Result_ {
+            id: ctx.id,
+            published: raw,
+            measured,
+            size,
+            memory: memory.clone(),
+            cache: cache.clone(),
+            environment: environment(1),
+        },
+        rows,
+        doc,
+    ))
+}
+
+fn ratio(a: f64, b: f64) -> f64 {
+    a / b.max(1e-9)
+}
+
+fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let find = |m: &Measured| p.rows.iter().find(|r| r.scene == m.scene && r.sf == m.sf);
+    let note = |m: &Measured| {
+        if m.thesis_row {
+            String::new()
+        } else {
+            format!("{}: not a row of the table (a smaller stand-in)", m.label())
+        }
+    };
+    for m in measured {
+        let pub_row = find(m);
+        let (b, sg, sgb) = (m.basic.total_s(), m.sg.total_s(), m.sgb.total_s());
+        let shown = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
+        rows.push(
+            Row::new(
+                "sg-ratio",
+                m.label(),
+                shown(pub_row.map(|r| r.sg)),
+                format!("{b:.1} s / {sg:.1} s = {:.2}", ratio(b, sg)),
+                Kind::Ratio,
+                Verdict::Shown,
+            )
+            .with_note(note(m)),
+        );
+        rows.push(
+            Row::new(
+                "sgb-ratio",
+                m.label(),
+                shown(pub_row.map(|r| r.sgb)),
+                format!("{b:.1} s / {sgb:.1} s = {:.2}", ratio(b, sgb)),
+                Kind::Ratio,
+                Verdict::Shown,
+            )
+            .with_note(note(m)),
+        );
+        rows.push(
+            Row::new(
+                "sgb-over-sg",
+                m.label(),
+                format!("{} (worst 0.99)", shown(pub_row.map(|r| r.sgb_over_sg))),
+                format!("{:.2}", ratio(sg, sgb)),
+                Kind::Ratio,
+                Verdict::of(ratio(sg, sgb) >= 0.95),
+            )
+            .with_note(note(m)),
+        );
+        let same = m.basic.sha256 == m.sg.sha256 && m.sg.sha256 == m.sgb.sha256;
+        rows.push(
+            Row::new(
+                "image-equal",
+                m.label(),
+                "equal",
+                format!(
+                    "{}… / {}… / {}…",
+                    &m.basic.sha256[..12],
+                    &m.sg.sha256[..12],
+                    &m.sgb.sha256[..12]
+                ),
+                Kind::Count,
+                Verdict::of(same),
+            )
+            .with_note(note(m)),
+        );
+        let peak = m
+            .basic
+            .peak_rss_bytes
+            .max(m.sg.peak_rss_bytes)
+            .max(m.sgb.peak_rss_bytes);
+        rows.push(
+            Row::new(
+                "memory",
+                m.label(),
+                format!("{} MB machine; bound 320 MiB", p.memory_mib),
+                format!("peak RSS {:.1} MiB", peak as f64 / 1048576.0),
+                Kind::Ordering,
+                Verdict::of(peak <= 320 << 20),
+            )
+            .with_note(note(m)),
+        );
+    }
+    // Per scene: S+G growing with size, and the ratios at the largest row measured.
+    let mut scenes: BTreeMap<&str, Vec<&Measured>> = BTreeMap::new();
+    for m in measured.iter().filter(|m| m.thesis_row) {
+        scenes.entry(m.scene.as_str()).or_default().push(m);
+    }
+    for (scene, mut ms) in scenes {
+        ms.sort_by_key(|m| m.sf);
+        let largest_pub = p.rows.iter().filter(|r| r.scene == scene).map(|r| r.sf).max();
+        let last = ms[ms.len() - 1];
+        let at_largest = Some(last.sf) == largest_pub;
+        let partial = if at_largest {
+            String::new()
+        } else {
+            format!("partial: largest row measured {} (the table's: {scene}{})", last.label(), largest_pub.unwrap_or(0))
+        };
+        let sgs: Vec<f64> = ms.iter().map(|m| ratio(m.basic.total_s(), m.sg.total_s())).collect();
+        if sgs.len() >= 2 {
+            let grows = sgs.windows(2).all(|w| w[1] >= w[0]);
+            rows.push(
+                Row::new(
+                    "sg-ratio",
+                    format!("{scene}: growth with size"),
+                    "grows with data size",
+                    ms.iter()
+                        .zip(&sgs)
+                        .map(|(m, r)| format!("{} {r:.2}", m.label()))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    Kind::Shape,
+                    Verdict::of(grows),
+                )
+                .with_note(partial.clone()),
+            );
+        }
+        let sg = sgs[sgs.len() - 1];
+        rows.push(
+            Row::new(
+                "sg-ratio",
+                format!("{scene}: at the largest row"),
+                "1.88–2.30",
+                format!("{} {sg:.2}", last.label()),
+                Kind::Range,
+                if at_largest {
+                    Verdict::of((1.88..=2.30).contains(&sg))
+                } else {
+                    Verdict::NotMeasured
+                },
+            )
+            .with_note(partial.clone()),
+        );
+        let sgb = ratio(last.basic.total_s(), last.sgb.total_s());
+        rows.push(
+            Row::new(
+                "sgb-ratio",
+                format!("{scene}: at the largest row"),
+                "1.39–4.48",
+                format!("{} {sgb:.2}", last.label()),
+                Kind::Range,
+                if at_largest {
+                    Verdict::of((1.39..=4.48).contains(&sgb))
+                } else {
+                    Verdict::NotMeasured
+                },
+            )
+            .with_note(partial),
+        );
+    }
+    rows
+}
+
+fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Document {
+    let mut doc = Document::new("nakamaru-4.1: basic method vs S+G and S+G+B");
+    doc.paragraph(format!(
+        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-4.1{}`, {}×{}, breadth-first engine memory {}, cache {}, one thread; totals = preprocessing (S+G+B: with the hierarchy's build) + tracing (intersection and shading, out of core). Ratios are basic / method. MiB = 2^20 bytes.",
+        p.source.cite(),
+        p.source.machine.as_deref().unwrap_or(""),
+        if quick { " --quick" } else { "" },
+        s.size,
+        s.size,
+        s.memory,
+        s.cache,
+    ));
+    let mut t = DocTable::new(
+        "",
+        &[
+            "row", "objects", "split MiB", "generation s", "basic s", "S+G", "S+G+B", "(S+G+B / S+G)",
+            "thesis S+G", "thesis S+G+B", "passes", "hierarchy boxes", "boxes read S+G+B / S+G",
+            "geometry loads", "bh build s", "peak RSS MiB", "images equal", "load avg",
+        ],
+    );
+    for m in measured {
+        let r = p.rows.iter().find(|r| r.scene == m.scene && r.sf == m.sf);
+        let (b, sg, sgb) = (m.basic.total_s(), m.sg.total_s(), m.sgb.total_s());
+        let peak = m.basic.peak_rss_bytes.max(m.sg.peak_rss_bytes).max(m.sgb.peak_rss_bytes);
+        t.push(vec![
+            m.label(),
+            m.objects.to_string(),
+            format!("{:.1}", m.split_bytes as f64 / 1048576.0),
+            format!("{:.1}", m.generation_s),
+            format!("{b:.1}"),
+            format!("{:.2}", ratio(b, sg)),
+            format!("{:.2}", ratio(b, sgb)),
+            format!("({:.2})", ratio(sg, sgb)),
+            r.map_or("-".into(), |r| format!("{:.2}", r.sg)),
+            r.map_or("-".into(), |r| format!("{:.2}", r.sgb)),
+            format!("{}/{}/{}", m.basic.passes, m.sg.passes, m.sgb.passes),
+            m.sgb
+                .bh_levels
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join("/"),
+            format!("{}/{}", m.sgb.boxes_read, m.sg.boxes_read),
+            format!("{}/{}", m.sgb.geometry_loads, m.sg.geometry_loads),
+            format!("{:.2}", m.sgb.bh_build_s),
+            format!("{:.1}", peak as f64 / 1048576.0),
+            (m.basic.sha256 == m.sg.sha256 && m.sg.sha256 == m.sgb.sha256).to_string(),
+            m.sgb.load_average.clone(),
+        ]);
+    }
+    doc.table(t);
+    let mut io = DocTable::new(
+        "Bytes read and seeks per stage (engine: preprocessing and intersection; workload: shading and spill files)",
+        &[
+            "row", "method", "preprocess s", "intersect s", "shade s", "preprocess bytes", "intersect bytes",
+            "intersect seeks", "workload bytes", "workload seeks",
+        ],
+    );
+    for m in measured {
+        for (name, r) in [("basic", &m.basic), ("S+G", &m.sg), ("S+G+B", &m.sgb)] {
+            io.push(vec![
+                m.label(),
+                name.into(),
+                format!("{:.2}", r.preprocess_s),
+                format!("{:.2}", r.intersect_s),
+                format!("{:.2}", r.shade_s),
+                r.preprocess_bytes_read.to_string(),
+                r.intersect_bytes_read.to_string(),
+                r.intersect_seeks.to_string(),
+                r.workload_bytes_read.to_string(),
+                r.workload_seeks.to_string(),
+            ]);
+        }
+    }
+    doc.table(io);
+    doc
+}
