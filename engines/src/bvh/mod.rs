@@ -94,7 +94,31 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     // wider trees collapse a binary tree built down to single primitives, merging subtrees of
     // at most `leaf` primitives into leaves (collapse.rs).
     let binary_leaf = if width == 2 { leaf } else { 1 };
+    let block_leaves = width > 2 && config.builder != Builder::Median && config.max_leaf > leaf;
+    let packable: Vec<bool> = if block_leaves {
+        geometry
+            .prims
+            .iter()
+            .map(|p| !config.packets || matches!(p, Prim::Triangle(_)))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let rule = build_sah::BlockLeaves {
+        min: leaf,
+        max: config.max_leaf,
+        block: config.sah_block,
+        packable: &packable,
+    };
     let binary = match config.builder {
+        Builder::SahSweep if block_leaves => build_sah::binary_blocks(
+            build_sah::Sweep::new(&prims).with_block(config.sah_block),
+            &rule,
+        ),
+        Builder::SahBinned if block_leaves => build_sah::binary_blocks(
+            build_sah::Binned::new(&prims, config.bins).with_block(config.sah_block),
+            &rule,
+        ),
         Builder::Median => build_median::binary(&prims, binary_leaf),
         Builder::SahSweep => build_sah::binary(build_sah::Sweep::new(&prims), binary_leaf),
         Builder::SahBinned => {
