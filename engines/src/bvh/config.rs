@@ -10,8 +10,8 @@
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
 //! | `precompute` | `on`: the ray's reciprocal direction and origin terms are computed once per ray (001 §1.7, thesis Ch. 4.2.2); `off`: each box test divides by the direction and orders the slabs itself (scalar only, for 001's ablation) | `on` |
-//! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16: a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets when `leaf` is not given, else `leaf` |
-//! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1–16 | 4 for bvh4/bvh8 with packets, else 1 |
+//! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16 (with packets: scenes of triangles only; spheres and cones keep one leaf each and the tree below): a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets when `leaf` is not given, else `leaf` |
+//! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets, else 1 |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound when `max_leaf` is `leaf` (bvh2, `packets=off`, or `leaf` given);
@@ -175,11 +175,11 @@ impl Config {
                 &format!("must be from leaf ({leaf}) to {MAX_LEAF_PRIMS}"),
             ));
         }
-        if !(1..=MAX_LEAF_PRIMS).contains(&sah_block) {
+        if !(1..=MAX_LEAF_PRIMS).contains(&sah_block) || !sah_block.is_power_of_two() {
             return Err(bad(
                 "sah_block",
                 sah_block.to_string(),
-                &format!("must be from 1 to {MAX_LEAF_PRIMS}"),
+                &format!("must be a power of two from 1 to {MAX_LEAF_PRIMS}"),
             ));
         }
         if !precompute && simd {
@@ -296,6 +296,7 @@ mod tests {
         assert!(parse(8, &[("leaf", "8"), ("max_leaf", "4")]).is_err());
         assert!(parse(8, &[("max_leaf", "17")]).is_err());
         assert!(parse(8, &[("sah_block", "0")]).is_err());
+        assert!(parse(8, &[("sah_block", "3")]).is_err());
     }
 
     #[test]

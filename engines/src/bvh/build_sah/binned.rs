@@ -101,7 +101,8 @@ impl Binned {
     /// The same search with the SAH counting primitives in blocks of `block` (Embree's
     /// `sahBlockSize`), for leaves whose primitives are tested `block` at a time.
     pub fn with_block(mut self, block: usize) -> Binned {
-        self.block = block.max(1);
+        assert!(block.is_power_of_two(), "block {block}");
+        self.block = block;
         self
     }
 

@@ -71,10 +71,13 @@ pub trait Splitter {
 
 /// Blocks of `block` primitives needed for `n` primitives: the SAH's primitive count when a
 /// leaf's primitives are tested `block` at a time (Embree's `sahBlockSize`: a leaf of 1–4
-/// triangles costs one `Triangle4` test, 5–8 two). `block = 1` is 001's count.
+/// triangles costs one `Triangle4` test, 5–8 two). `block = 1` is 001's count. `block` is a
+/// power of two (checked by the config), so this is a shift: the binned search evaluates it
+/// twice per candidate plane, where a division cost 3% of the build's instructions.
 #[inline(always)]
 pub fn blocks(n: usize, block: usize) -> usize {
-    n.div_ceil(block)
+    debug_assert!(block.is_power_of_two());
+    (n + block - 1) >> block.trailing_zeros()
 }
 
 /// Eq. 3.4 from `A(S1)·N(S1) + A(S2)·N(S2)` (what the searches minimise) and `A(S)`.

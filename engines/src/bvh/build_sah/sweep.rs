@@ -38,7 +38,8 @@ impl<'a> Sweep<'a> {
     /// The same search with the SAH counting primitives in blocks of `block` (Embree's
     /// `sahBlockSize`), for leaves whose primitives are tested `block` at a time.
     pub fn with_block(mut self, block: usize) -> Sweep<'a> {
-        self.block = block.max(1);
+        assert!(block.is_power_of_two(), "block {block}");
+        self.block = block;
         self
     }
 
