@@ -10,9 +10,14 @@
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
 //! | `precompute` | `on`: the ray's reciprocal direction and origin terms are computed once per ray (001 §1.7, thesis Ch. 4.2.2); `off`: each box test divides by the direction and orders the slabs itself (scalar only, for 001's ablation) | `on` |
+//! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16 (with packets: scenes of triangles only; spheres and cones keep one leaf each and the tree below): a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets when `leaf` is not given, else `leaf` |
+//! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets, else 1 |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
-//! `leaf` is an upper bound. bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
+//! `leaf` is an upper bound when `max_leaf` is `leaf` (bvh2, `packets=off`, or `leaf` given);
+//! otherwise subtrees of at most `leaf` primitives are always leaves and the SAH may choose
+//! leaves of up to `max_leaf` (issue 20: the default bvh8 tree of gears4 went from 3,462 inner
+//! nodes with 2.9 triangles per leaf to 1,566 with 7.7, as Embree's 1,610). bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
 //! the SAH prefers a leaf (`median`: always). With `wide=collapse` a subtree of ≤ `leaf`
 //! primitives becomes a leaf; with `split_leaves=on` node slots left free are spent splitting
 //! such leaves further (`collapse.rs`), so wide leaves are often smaller. With triangle packets
@@ -118,6 +123,10 @@ pub struct Config {
     pub split_leaves: bool,
     /// Per-ray precomputation of the slab test (`precompute=off` needs `simd=off`).
     pub precompute: bool,
+    /// The largest leaf the SAH may choose (≥ `leaf`; wide trees only).
+    pub max_leaf: usize,
+    /// The SAH counts primitives in blocks of this many (Embree's `sahBlockSize`).
+    pub sah_block: usize,
 }
 
 impl Config {
@@ -132,14 +141,47 @@ impl Config {
         };
         let builder = settings.get("builder", Builder::SahBinned)?;
         let wide = settings.get("wide", WideMethod::Collapse)?;
-        let leaf = settings.get("leaf", if width == 2 { 1usize } else { 4 })?;
+        // usize::MAX: not given.
+        let leaf_given = settings.get("leaf", usize::MAX)?;
+        let leaf = if leaf_given != usize::MAX {
+            leaf_given
+        } else if width == 2 {
+            1
+        } else {
+            4
+        };
         let simd = settings.get("simd", OnOff(width > 2))?.0;
         let triangle = settings.get("triangle", TriangleTest::default())?;
         let bins = settings.get("bins", 32usize)?;
         let packets = settings.get("packets", OnOff(width > 2))?.0;
         let split_leaves = settings.get("split_leaves", OnOff(!packets))?.0;
         let precompute = settings.get("precompute", OnOff(true))?.0;
+        let wide_packets = width > 2 && packets;
+        // A `leaf` given is the largest leaf, as before `max_leaf` existed (001's leaf=1).
+        let max_leaf = settings.get(
+            "max_leaf",
+            if wide_packets && leaf_given == usize::MAX {
+                MAX_LEAF_PRIMS
+            } else {
+                leaf
+            },
+        )?;
+        let sah_block = settings.get("sah_block", if wide_packets { 4usize } else { 1 })?;
         settings.finish()?;
+        if (1..=MAX_LEAF_PRIMS).contains(&leaf) && !(leaf..=MAX_LEAF_PRIMS).contains(&max_leaf) {
+            return Err(bad(
+                "max_leaf",
+                max_leaf.to_string(),
+                &format!("must be from leaf ({leaf}) to {MAX_LEAF_PRIMS}"),
+            ));
+        }
+        if !(1..=MAX_LEAF_PRIMS).contains(&sah_block) || !sah_block.is_power_of_two() {
+            return Err(bad(
+                "sah_block",
+                sah_block.to_string(),
+                &format!("must be a power of two from 1 to {MAX_LEAF_PRIMS}"),
+            ));
+        }
         if !precompute && simd {
             return Err(bad(
                 "precompute",
@@ -176,6 +218,8 @@ impl Config {
             packets,
             split_leaves,
             precompute,
+            max_leaf,
+            sah_block,
         })
     }
 }
@@ -237,6 +281,22 @@ mod tests {
             parse(4, &[("colour", "red")]),
             Err(EngineError::UnknownKey { .. })
         ));
+    }
+
+    #[test]
+    fn sah_leaves_default_with_packets_only() {
+        let c = parse(8, &[]).unwrap();
+        assert_eq!((c.leaf, c.max_leaf, c.sah_block), (4, 16, 4));
+        // A leaf given is the largest (001's leaf=1 keeps one primitive per leaf).
+        let c = parse(4, &[("leaf", "1")]).unwrap();
+        assert_eq!((c.leaf, c.max_leaf), (1, 1));
+        let c = parse(4, &[("packets", "off")]).unwrap();
+        assert_eq!((c.max_leaf, c.sah_block), (4, 1));
+        assert_eq!(parse(2, &[]).unwrap().max_leaf, 1);
+        assert!(parse(8, &[("leaf", "8"), ("max_leaf", "4")]).is_err());
+        assert!(parse(8, &[("max_leaf", "17")]).is_err());
+        assert!(parse(8, &[("sah_block", "0")]).is_err());
+        assert!(parse(8, &[("sah_block", "3")]).is_err());
     }
 
     #[test]

@@ -421,6 +421,8 @@ fn packets_change_no_answer_and_no_count() {
                     let kv = [
                         ("packets", packets),
                         ("split_leaves", "off"),
+                        ("max_leaf", "16"),
+                        ("sah_block", "4"),
                         ("triangle", triangle),
                         ("simd", simd),
                     ];

@@ -13,6 +13,31 @@ pub struct EmbreeConfig {
     pub compact: bool,
     pub isa: Option<String>,
     pub verbose: u32,
+    pub api: Api,
+}
+
+/// Which of Embree's query calls a batch goes through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Api {
+    /// `rtcIntersect1` / `rtcOccluded1`, ray by ray.
+    Single,
+    /// `rtcIntersect8` / `rtcOccluded8`: consecutive rays of a batch 8 at a time (Embree's
+    /// packet traversal, the fair partner of a packet tracer).
+    Packet8,
+    /// `rtcIntersect16` / `rtcOccluded16`, 16 at a time.
+    Packet16,
+}
+
+impl std::str::FromStr for Api {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "single" | "1" => Ok(Api::Single),
+            "packet8" | "8" => Ok(Api::Packet8),
+            "packet16" | "16" => Ok(Api::Packet16),
+            _ => Err("expected single, packet8 or packet16".into()),
+        }
+    }
 }
 
 impl Default for EmbreeConfig {
@@ -24,6 +49,7 @@ impl Default for EmbreeConfig {
             compact: false,
             isa: None,
             verbose: 0,
+            api: Api::Single,
         }
     }
 }
@@ -61,6 +87,7 @@ impl EmbreeConfig {
         let compact = s.get("compact", d.compact)?;
         let isa: String = s.get("isa", String::new())?;
         let verbose = s.get("verbose", d.verbose)?;
+        let api = s.get("api", d.api)?;
         s.finish()?;
         let isa = if isa.is_empty() {
             None
@@ -81,6 +108,7 @@ impl EmbreeConfig {
             compact,
             isa,
             verbose,
+            api,
         })
     }
 

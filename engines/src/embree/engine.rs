@@ -1,7 +1,7 @@
 //! The built `embree` engine: set-up with a few raw calls, tracing with raw `rtcIntersect1` /
 //! `rtcOccluded1` (no error check per ray).
 
-use super::config::{EmbreeConfig, Quality};
+use super::config::{Api, EmbreeConfig, Quality};
 use super::raw::{self, Device, Geometry, RayHit, Scene};
 use super::user::{self, UserPrims};
 use crate::engine::{BuildInput, Counters, Engine, EngineError};
@@ -29,6 +29,7 @@ pub struct EmbreeEngine {
     objects: [Vec<u32>; 2],
     stats: BTreeMap<String, f64>,
     structure_bytes: u64,
+    api: Api,
 }
 
 // SAFETY: after `build` nothing mutates the scene, the device or the user primitives. Embree
@@ -203,6 +204,14 @@ impl EmbreeEngine {
         stats.insert("own_bytes".into(), own_bytes as f64);
         stats.insert("threads".into(), config.threads as f64);
         stats.insert(
+            "packet_width".into(),
+            match config.api {
+                Api::Single => 1.0,
+                Api::Packet8 => 8.0,
+                Api::Packet16 => 16.0,
+            },
+        );
+        stats.insert(
             "embree_version".into(),
             device.property(sys::RTCDeviceProperty::VERSION) as f64,
         );
@@ -213,6 +222,7 @@ impl EmbreeEngine {
             objects: [tri_object, user_object],
             stats,
             structure_bytes,
+            api: config.api,
         })
     }
 
@@ -233,11 +243,98 @@ impl EmbreeEngine {
     }
 }
 
+/// A packet's valid mask: Embree reads it with aligned vector loads (64 bytes covers 16 lanes).
+#[repr(C, align(64))]
+struct Valid<const N: usize>([i32; N]);
+
+/// Packet forms of `intersect` and `occluded`: consecutive rays N at a time through
+/// `rtcIntersectN` / `rtcOccludedN`, a short last packet masked by `valid`.
+macro_rules! packet_queries {
+    ($closest:ident, $any:ident, $n:literal, $rh:ty, $fill:path, $isect:path, $occl:path) => {
+        fn $closest(&self, rays: &[Ray], hits: &mut [Hit]) {
+            let mut p = <$rh>::new();
+            let mut valid = Valid([0i32; $n]);
+            for (rs, hs) in rays.chunks($n).zip(hits.chunks_mut($n)) {
+                $fill(rs, &mut p.rh.ray, &mut valid.0);
+                p.rh.hit.geomID = [sys::RTC_INVALID_GEOMETRY_ID; $n];
+                p.rh.hit.primID = [sys::RTC_INVALID_GEOMETRY_ID; $n];
+                // SAFETY: committed, unchanging scene (see `Sync`); `p` is an aligned SoA packet
+                // with room for the hit fields newer Embree versions append; `valid` has N
+                // lanes; null arguments select Embree's defaults.
+                unsafe { $isect(valid.0.as_ptr(), self.scene.0, &mut p.rh, null_mut()) };
+                let hit = &p.rh.hit;
+                for (i, h) in hs.iter_mut().enumerate() {
+                    *h = match self
+                        .objects
+                        .get(hit.geomID[i] as usize)
+                        .and_then(|m| m.get(hit.primID[i] as usize))
+                    {
+                        Some(&object) => Hit {
+                            t: p.rh.ray.tfar[i],
+                            object,
+                            u: hit.u[i],
+                            v: hit.v[i],
+                        },
+                        None => Hit::MISS,
+                    };
+                }
+            }
+        }
+
+        fn $any(&self, rays: &[Ray], occluded: &mut [bool]) {
+            let mut p = <$rh>::new();
+            let mut valid = Valid([0i32; $n]);
+            for (rs, os) in rays.chunks($n).zip(occluded.chunks_mut($n)) {
+                $fill(rs, &mut p.rh.ray, &mut valid.0);
+                // SAFETY: as for the closest-hit packet; only the ray part is passed.
+                unsafe { $occl(valid.0.as_ptr(), self.scene.0, &mut p.rh.ray, null_mut()) };
+                for (i, o) in os.iter_mut().enumerate() {
+                    *o = p.rh.ray.tfar[i] == f32::NEG_INFINITY;
+                }
+            }
+        }
+    };
+}
+
+impl EmbreeEngine {
+    packet_queries!(
+        intersect8,
+        occluded8,
+        8,
+        raw::RayHit8,
+        raw::fill_ray8,
+        sys::rtcIntersect8,
+        sys::rtcOccluded8
+    );
+    packet_queries!(
+        intersect16,
+        occluded16,
+        16,
+        raw::RayHit16,
+        raw::fill_ray16,
+        sys::rtcIntersect16,
+        sys::rtcOccluded16
+    );
+}
+
 impl Engine for EmbreeEngine {
     fn intersect(&self, rays: &[Ray], hits: &mut [Hit], counters: &mut Counters) {
         assert_eq!(rays.len(), hits.len(), "one hit per ray");
         user::TESTS.with(|c| c.set(0));
         user::HITS.with(|c| c.set(0));
+        match self.api {
+            Api::Single => {}
+            Api::Packet8 | Api::Packet16 => {
+                if self.api == Api::Packet8 {
+                    self.intersect8(rays, hits);
+                } else {
+                    self.intersect16(rays, hits);
+                }
+                counters.rays += rays.len() as u64;
+                Self::collect_user_counts(counters);
+                return;
+            }
+        }
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
             let mut rh = RayHit::new(raw::rtc_ray(r));
             // SAFETY: the scene is committed and never changed (see `Sync`); `rh` is a properly
@@ -267,6 +364,16 @@ impl Engine for EmbreeEngine {
         assert_eq!(rays.len(), occluded.len(), "one answer per ray");
         user::TESTS.with(|c| c.set(0));
         user::HITS.with(|c| c.set(0));
+        if self.api != Api::Single {
+            if self.api == Api::Packet8 {
+                self.occluded8(rays, occluded);
+            } else {
+                self.occluded16(rays, occluded);
+            }
+            counters.rays += rays.len() as u64;
+            Self::collect_user_counts(counters);
+            return;
+        }
         for (r, o) in rays.iter().zip(occluded.iter_mut()) {
             let mut ray = raw::rtc_ray(r);
             // SAFETY: committed, unchanging scene; `ray` is a valid RTCRay (its layout is the same

@@ -21,6 +21,10 @@
 //! - `compact` (default false): `RTC_SCENE_FLAG_COMPACT`.
 //! - `isa` (default: the best the CPU has): `sse2`, `sse4.2`, `avx`, `avx2` or `avx512`.
 //! - `verbose` (default 0): Embree's verbosity (1 prints the device and the BVH chosen, on stdout).
+//! - `api` (default `single`): `single` traces ray by ray (`rtcIntersect1`/`rtcOccluded1`);
+//!   `packet8` / `packet16` hand consecutive rays of a batch to `rtcIntersect8/16` and
+//!   `rtcOccluded8/16` (Embree's packet traversal; a short last packet is masked), the fair
+//!   partner for packet tracers (issue 20). The answers are the same queries' answers.
 //!
 //! Memory: [`Engine::structure_bytes`] is what Embree holds after the build, as its memory monitor
 //! (`rtcSetDeviceMemoryMonitorFunction`) reports it — the BVH with its leaves (which copy the
@@ -40,7 +44,7 @@ mod raw;
 #[cfg(feature = "embree")]
 mod user;
 
-pub use config::{EmbreeConfig, Quality};
+pub use config::{Api, EmbreeConfig, Quality};
 
 /// The registry entry of the `embree` engine.
 pub fn info() -> EngineInfo {

@@ -200,3 +200,67 @@ pub fn rtc_ray(r: &crate::ray::Ray) -> sys::RTCRay {
         flags: 0,
     }
 }
+
+/// `RTCRayHit8` / `RTCRayHit16` with room for the `instPrimID[1][N]` row Embree ≥ 4.3 appends
+/// to the hit (see the module notes; 4.2's bindings end the hit at `instID`).
+#[repr(C, align(32))]
+pub struct RayHit8 {
+    pub rh: sys::RTCRayHit8,
+    _tail: [u32; 8],
+}
+
+#[repr(C, align(64))]
+pub struct RayHit16 {
+    pub rh: sys::RTCRayHit16,
+    _tail: [u32; 16],
+}
+
+macro_rules! packet_fill {
+    ($name:ident, $rays:ty, $n:literal) => {
+        /// Writes up to N rays into the SoA ray packet `p` and their `valid` mask (-1: live
+        /// lane, 0: padding); lanes past `rays.len()` get an empty segment.
+        #[inline(always)]
+        pub fn $name(rays: &[crate::ray::Ray], p: &mut $rays, valid: &mut [i32; $n]) {
+            for i in 0..$n {
+                match rays.get(i) {
+                    Some(r) => {
+                        p.org_x[i] = r.origin.x;
+                        p.org_y[i] = r.origin.y;
+                        p.org_z[i] = r.origin.z;
+                        p.tnear[i] = r.tmin;
+                        p.dir_x[i] = r.dir.x;
+                        p.dir_y[i] = r.dir.y;
+                        p.dir_z[i] = r.dir.z;
+                        p.tfar[i] = r.tmax;
+                        valid[i] = -1;
+                    }
+                    None => {
+                        p.tnear[i] = 0.0;
+                        p.tfar[i] = -1.0;
+                        valid[i] = 0;
+                    }
+                }
+                p.time[i] = 0.0;
+                p.mask[i] = u32::MAX;
+                p.id[i] = 0;
+                p.flags[i] = 0;
+            }
+        }
+    };
+}
+packet_fill!(fill_ray8, sys::RTCRay8, 8);
+packet_fill!(fill_ray16, sys::RTCRay16, 16);
+
+impl RayHit8 {
+    pub fn new() -> Box<RayHit8> {
+        // SAFETY: every field is a plain f32/u32 array, for which all-zero bytes are valid.
+        Box::new(unsafe { std::mem::zeroed() })
+    }
+}
+
+impl RayHit16 {
+    pub fn new() -> Box<RayHit16> {
+        // SAFETY: as for `RayHit8`.
+        Box::new(unsafe { std::mem::zeroed() })
+    }
+}

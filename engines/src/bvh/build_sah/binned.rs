@@ -1,6 +1,6 @@
 //! Wald 2007's binned SAH split search.
 
-use super::{axes, split_cost, Range, Split, Splitter};
+use super::{axes, blocks, split_cost, Range, Split, Splitter};
 use crate::bvh::tree::BuildPrims;
 use crate::geometry::aabb::Aabb;
 use glam::{UVec3, Vec3A};
@@ -60,6 +60,8 @@ pub struct Binned {
     bins: Vec<[Bin; 3]>,
     right_area: Vec<f32>,
     right_count: Vec<usize>,
+    /// The SAH counts primitives in blocks of this many ([`super::blocks`]; 1: one by one).
+    block: usize,
 }
 
 #[derive(Clone, Copy)]
@@ -92,7 +94,16 @@ impl Binned {
             bins: vec![[Bin::EMPTY; 3]; nb],
             right_area: vec![0.0; nb],
             right_count: vec![0; nb],
+            block: 1,
         }
+    }
+
+    /// The same search with the SAH counting primitives in blocks of `block` (Embree's
+    /// `sahBlockSize`), for leaves whose primitives are tested `block` at a time.
+    pub fn with_block(mut self, block: usize) -> Binned {
+        assert!(block.is_power_of_two(), "block {block}");
+        self.block = block;
+        self
     }
 
     fn range(&self, start: usize, end: usize) -> Range {
@@ -183,7 +194,8 @@ impl Splitter for Binned {
                 lc += self.bins[k - 1][a].count;
                 let rc = self.right_count[k];
                 if lc > 0 && rc > 0 {
-                    let c = l.half_area() * lc as f32 + self.right_area[k] * rc as f32;
+                    let (lb, rb) = (blocks(lc, self.block), blocks(rc, self.block));
+                    let c = l.half_area() * lb as f32 + self.right_area[k] * rb as f32;
                     if best.is_none_or(|b| c < b.2) {
                         best = Some((a, k as u32, c));
                     }
@@ -232,6 +244,10 @@ impl Splitter for Binned {
             axis: a,
             cost: split_cost(c, r.bounds.half_area()),
         }
+    }
+
+    fn ids(&self, r: &Range) -> &[u32] {
+        &self.ids[r.start..r.end]
     }
 
     fn into_order(self) -> Vec<u32> {

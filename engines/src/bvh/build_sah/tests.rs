@@ -90,3 +90,45 @@ fn same_axis_wide_children_are_ordered_on_one_axis() {
         assert!(along(0) || along(1), "{b:?}");
     }
 }
+
+/// Embree's leaf rule: twelve coincident boxes are one leaf (three blocks of 4 cost less than
+/// any split, whose halves keep the whole box); a primitive that is not packable never shares a
+/// leaf; distant clusters are still split.
+#[test]
+fn block_leaves_follow_the_sah_in_blocks() {
+    use super::{binary_blocks, BlockLeaves};
+    let same = prims(&vec![(Vec3::ZERO, Vec3::ONE); 12]);
+    let all = vec![true; 12];
+    let rule = BlockLeaves {
+        min: 4,
+        max: 16,
+        block: 4,
+        packable: &all,
+    };
+    let t = binary_blocks(Binned::new(&same, 32).with_block(4), &rule);
+    t.validate(&same, 2).unwrap();
+    assert_eq!(t.nodes.len(), 1, "one leaf of 12");
+    let mut one_scalar = all.clone();
+    one_scalar[5] = false;
+    let rule = BlockLeaves {
+        packable: &one_scalar,
+        ..rule
+    };
+    let t = binary_blocks(Binned::new(&same, 32).with_block(4), &rule);
+    t.validate(&same, 2).unwrap();
+    for n in &t.nodes {
+        if let BuildKind::Leaf { first, count } = n.kind {
+            let ids = &t.order[first as usize..(first + count) as usize];
+            assert!(count == 1 || !ids.contains(&5), "primitive 5 shares a leaf");
+        }
+    }
+    let c = clusters();
+    let all = vec![true; c.len()];
+    let rule = BlockLeaves {
+        packable: &all,
+        ..rule
+    };
+    let t = binary_blocks(Binned::new(&c, 32).with_block(4), &rule);
+    t.validate(&c, 2).unwrap();
+    assert_eq!(t.children(0).len(), 2, "the clusters are split");
+}
