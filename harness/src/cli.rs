@@ -334,6 +334,10 @@ pub enum SceneCommand {
         /// through the codec (seed 000 Table 3.3; `--layout basic` only).
         #[arg(long, default_value = "none")]
         compress: String,
+        /// Also build the bounding-box hierarchy (bbox-K.bin, hierarchy.json; seed 000 §4.2.2
+        /// "B") with the thesis's constants for the scene (`--layout split` only).
+        #[arg(long)]
+        hierarchy: bool,
         #[arg(long)]
         json: bool,
     },
