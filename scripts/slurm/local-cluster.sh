@@ -8,12 +8,13 @@
 #   bash scripts/slurm/local-cluster.sh status [DIR]   sinfo and squeue
 #   bash scripts/slurm/local-cluster.sh stop [DIR]     cancel jobs, stop the daemons, remove DIR
 #
-# DIR defaults to /tmp/rtbench-slurm. Needs root (apt-get, the daemons). Exit 3 when the cluster
+# DIR defaults to out/slurm-cluster in the repository (git-ignored). Needs root (apt-get, the daemons). Exit 3 when the cluster
 # cannot be started here (not root, no apt-get, a daemon that will not come up): tests then skip,
 # printing the reason.
 set -euo pipefail
 CMD="${1:-}"
-DIR="${2:-/tmp/rtbench-slurm}"
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+DIR="${2:-$ROOT/out/slurm-cluster}"
 CONF="$DIR/slurm.conf"
 cannot() { echo "local-cluster.sh: cannot start a local Slurm cluster here: $*" >&2; exit 3; }
 say() { echo "local-cluster.sh: $*" >&2; }

@@ -101,6 +101,14 @@ pub fn run_group(j: &Job) -> (String, u32, Option<u32>, Option<usize>) {
     (j.program.clone(), j.sf, j.tessellate, j.threads)
 }
 
+/// `--shard K/N`, if given.
+fn shard_of(p: &PlanArgs) -> Result<Option<ShardSpec>> {
+    p.shard
+        .as_deref()
+        .map(|s| ShardSpec::parse(s, "--shard"))
+        .transpose()
+}
+
 /// What identifies a plan across its shards: the command, the shared settings, every job key.
 pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
     format!(
@@ -200,12 +208,7 @@ pub fn run_plan(a: &RunArgs) -> Result<(Vec<Job>, Common)> {
 
 pub fn run(a: &RunArgs) -> Result<()> {
     let (mut jobs, common) = run_plan(a)?;
-    let shard = a
-        .plan
-        .shard
-        .as_deref()
-        .map(|s| ShardSpec::parse(s, "--shard"))
-        .transpose()?;
+    let shard = shard_of(&a.plan)?;
     let manifest = match shard {
         Some(spec) => {
             let plan_jobs: Vec<String> = jobs.iter().map(Job::key).collect();
@@ -294,12 +297,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
             })
             .collect()
     };
-    let shard = a
-        .plan
-        .shard
-        .as_deref()
-        .map(|s| ShardSpec::parse(s, "--shard"))
-        .transpose()?;
+    let shard = shard_of(&a.plan)?;
     let mut programs = programs;
     let manifest = match shard {
         Some(spec) => {
