@@ -265,6 +265,8 @@ pub struct TimeVerdict {
     /// How many prediction-interval widths tonight lies out, and the threshold.
     pub score: f64,
     pub threshold: f64,
+    /// One night's prediction width on the log scale, without the `√(1 + 1/K)` factor.
+    pub spread: f64,
     pub mw_p: f64,
     /// The smallest (for a slowdown; the largest for a speed-up) round's change, percent.
     pub weakest_round_pct: f64,
@@ -281,6 +283,63 @@ pub fn time_verdict(
     alpha: f64,
     min_change_pct: f64,
 ) -> Option<TimeVerdict> {
+    time_verdict_over(tonight, None, tonight_samples, rounds, nights, alpha, min_change_pct)
+}
+
+/// The first-night threshold of a two-night rule: a suspect at `√α`, so that a change must
+/// stand out on each night at `√α` and on the two nights' mean at `α` (below). Independent
+/// nights under no change pass both at a rate of at most `α`: the mean test alone bounds it.
+pub fn suspect_alpha(alpha: f64) -> f64 {
+    alpha.sqrt()
+}
+
+/// As [`time_verdict`], over two nights when `previous` (the suspect night's value, left out of
+/// `nights`) is given: the centre of tonight's and the previous night's log values is tested
+/// against the baseline with the prediction width of a mean of two, `s·√(1/2 + 1/K)`, and the
+/// change must also stand out tonight alone at [`suspect_alpha`]. The change reported is the
+/// two nights' centre against the baseline's.
+pub fn time_verdict_over(
+    tonight: f64,
+    previous: Option<f64>,
+    tonight_samples: &[f64],
+    rounds: &[f64],
+    nights: &[(f64, Vec<f64>)],
+    alpha: f64,
+    min_change_pct: f64,
+) -> Option<TimeVerdict> {
+    if let Some(prev) = previous.filter(|p| *p > 0.0) {
+        let single = time_verdict_over(
+            tonight,
+            None,
+            tonight_samples,
+            rounds,
+            nights,
+            suspect_alpha(alpha),
+            min_change_pct,
+        )?;
+        let k = nights.iter().filter(|(v, _)| *v > 0.0).count() as f64;
+        let d = (tonight.ln() + prev.ln()) / 2.0 - single.baseline.ln();
+        let score = d / (single.spread * (0.5 + 1.0 / k).sqrt());
+        let threshold = t_quantile(1.0 - alpha, k - 1.0);
+        let change_pct = (d.exp() - 1.0) * 100.0;
+        let direction = if single.direction == 1
+            && score > threshold
+            && change_pct >= min_change_pct
+        {
+            1
+        } else if single.direction == -1 && score < -threshold && change_pct <= -min_change_pct {
+            -1
+        } else {
+            0
+        };
+        return Some(TimeVerdict {
+            direction,
+            change_pct,
+            score,
+            threshold,
+            ..single
+        });
+    }
     let logs: Vec<f64> = nights
         .iter()
         .map(|(v, _)| *v)
@@ -309,7 +368,8 @@ pub fn time_verdict(
             .collect();
         median(&rel)
     };
-    let s = sd.max(within).max(1e-6) * (1.0 + 1.0 / k).sqrt();
+    let spread = sd.max(within).max(1e-6);
+    let s = spread * (1.0 + 1.0 / k).sqrt();
     let d = tonight.ln() - m;
     let threshold = t_quantile(1.0 - alpha, k - 1.0);
     let score = d / s;
@@ -342,6 +402,7 @@ pub fn time_verdict(
         baseline: m.exp(),
         score,
         threshold,
+        spread,
         mw_p: if d >= 0.0 { mw_up } else { mw_down },
         weakest_round_pct: if d >= 0.0 { weakest_up } else { weakest_down },
     })

@@ -257,9 +257,13 @@ pub fn compare(
                     .map(|h| (h.value, h.samples.clone()))
                     .collect();
                 let confirming = suspects.contains(&m.name);
-                if confirming {
-                    nights.pop();
-                }
+                // The suspect night leaves the baseline; its value joins tonight's in the
+                // two-night test (detect::time_verdict_over).
+                let previous = if confirming {
+                    nights.pop().map(|n| n.0)
+                } else {
+                    None
+                };
                 // Start the baseline after the latest change point within it (if ≥ 3 nights remain).
                 let values: Vec<f64> = nights.iter().map(|n| n.0).collect();
                 if let Some(&cp) = detect::change_points(&values, 0.01, 3).last() {
@@ -268,19 +272,34 @@ pub fn compare(
                     }
                 }
                 let rounds = round_medians(s, m);
-                let Some(v) = detect::time_verdict(
-                    m.value,
-                    &m.samples,
-                    &rounds,
-                    &nights,
-                    alpha,
-                    s.min_change_pct,
-                ) else {
+                let two_night = m.gated && s.confirm_nights > 1;
+                let verdict_at = |a: f64| {
+                    detect::time_verdict_over(
+                        m.value,
+                        previous,
+                        &m.samples,
+                        &rounds,
+                        &nights,
+                        a,
+                        s.min_change_pct,
+                    )
+                };
+                let Some(mut v) = verdict_at(alpha) else {
                     continue;
                 };
+                let mut used_alpha = alpha;
+                // On a first night a slowdown is a suspect already at √α: the next night's
+                // two-night test at α decides (the pair passes both at most at rate α).
+                if two_night && !confirming && v.direction == 0 {
+                    if let Some(w) = verdict_at(detect::suspect_alpha(alpha)) {
+                        if w.direction == 1 {
+                            v = w;
+                            used_alpha = detect::suspect_alpha(alpha);
+                        }
+                    }
+                }
                 if v.direction != 0 {
-                    let first_night =
-                        v.direction == 1 && m.gated && s.confirm_nights > 1 && !confirming;
+                    let first_night = v.direction == 1 && two_night && !confirming;
                     out.push(Finding {
                         name: m.name.clone(),
                         verdict: if first_night {
@@ -293,15 +312,19 @@ pub fn compare(
                         value: Some(m.value),
                         change_pct: Some(v.change_pct),
                         message: format!(
-                            "{}: {:.4} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3}; every round {:+.2}% or more)",
+                            "{}: {:.4}{} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3}; every round {:+.2}% or more)",
                             m.name,
                             m.value,
+                            match previous {
+                                Some(p) => format!(" (and {p:.4} the night before)"),
+                                None => String::new(),
+                            },
                             v.baseline,
                             nights.len(),
                             v.change_pct,
                             v.score,
                             v.threshold,
-                            alpha,
+                            used_alpha,
                             v.mw_p,
                             v.weakest_round_pct
                         ),
@@ -958,6 +981,39 @@ mod tests {
             gated: true,
             samples: vec![value * 0.999, value, value * 1.001],
         }
+    }
+
+    #[test]
+    fn a_change_too_small_for_one_night_is_caught_by_two() {
+        let text = |confirm: u32| {
+            format!(
+                "engines = [\"embree\", \"grid\"]\nscenes = [\"tetra\"]\nsf = [3]\n\
+                 gate = [\"time_ratio\"]\nconfirm_nights = {confirm}\nfalse_alarm_budget = 0.0015\n"
+            )
+        };
+        let two = suite::parse("s.toml", &text(2)).unwrap();
+        let one = suite::parse("s.toml", &text(1)).unwrap();
+        let baseline: Vec<Vec<Metric>> = [1.0, 1.02, 0.98, 1.01, 0.99, 1.02, 0.98, 1.0, 1.01, 0.99]
+            .iter()
+            .map(|&v| vec![ratio(v)])
+            .collect();
+        let none = Default::default();
+        let slow = [ratio(1.055)];
+        // One night alone: inside α's prediction interval (no finding with one-night rules) …
+        assert!(compare(&one, &slow, &baseline, &none).is_empty());
+        // … but past √α's: a suspect.
+        let f = compare(&two, &slow, &baseline, &none);
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert_eq!(f[0].verdict, "suspect", "{}", f[0].message);
+        // Two such nights: their mean is past α's interval for a mean of two.
+        let mut with_suspect = baseline.clone();
+        with_suspect.push(vec![ratio(1.055)]);
+        let f2 = compare(&two, &slow, &with_suspect, &suspects_of(&f));
+        assert_eq!(f2.len(), 1, "{f2:?}");
+        assert_eq!(f2[0].verdict, "regression", "{}", f2[0].message);
+        assert!(f2[0].message.contains("the night before"), "{}", f2[0].message);
+        // A suspect night followed by an ordinary one is nothing.
+        assert!(compare(&two, &[ratio(1.0)], &with_suspect, &suspects_of(&f)).is_empty());
     }
 
     #[test]

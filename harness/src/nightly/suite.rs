@@ -162,6 +162,20 @@ fn variant(file: &str, entry: &str) -> Result<Variant> {
         )));
     }
     let mut settings = Vec::new();
+    if name == "plugin" {
+        // plugin:PATH[:key=value…], as `--engines` takes it (crate::select); plugin:path=PATH too.
+        let mut rest = parts.clone();
+        if let Some(spec) = rest.next().map(str::trim).filter(|s| !s.contains('=')) {
+            if spec.is_empty() {
+                return Err(input(format!(
+                    "{file}: variant '{entry}': expected plugin:PATH[:key=value…]"
+                )));
+            }
+            rtbench_engines::plugin::resolve(spec).map_err(|e| input(format!("{file}: {e}")))?;
+            settings.push(("path".to_string(), spec.to_string()));
+            parts = rest;
+        }
+    }
     for kv in parts {
         let (k, v) = kv
             .split_once('=')
@@ -428,5 +442,28 @@ gate = ["counters", "time_ratio"]
             assert!(e.contains(want), "{e} lacks {want}");
             assert_eq!(e.lines().count(), 1, "{e}");
         }
+    }
+
+    #[test]
+    fn a_plugin_is_named_by_its_path_as_on_the_command_line() {
+        let lib = std::env::temp_dir().join(format!("rtbench-suite-{}.so", std::process::id()));
+        std::fs::write(&lib, b"not loaded by parse").unwrap();
+        let text = GOOD.replace(
+            "\"bvh4:simd=off\"",
+            &format!("\"plugin:{}:leaf=2\"", lib.display()),
+        );
+        let s = parse("s.toml", &text).unwrap();
+        let v = &s.variants[2];
+        assert_eq!(v.engine, "plugin");
+        assert_eq!(
+            v.settings,
+            vec![
+                ("path".to_string(), lib.display().to_string()),
+                ("leaf".to_string(), "2".to_string())
+            ]
+        );
+        std::fs::remove_file(&lib).unwrap();
+        let e = err(&GOOD.replace("\"bvh4:simd=off\"", "\"plugin:/no/such/lib.so\""));
+        assert!(e.starts_with("s.toml: ") && e.contains("no such file"), "{e}");
     }
 }
