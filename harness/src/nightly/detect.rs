@@ -274,7 +274,8 @@ pub struct TimeVerdict {
 
 /// Tonight's value, samples and round medians against the baseline nights' values and samples.
 /// `None` when the baseline has fewer than 3 nights. `alpha` is this metric's share of the
-/// false-alarm budget.
+/// false-alarm budget. (One night; the nightly comparison calls [`time_verdict_over`].)
+#[cfg(test)]
 pub fn time_verdict(
     tonight: f64,
     tonight_samples: &[f64],

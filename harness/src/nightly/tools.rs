@@ -57,6 +57,9 @@ fn read_json(p: &Path) -> Option<serde_json::Value> {
 /// benchmark's mean estimate and samples (nanoseconds per iteration).
 pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>, f64), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // cargo runs a bench in its package's directory: a relative CRITERION_HOME (the default
+    // `--out out/nightly` of scripts/nightly.sh) would land in engines/ and be read back from here.
+    let home = &std::path::absolute(home).map_err(|e| format!("{}: {e}", home.display()))?;
     let _ = std::fs::remove_dir_all(home);
     let mut cmd = Command::new(cargo);
     cmd.args(["bench", "-p", "rtbench-engines", "--bench", &c.bench, "--"])
