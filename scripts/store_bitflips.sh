@@ -26,11 +26,11 @@ render() { # store → prints the image sha256, returns rtbench's status
 BASE=$(render "$WORK/store") || { echo "the unflipped store does not render" >&2; exit 2; }
 
 refused=0 same=0 different=0 panics=0 signals=0 hangs=0 other=0
-files=(header.json bbox.bin geometry.bin)
+files=(header.json bbox.bin geometry.bin materials.bin)
 for ((i = 0; i < FLIPS; i++)); do
     rm -rf "$WORK/flip"
     cp -r "$WORK/store" "$WORK/flip"
-    f="$WORK/flip/${files[$((i % 3))]}"
+    f="$WORK/flip/${files[$((i % 4))]}"
     size=$(stat -c %s "$f")
     off=$(( (RANDOM * 32768 + RANDOM) % size ))
     bit=$((RANDOM % 8))
@@ -41,11 +41,11 @@ for ((i = 0; i < FLIPS; i++)); do
     case $rc in
         2) refused=$((refused + 1)) ;;
         0) if [ "$sha" = "$BASE" ]; then same=$((same + 1)); else different=$((different + 1)); fi
-           echo "accepted: ${files[$((i % 3))]} byte $off bit $bit (image $([ "$sha" = "$BASE" ] && echo same || echo different))" >&2 ;;
-        101) panics=$((panics + 1)); echo "panic: ${files[$((i % 3))]} byte $off bit $bit" >&2 ;;
-        124) hangs=$((hangs + 1)); echo "hang: ${files[$((i % 3))]} byte $off bit $bit" >&2 ;;
+           echo "accepted: ${files[$((i % 4))]} byte $off bit $bit (image $([ "$sha" = "$BASE" ] && echo same || echo different))" >&2 ;;
+        101) panics=$((panics + 1)); echo "panic: ${files[$((i % 4))]} byte $off bit $bit" >&2 ;;
+        124) hangs=$((hangs + 1)); echo "hang: ${files[$((i % 4))]} byte $off bit $bit" >&2 ;;
         *) if [ "$rc" -gt 128 ]; then signals=$((signals + 1)); else other=$((other + 1)); fi
-           echo "exit $rc: ${files[$((i % 3))]} byte $off bit $bit: $(head -c 200 "$WORK/err")" >&2 ;;
+           echo "exit $rc: ${files[$((i % 4))]} byte $off bit $bit: $(head -c 200 "$WORK/err")" >&2 ;;
     esac
 done
 echo "flips $FLIPS refused $refused same_image_exit0 $same different_image_exit0 $different panics $panics signals $signals hangs $hangs other $other"

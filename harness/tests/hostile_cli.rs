@@ -352,7 +352,7 @@ fn corrupt_stores_are_refused() {
     let s = fresh("nomat");
     edit_header(&s, |t| {
         let mut v: serde_json::Value = serde_json::from_str(t).unwrap();
-        v["materials"] = serde_json::json!([]);
+        v["materials"] = serde_json::json!(0);
         serde_json::to_string_pretty(&v).unwrap()
     });
     run(render(&s, "memory=1MiB"), "no materials");

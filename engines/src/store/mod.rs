@@ -1,9 +1,17 @@
 //! The on-disk scene store of the breadth-first engine (seed 000 §4.2.1, "S"): a scene written
 //! by streaming from its generator, never held, as three files in one directory.
 //!
-//! - `header.json`: format version, name, camera, background, lights, materials, object and
-//!   primitive counts, the bounds of the prepared primitives, and the byte sizes of the two
-//!   binary files (`bbox_bytes`, `geometry_bytes`). Small: no per-object data.
+//! - `header.json`: format version, name, camera, background, lights (at most [`MAX_LIGHTS`]),
+//!   object and primitive counts, the bounds of the prepared primitives, the byte sizes of the
+//!   binary files (`bbox_bytes`, `geometry_bytes`), and the material table's count, size and
+//!   CRC-32 (`materials`, `materials_bytes`, `materials_crc`). Bounded (at most
+//!   `MAX_HEADER_BYTES`) whatever the object count: no per-object and no per-material data.
+//! - `materials.bin`: 16-byte header (magic `RTMATS\0\0`, u32 version, u32 count), then one
+//!   64-byte record per *distinct* material, in order of first use: 8 × f64 (color r g b, kd, ks,
+//!   shine, t, ior). The writer shares one entry among bit-equal materials, so the table is the
+//!   scene's palette (rings: 7 entries, where the generator emits one material per ring; gears:
+//!   one per gear). Each geometry record's material index points into it. Written before
+//!   header.json, whose `materials_crc` vouches for its bytes.
 //! - `bbox.bin`: 16-byte header, then one 36-byte record per object in stream order: its
 //!   bounding box (6 × f32: min x y z, max x y z, of its prepared `f32` primitives), the byte
 //!   offset (u64) of its record in `geometry.bin`, and a CRC-32 (u32) of the object id (u64)
@@ -58,8 +66,10 @@ pub use read::{
 pub use surface::Surface;
 pub use write::StoreWriter;
 
-/// Format version written in all three files; readers refuse any other (2: checksums).
-pub const VERSION: u32 = 2;
+/// Format version written in every file; readers refuse any other (2: checksums; 3: the material
+/// table moved out of header.json into `materials.bin`, so that the header stays small at 10^9
+/// objects).
+pub const VERSION: u32 = 3;
 pub const BBOX_MAGIC: &[u8; 8] = b"RTBBOX\0\0";
 pub const GEOMETRY_MAGIC: &[u8; 8] = b"RTGEOM\0\0";
 /// Bytes of a bbox record: 6 × f32 + u64 + u32 checksum.
@@ -71,6 +81,11 @@ pub const MIN_GEOMETRY_RECORD: usize = 17;
 pub const FILE_HEADER: u64 = 16;
 
 pub const OBJECTS_MAGIC: &[u8; 8] = b"RTOBJS\0\0";
+pub const MATERIALS_MAGIC: &[u8; 8] = b"RTMATS\0\0";
+/// Bytes of a material record: 8 × f64.
+pub const MATERIAL_RECORD: usize = 64;
+/// Most lights a store holds (they stay in header.json, whose size this bounds).
+pub const MAX_LIGHTS: usize = 4096;
 
 /// How a store lays its records out on disk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,6 +122,7 @@ pub const OBJECTS_FILE: &str = "objects.bin";
 pub const OBJECTS_FILE_GZ: &str = "objects.bin.gz";
 pub const BBOX_FILE: &str = "bbox.bin";
 pub const GEOMETRY_FILE: &str = "geometry.bin";
+pub const MATERIALS_FILE: &str = "materials.bin";
 
 #[cfg(test)]
 pub(crate) mod tests;

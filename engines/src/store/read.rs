@@ -5,8 +5,8 @@ use super::io::{Codec, IoCounters, IoFile};
 use super::write::bbox_checksum;
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE,
-    GEOMETRY_MAGIC, HEADER_FILE, MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC,
-    VERSION,
+    GEOMETRY_MAGIC, HEADER_FILE, MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS,
+    MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
@@ -48,17 +48,24 @@ fn bad(dir: &Path, what: impl std::fmt::Display) -> io::Error {
 impl StoreHeader {
     pub fn read(dir: &Path) -> io::Result<StoreHeader> {
         let path = dir.join(HEADER_FILE);
-        let text = read_bounded(&path, MAX_HEADER_BYTES)?;
+        let text = match read_bounded(&path, MAX_HEADER_BYTES) {
+            Ok(t) => t,
+            // Format 2 kept the materials in header.json, one per object on some scenes: an
+            // old store's header can pass the limit. Its binary files say which format it is.
+            Err(e) => match data_file_version(dir) {
+                Some(n) if n != VERSION => return Err(old_format(dir, n)),
+                _ => return Err(e),
+            },
+        };
         let crc = crc32fast::hash(text.as_bytes());
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(dir, e))?;
         if v["format"] != "rtbench-store" {
             return Err(bad(dir, "header.json has no \"format\": \"rtbench-store\""));
         }
-        if v["version"].as_u64() != Some(VERSION as u64) {
-            return Err(bad(
-                dir,
-                format!("version {} (this rtbench reads {VERSION})", v["version"]),
-            ));
+        match v["version"].as_u64() {
+            Some(n) if n == VERSION as u64 => {}
+            Some(n) => return Err(old_format(dir, n)),
+            None => return Err(bad(dir, format!("version {}", v["version"]))),
         }
         let num = |v: &Value, k: &str| -> io::Result<f64> {
             v[k].as_f64()
@@ -98,7 +105,14 @@ impl StoreHeader {
             ],
         };
         let mut lights = Vec::new();
-        for l in v["lights"].as_array().into_iter().flatten() {
+        let light_list = v["lights"].as_array();
+        if light_list.map_or(0, |l| l.len()) > MAX_LIGHTS {
+            return Err(bad(
+                dir,
+                format!("header.json: more than {MAX_LIGHTS} lights"),
+            ));
+        }
+        for l in light_list.into_iter().flatten() {
             lights.push(Light {
                 position: d3(&l["position"])?,
                 color: if l["color"].is_null() {
@@ -108,23 +122,23 @@ impl StoreHeader {
                 },
             });
         }
-        let mut materials = Vec::new();
-        for m in v["materials"].as_array().into_iter().flatten() {
-            materials.push(Material {
-                color: d3(&m["color"])?,
-                kd: num(m, "kd")?,
-                ks: num(m, "ks")?,
-                shine: num(m, "shine")?,
-                t: num(m, "t")?,
-                ior: num(m, "ior")?,
-            });
-        }
         let b = d3(&v["bounds"][0])?.as_vec3();
         let c = d3(&v["bounds"][1])?.as_vec3();
         let count = |k: &str| -> io::Result<u64> {
             v[k].as_u64()
                 .ok_or_else(|| bad(dir, format!("'{k}' is not a whole number")))
         };
+        let objects = count("objects")?;
+        let material_count = count("materials")?;
+        if objects > 0 && material_count == 0 {
+            return Err(bad(dir, "header.json: objects but no materials"));
+        }
+        let materials = read_materials(
+            dir,
+            material_count,
+            count("materials_bytes")?,
+            count("materials_crc")?,
+        )?;
         let layout = match v["layout"].as_str() {
             None if v["layout"].is_null() => Layout::Split,
             Some("split") => Layout::Split,
@@ -152,7 +166,7 @@ impl StoreHeader {
         let h = StoreHeader {
             dir: dir.to_path_buf(),
             name: v["name"].as_str().unwrap_or("").to_string(),
-            objects: count("objects")?,
+            objects,
             primitives: count("primitives")?,
             bounds: [b, c],
             background: d3(&v["background"])?,
@@ -187,9 +201,6 @@ impl StoreHeader {
                 dir,
                 format!("{} objects (at most 2^32 − 1)", self.objects),
             ));
-        }
-        if self.objects > 0 && self.materials.is_empty() {
-            return Err(bad(dir, "header.json: objects but no materials"));
         }
         let want_bbox = FILE_HEADER + self.objects * BBOX_RECORD as u64;
         if self.layout == Layout::Split && self.bbox_bytes != want_bbox {
@@ -311,8 +322,106 @@ impl StoreHeader {
     }
 }
 
-/// Largest header.json read (it holds no per-object data: lights and materials only).
-const MAX_HEADER_BYTES: u64 = 64 << 20;
+/// Largest header.json read. It holds no per-object or per-material data, and at most
+/// [`MAX_LIGHTS`] lights (about 250 bytes each in pretty JSON), so 4 MiB bounds it whatever the
+/// scene's size.
+const MAX_HEADER_BYTES: u64 = 4 << 20;
+
+/// The one-line refusal of a store of another format.
+fn old_format(dir: &Path, n: impl std::fmt::Display) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!(
+            "{}: store format {n}, this rtbench reads {VERSION}: rebuild with `rtbench scene store`",
+            dir.display()
+        ),
+    )
+}
+
+/// The format version in the header of the store's main binary file (bbox.bin, objects.bin or
+/// objects.bin.gz), when there is one with one of the store's magics.
+fn data_file_version(dir: &Path) -> Option<u32> {
+    let files = [
+        (BBOX_FILE, Codec::None),
+        (OBJECTS_FILE, Codec::None),
+        (OBJECTS_FILE_GZ, Codec::Gzip(6)),
+    ];
+    for (name, codec) in files {
+        let path = dir.join(name);
+        if !path.is_file() {
+            continue;
+        }
+        let mut f = IoFile::open_codec(&path, 64, codec).ok()?;
+        let mut h = [0u8; FILE_HEADER as usize];
+        f.read_exact(&mut h).ok()?;
+        if [BBOX_MAGIC, OBJECTS_MAGIC].iter().any(|m| h[..8] == m[..]) {
+            return Some(u32::from_le_bytes(h[8..12].try_into().unwrap()));
+        }
+    }
+    None
+}
+
+/// `materials.bin`: its size against header.json's count and size, its bytes against the CRC-32
+/// header.json records, then each material against the scene rules.
+fn read_materials(dir: &Path, count: u64, bytes: u64, crc: u64) -> io::Result<Vec<Material>> {
+    let want = count
+        .checked_mul(MATERIAL_RECORD as u64)
+        .and_then(|b| b.checked_add(FILE_HEADER))
+        .filter(|_| count <= u32::MAX as u64)
+        .ok_or_else(|| bad(dir, format!("header.json: {count} materials")))?;
+    if bytes != want {
+        return Err(bad(
+            dir,
+            format!("header.json: materials_bytes {bytes} for {count} materials (expected {want})"),
+        ));
+    }
+    let path = dir.join(MATERIALS_FILE);
+    let file = std::fs::File::open(&path)
+        .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+    let size = file.metadata()?.len();
+    let mut f = io::BufReader::with_capacity(1 << 16, file);
+    if size != bytes {
+        return Err(bad(
+            dir,
+            format!("{MATERIALS_FILE} has {size} bytes, header.json says {bytes}"),
+        ));
+    }
+    let mut hasher = crc32fast::Hasher::new();
+    let mut h = [0u8; FILE_HEADER as usize];
+    io::Read::read_exact(&mut f, &mut h)?;
+    hasher.update(&h);
+    let mut materials = Vec::with_capacity(count as usize);
+    let mut r = [0u8; MATERIAL_RECORD];
+    for _ in 0..count {
+        io::Read::read_exact(&mut f, &mut r)?;
+        hasher.update(&r);
+        let x = |i: usize| f64::from_le_bytes(r[i * 8..i * 8 + 8].try_into().unwrap());
+        materials.push(Material {
+            color: DVec3::new(x(0), x(1), x(2)),
+            kd: x(3),
+            ks: x(4),
+            shine: x(5),
+            t: x(6),
+            ior: x(7),
+        });
+    }
+    if hasher.finalize() as u64 != crc {
+        return Err(bad(
+            dir,
+            format!("{MATERIALS_FILE} does not match header.json (checksum)"),
+        ));
+    }
+    if &h[..8] != MATERIALS_MAGIC
+        || u32::from_le_bytes(h[8..12].try_into().unwrap()) != VERSION
+        || u32::from_le_bytes(h[12..16].try_into().unwrap()) as u64 != count
+    {
+        return Err(bad(
+            dir,
+            format!("{MATERIALS_FILE}: wrong magic, version or count"),
+        ));
+    }
+    Ok(materials)
+}
 
 /// A text file of at most `max` bytes, its size checked before reading.
 fn read_bounded(path: &Path, max: u64) -> io::Result<String> {

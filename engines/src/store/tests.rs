@@ -46,7 +46,8 @@ fn round_trip(program: Program, sf: u32) {
     assert_eq!(h.primitives as usize, geometry.prims.len());
     assert_eq!(h.view, scene.view);
     assert_eq!(h.lights, scene.lights);
-    assert_eq!(h.materials, scene.materials);
+    // The table holds each distinct material once; every object's entry equals its own.
+    assert!(h.materials.len() <= scene.materials.len());
     assert_eq!(h.background, scene.background);
     assert_eq!(h.bounds, [geometry.bounds_min, geometry.bounds_max]);
 
@@ -57,7 +58,10 @@ fn round_trip(program: Program, sf: u32) {
     while let Some((id, b)) = bb.next_record().unwrap() {
         geo.read_at(b.offset, &mut rec).unwrap();
         let o = &scene.objects[id as usize];
-        assert_eq!(rec.material, o.material);
+        assert_eq!(
+            h.materials[rec.material as usize],
+            scene.materials[o.material as usize]
+        );
         assert_eq!(rec.surface, Some(Surface::of(o.shape.as_ref())));
         let n = rec.prims.len();
         assert_eq!(&rec.prims[..], &geometry.prims[next_prim..next_prim + n]);
@@ -129,7 +133,7 @@ fn every_bit_flip_is_refused() {
         x
     };
     for k in 0..300 {
-        let name = [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE][k % 3];
+        let name = [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE, MATERIALS_FILE][k % 4];
         let path = dir.0.join(name);
         let orig = std::fs::read(&path).unwrap();
         let mut bytes = orig.clone();
@@ -263,4 +267,136 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
     std::fs::write(&f, &bad).unwrap();
     let h = StoreHeader::read(&gz.0).unwrap();
     assert!(h.verify().is_err());
+}
+
+/// A stream of `n` objects, each after its own material emission (cycling through `colors`
+/// distinct colours, as SPD's rings emits one per ring): what made format 2's header.json grow
+/// with the object count.
+fn write_many(dir: &TempDir, n: u32, colors: u32) {
+    use rtbench_scenes::{Material, Sink};
+    let mut w = StoreWriter::create_layout(&dir.0, "many", Layout::Basic).unwrap();
+    Sink::light(
+        &mut w,
+        &rtbench_scenes::Light {
+            position: glam::DVec3::new(0.0, 0.0, 10.0),
+            color: None,
+        },
+    );
+    for i in 0..n {
+        let c = (i % colors) as f64 / colors as f64;
+        Sink::material(
+            &mut w,
+            &Material {
+                color: glam::DVec3::new(c, 0.5, 1.0 - c),
+                kd: 0.5,
+                ks: 0.2,
+                shine: 8.0,
+                t: 0.0,
+                ior: 1.0,
+            },
+        );
+        let x = i as f64;
+        Sink::shape(
+            &mut w,
+            rtbench_scenes::ShapeRef::Sphere {
+                center: glam::DVec3::new(x, 0.0, 0.0),
+                radius: 0.4,
+            },
+        );
+    }
+    w.finish().unwrap();
+}
+
+/// header.json stays small and bounded however many objects (and material emissions) the scene
+/// has: 200,000 objects give a header within a few bytes (digits) of 10 objects', and the
+/// material table holds the distinct materials only.
+#[test]
+fn header_size_does_not_grow_with_the_object_count() {
+    let (small, large) = (TempDir::new("few"), TempDir::new("many"));
+    write_many(&small, 10, 6);
+    write_many(&large, 200_000, 6);
+    let size = |d: &TempDir| std::fs::metadata(d.0.join(HEADER_FILE)).unwrap().len();
+    let (a, b) = (size(&small), size(&large));
+    assert!(b < 4096, "header.json of 200,000 objects: {b} bytes");
+    assert!(
+        b <= a + 64,
+        "header.json: {a} bytes for 10 objects, {b} for 200,000"
+    );
+    let h = StoreHeader::read(&large.0).unwrap();
+    assert_eq!(h.objects, 200_000);
+    assert_eq!(h.materials.len(), 6);
+    assert_eq!(
+        std::fs::metadata(large.0.join(MATERIALS_FILE))
+            .unwrap()
+            .len(),
+        FILE_HEADER + 6 * MATERIAL_RECORD as u64
+    );
+    h.verify().unwrap();
+    // Distinct materials per object (gears: one per gear) go to materials.bin, not the header.
+    let distinct = TempDir::new("distinct");
+    write_many(&distinct, 50_000, 50_000);
+    assert!(size(&distinct) <= a + 64);
+    assert_eq!(
+        StoreHeader::read(&distinct.0).unwrap().materials.len(),
+        50_000
+    );
+}
+
+/// A store of format 2 (materials in header.json) is refused with one line naming both formats
+/// and the way out, whether its header is small enough to parse or too large to read.
+#[test]
+fn an_old_format_store_is_refused_with_the_way_out() {
+    let dir = TempDir::new("old");
+    write_store(&dir, Program::Tetra, 1);
+    let path = dir.0.join(HEADER_FILE);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let old = text.replace(&format!("\"version\": {VERSION}"), "\"version\": 2");
+    assert_ne!(old, text);
+    std::fs::write(&path, &old).unwrap();
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    let want =
+        format!("store format 2, this rtbench reads {VERSION}: rebuild with `rtbench scene store`");
+    assert!(e.ends_with(&want), "{e}");
+    assert_eq!(e.lines().count(), 1);
+    // Too large to read (format 2's rings80: 187 MB): the version comes from bbox.bin.
+    let mut big = old.into_bytes();
+    big.resize(5 << 20, b' ');
+    std::fs::write(&path, &big).unwrap();
+    for name in [BBOX_FILE, GEOMETRY_FILE] {
+        let p = dir.0.join(name);
+        let mut b = std::fs::read(&p).unwrap();
+        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        std::fs::write(&p, &b).unwrap();
+    }
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    assert!(e.ends_with(&want), "{e}");
+    // Too large and of this format: the size is what is wrong.
+    for name in [BBOX_FILE, GEOMETRY_FILE] {
+        let p = dir.0.join(name);
+        let mut b = std::fs::read(&p).unwrap();
+        b[8..12].copy_from_slice(&VERSION.to_le_bytes());
+        std::fs::write(&p, &b).unwrap();
+    }
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    assert!(e.contains("at most"), "{e}");
+}
+
+/// materials.bin is vouched for by header.json: a changed byte or a shortened file is refused.
+#[test]
+fn a_damaged_material_table_is_refused() {
+    let dir = TempDir::new("mats");
+    write_store(&dir, Program::Gears, 1);
+    let path = dir.0.join(MATERIALS_FILE);
+    let orig = std::fs::read(&path).unwrap();
+    let mut b = orig.clone();
+    let last = b.len() - 3;
+    b[last] ^= 1;
+    std::fs::write(&path, &b).unwrap();
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    assert!(e.contains("checksum"), "{e}");
+    std::fs::write(&path, &orig[..orig.len() - 64]).unwrap();
+    let e = StoreHeader::read(&dir.0).unwrap_err().to_string();
+    assert!(e.contains("materials.bin has"), "{e}");
+    std::fs::write(&path, &orig).unwrap();
+    StoreHeader::read(&dir.0).unwrap().verify().unwrap();
 }

@@ -5,12 +5,14 @@
 use super::io::{Codec, IoCounters, IoFile};
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
-    OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
+    MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS, OBJECTS_FILE, OBJECTS_FILE_GZ,
+    OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
 use rtbench_scenes::{Light, Material, Scene, ShapeRef, Sink, View};
 use serde_json::json;
+use std::collections::HashMap;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -32,7 +34,13 @@ pub struct StoreWriter {
     view: View,
     background: DVec3,
     lights: Vec<Light>,
+    /// The scene's distinct materials, in order of first use (what `materials.bin` holds), and
+    /// each one's index by its bits: generators emit a material per object or per group (SPD's
+    /// rings one per ring, of six colours), so the table stays as small as the scene's palette.
     materials: Vec<Material>,
+    material_ids: HashMap<[u64; 8], u32>,
+    /// The table index of the material the next shape takes (the last one emitted).
+    current_material: Option<u32>,
     objects: u64,
     prims_total: u64,
     lo: Vec3,
@@ -128,6 +136,8 @@ impl StoreWriter {
             background: DVec3::ZERO,
             lights: Vec::new(),
             materials: Vec::new(),
+            material_ids: HashMap::new(),
+            current_material: None,
             objects: 0,
             prims_total: 0,
             lo: Vec3::INFINITY,
@@ -143,12 +153,48 @@ impl StoreWriter {
     pub fn write_scene(mut self, scene: &Scene) -> io::Result<IoCounters> {
         self.background = scene.background;
         self.view = scene.view.clone();
-        self.lights = scene.lights.clone();
-        self.materials = scene.materials.clone();
+        for l in &scene.lights {
+            self.add_light(l)?;
+        }
+        let ids: Vec<u32> = scene
+            .materials
+            .iter()
+            .map(|m| self.material_id(m))
+            .collect();
         for o in &scene.objects {
-            self.write_object(o.material, o.shape.as_ref())?;
+            let id = ids.get(o.material as usize).copied().ok_or_else(|| {
+                io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!("an object names material {} of {}", o.material, ids.len()),
+                )
+            })?;
+            self.write_object(id, o.shape.as_ref())?;
         }
         self.finish()
+    }
+
+    /// The table index of `m`, adding it on first use. Bit-equal materials share one entry,
+    /// so shading reads the same values as from the scene's own list.
+    fn material_id(&mut self, m: &Material) -> u32 {
+        let key = material_bits(m);
+        if let Some(&id) = self.material_ids.get(&key) {
+            return id;
+        }
+        let id = self.materials.len() as u32;
+        self.materials.push(m.clone());
+        self.material_ids.insert(key, id);
+        id
+    }
+
+    fn add_light(&mut self, l: &Light) -> io::Result<()> {
+        if self.lights.len() >= MAX_LIGHTS {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("more than {MAX_LIGHTS} lights (a store's header.json holds at most {MAX_LIGHTS})"),
+            ));
+        }
+        self.lights.push(l.clone());
+        Ok(())
     }
 
     fn write_object(&mut self, material: u32, shape: ShapeRef<'_>) -> io::Result<()> {
@@ -216,6 +262,9 @@ impl StoreWriter {
         if let Some(b) = self.bbox {
             io.add(&b.finish()?);
         }
+        let (materials_bytes, materials_crc) = write_materials(&self.dir, &self.materials)?;
+        io.bytes_written += materials_bytes;
+        io.write_calls += 1;
         let v = &self.view;
         let d3 = |v: DVec3| json!([v.x, v.y, v.z]);
         let mut header = json!({
@@ -230,9 +279,9 @@ impl StoreWriter {
                      "hither": v.hither, "resolution": v.resolution},
             "lights": self.lights.iter().map(|l| json!({
                 "position": d3(l.position), "color": l.color.map(d3)})).collect::<Vec<_>>(),
-            "materials": self.materials.iter().map(|m| json!({
-                "color": d3(m.color), "kd": m.kd, "ks": m.ks, "shine": m.shine, "t": m.t,
-                "ior": m.ior})).collect::<Vec<_>>(),
+            "materials": self.materials.len(),
+            "materials_bytes": materials_bytes,
+            "materials_crc": materials_crc,
         });
         match self.layout {
             Layout::Split => {
@@ -272,6 +321,34 @@ impl StoreWriter {
         }
         Ok(io)
     }
+}
+
+/// A material's values as bits (color x y z, kd, ks, shine, t, ior): the key under which
+/// bit-equal materials share a table entry, and the record of `materials.bin`.
+fn material_bits(m: &Material) -> [u64; 8] {
+    [
+        m.color.x, m.color.y, m.color.z, m.kd, m.ks, m.shine, m.t, m.ior,
+    ]
+    .map(f64::to_bits)
+}
+
+/// Writes `materials.bin` (its header, then one record per material); returns its size and
+/// CRC-32, which header.json records (the file is written first, so the header vouches for it).
+fn write_materials(dir: &Path, materials: &[Material]) -> io::Result<(u64, u32)> {
+    let count = u32::try_from(materials.len())
+        .map_err(|_| io::Error::other("more than 2^32 − 1 distinct materials"))?;
+    let mut bytes = Vec::with_capacity(16 + materials.len() * MATERIAL_RECORD);
+    bytes.extend_from_slice(&file_header(MATERIALS_MAGIC, count));
+    for m in materials {
+        for b in material_bits(m) {
+            bytes.extend_from_slice(&b.to_le_bytes());
+        }
+    }
+    let path = dir.join(MATERIALS_FILE);
+    let f = std::fs::File::create(&path)?;
+    std::io::Write::write_all(&mut &f, &bytes)?;
+    f.sync_data()?;
+    Ok((bytes.len() as u64, crc32fast::hash(&bytes)))
 }
 
 pub(super) fn encode_surface(r: &mut Vec<u8>, s: &Surface) {
@@ -338,18 +415,26 @@ impl Sink for StoreWriter {
         self.view = view.clone();
     }
     fn light(&mut self, light: &Light) {
-        self.lights.push(light.clone());
+        if self.error.is_none() {
+            if let Err(e) = self.add_light(light) {
+                self.error = Some(e);
+            }
+        }
     }
     fn material(&mut self, material: &Material) {
-        self.materials.push(material.clone());
+        self.current_material = Some(self.material_id(material));
     }
     fn shape(&mut self, shape: ShapeRef<'_>) {
-        if self.materials.is_empty() {
-            // NFF allows primitives before any `f`: they get the default material (as
-            // `SceneCollector` does).
-            self.materials.push(Material::default());
-        }
-        let material = (self.materials.len() - 1) as u32;
+        // NFF allows primitives before any `f`: they get the default material (as
+        // `SceneCollector` does).
+        let material = match self.current_material {
+            Some(m) => m,
+            None => {
+                let m = self.material_id(&Material::default());
+                self.current_material = Some(m);
+                m
+            }
+        };
         if self.error.is_none() {
             if let Err(e) = self.write_object(material, shape) {
                 self.error = Some(e);
