@@ -305,7 +305,10 @@ pub fn run_all(
     for (i, r) in fresh {
         done[i] = Some(r?);
     }
-    Ok(done.into_iter().map(|r| r.expect("every machine run")).collect())
+    Ok(done
+        .into_iter()
+        .map(|r| r.expect("every machine run"))
+        .collect())
 }
 
 /// A saved machine's key: everything its run depends on (scene, pass, threshold, image size,
