@@ -129,6 +129,36 @@ fn yamauchi_static_lb_small_run_reports_every_machine() {
     assert!(dir
         .join("plots/yamauchi-static-lb-tetra6-efficiency.svg")
         .exists());
+    // Each machine was saved: resumed (on two threads), every one is loaded, with the same clocks.
+    let again = rtbench(&[
+        "reproduce",
+        "yamauchi-static-lb",
+        "--scenes",
+        "tetra",
+        "--size",
+        "32",
+        "--max-pes",
+        "16",
+        "--threads",
+        "2",
+        "--resume",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(again.status.success());
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(stderr.contains("33 of 33 machines loaded"), "{stderr}");
+    let w: Value = serde_json::from_slice(&again.stdout).unwrap();
+    let clocks = |v: &Value| -> Vec<u64> {
+        v["measured"][0]["runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["clocks"].as_u64().unwrap())
+            .collect()
+    };
+    assert_eq!(clocks(&v), clocks(&w));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -5,9 +5,9 @@
 //!
 //! | parameter | value | why |
 //! |---|---|---|
-//! | room | 8 m × 8 m floor (x, y), 4 m high (z up) | a room; with 32³ subspaces a subspace is 0.25 × 0.25 × 0.125 m |
-//! | vertical axis | z | 003's 2D skewed allocation (eq. 10) folds X and Z together; 003 motivates skewing by upright walls and pillars, so upright is the axis without a PE dimension |
-//! | front wall | open (y = 0), eye outside at y = −6 | as in a Cornell box: primary rays enter the subspace grid through its front face, so the FRGUs of the PEs owning that face make them (an eye inside the room would put every primary ray on one PE's FRGU) |
+//! | room | 8 m wide (x), 4 m high (y up), 8 m deep (z) | a room; with 32³ subspaces a subspace is 0.25 × 0.125 × 0.25 m |
+//! | axes: y up, the eye looking along +z | 003 laid its PEs parallel to the screen (§4.2.1 on Table 6; §2.3: "so block and distributed already spread the primary rays over the PEs"). A 2D machine's torus axes are eq. (8)'s (X, Y) and eq. (10)'s (X + Z, Y): Z is the axis left out or folded, so the screen is parallel to the torus only when the eye looks along Z, and every allocation then gives the front face's subspaces (X, Y, 0) to all N_x × N_y PEs. The skew still spreads what 003 motivates it by: upright walls at a fixed X or Z. The price: the floor and ceiling (fixed Y) lie on one PE row each under 2D distributed and skewed allocation |
+//! | front wall | open (z = 0), eye outside at z = −6 | as in a Cornell box: primary rays enter the subspace grid through its front face, so the FRGUs of the PEs owning that face make them (an eye inside the room would put every primary ray on one PE's FRGU) |
 //! | patch size | 1/`ppm` m, `ppm` = patches per metre (default 8: 0.125 m) | at 8, walls, floor, ceiling, lights and furniture give 18,910 patches, 003's 18,859 to 0.3% (ppm 1: 427, 2: 1,325, 4: 4,888) |
 //! | furniture | a table with legs, two bookcases with shelves, a sofa, two chairs, a pillar, a low cabinet: boxes meshed into patches on all visible faces | occluders and upright coherent objects, so subspaces are unevenly loaded as in a furnished room |
 //! | specular quadrics | three mirror spheres and one mirror cylinder (k_s 0.9, k_d 0) | 003: specular elements (smooth quadrics) are not meshed; delta-radiosity rays reflect off them |
@@ -25,8 +25,22 @@ use glam::DVec3;
 
 /// The default resolution: patches per metre.
 pub const DEFAULT_PPM: u32 = 8;
-/// Room extent (x, y, z), z up.
+/// Room extent in the frame it is modelled in (width, depth, height: the floor spans the first
+/// two); [`turn`] gives the scene's frame, y up and the eye looking along +z.
 pub const SIZE: DVec3 = DVec3::new(8.0, 8.0, 4.0);
+
+/// The modelling frame (floor x-y, z up, front at y = 0) to the scene's (y up, front at z = 0):
+/// a proper rotation (determinant +1), so polygons keep their winding and facing, and a shift
+/// keeping x in [0, 8]. Why the scene's frame is y up: see the module doc (003's PEs parallel to
+/// the screen).
+pub fn turn(p: DVec3) -> DVec3 {
+    DVec3::new(SIZE.x - p.x, p.z, p.y)
+}
+
+/// [`turn`] for directions.
+fn turn_dir(v: DVec3) -> DVec3 {
+    DVec3::new(-v.x, v.z, v.y)
+}
 /// Emission of the light panels' material (radiosity units; RGB).
 pub const LIGHT_EMISSION: DVec3 = DVec3::new(12.0, 12.0, 10.0);
 
@@ -112,6 +126,7 @@ impl Mesher<'_> {
     /// The rectangle `o`, `o + u`, `o + u + v`, `o + v` cut into patches of at most 1/ppm a side;
     /// its normal is u × v.
     fn rect(&mut self, o: DVec3, u: DVec3, v: DVec3) {
+        let (o, u, v) = (turn(o), turn_dir(u), turn_dir(v));
         let nu = ((u.length() * self.ppm).ceil() as u32).max(1);
         let nv = ((v.length() * self.ppm).ceil() as u32).max(1);
         let (du, dv) = (u / nu as f64, v / nv as f64);
@@ -153,9 +168,9 @@ pub fn generate(ppm: u32, sink: &mut dyn Sink) -> Result<(), RoomError> {
     }
     sink.background(DVec3::ZERO);
     sink.view(&View {
-        from: DVec3::new(4.0, -6.0, 2.2),
-        at: DVec3::new(4.0, 4.0, 1.6),
-        up: DVec3::Z,
+        from: turn(DVec3::new(4.0, -6.0, 2.2)),
+        at: turn(DVec3::new(4.0, 4.0, 1.6)),
+        up: turn_dir(DVec3::Z),
         angle: 50.0,
         hither: 1e-3,
         resolution: [512, 512],
@@ -163,7 +178,7 @@ pub fn generate(ppm: u32, sink: &mut dyn Sink) -> Result<(), RoomError> {
     // For renderers that light locally (the NFF view of the scene): the panels' centres.
     for c in [DVec3::new(2.5, 4.5, 3.9), DVec3::new(5.5, 4.5, 3.9)] {
         sink.light(&Light {
-            position: c,
+            position: turn(c),
             color: None,
         });
     }
@@ -234,14 +249,14 @@ pub fn generate(ppm: u32, sink: &mut dyn Sink) -> Result<(), RoomError> {
         (v(2.0, 5.8, 0.35), 0.35),
     ] {
         m.sink.shape(ShapeRef::Sphere {
-            center: c,
+            center: turn(c),
             radius: r,
         });
     }
     m.sink.shape(ShapeRef::Cone {
-        base: v(1.2, 6.2, 0.0),
+        base: turn(v(1.2, 6.2, 0.0)),
         base_radius: 0.15,
-        apex: v(1.2, 6.2, s.z),
+        apex: turn(v(1.2, 6.2, s.z)),
         apex_radius: 0.15,
     });
     Ok(())
@@ -275,20 +290,25 @@ mod tests {
         generate(2, &mut c).unwrap();
         let s = c.scene;
         let em = emission(&s.materials);
+        // The eye looks along +z, y up, into the open front at z = 0 (003: PEs parallel to the
+        // screen; see the module doc).
+        let dir = (s.view.at - s.view.from).normalize();
+        assert!(dir.z > 0.99 && s.view.from.z < 0.0 && s.view.up == DVec3::Y);
         let mut lights = 0;
         for o in &s.objects {
             if let crate::model::Shape::Polygon(v) = &o.shape {
+                assert!(v.iter().all(|p| p.z >= 0.0 && p.y >= 0.0 && p.x >= 0.0));
                 let n = (v[1] - v[0]).cross(v[3] - v[0]).normalize();
                 let centre = (v[0] + v[2]) / 2.0;
-                // Shell patches face the room's centre.
-                if centre.z == 0.0 {
-                    assert!(n.z > 0.99);
+                // Shell patches face the room's centre (y up, the red wall at x = 8).
+                if centre.y == 0.0 {
+                    assert!(n.y > 0.99, "the floor faces up");
                 }
-                if centre.x == 0.0 && s.materials[o.material as usize] == RED {
-                    assert!(n.x > 0.99);
+                if centre.x == SIZE.x && s.materials[o.material as usize] == RED {
+                    assert!(n.x < -0.99);
                 }
                 if em[o.material as usize] != DVec3::ZERO {
-                    assert!(n.z < -0.99, "lights face down");
+                    assert!(n.y < -0.99, "lights face down");
                     lights += 1;
                 }
             }

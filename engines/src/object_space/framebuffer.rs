@@ -28,7 +28,7 @@ pub struct Emission {
 }
 
 /// What the frame buffer saw.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct FrameBufferStats {
     pub packets: u64,
     /// First-stage FBC hits and misses (0 without caches).

@@ -513,8 +513,8 @@ pub fn reference(os: &ObjectSpace, patches: &Patches, threshold: f32) -> Solutio
     loop {
         let mut best = None;
         let mut level = threshold;
-        for i in 0..patches.area.len() {
-            let u = s.unshot[i].max_element();
+        for (i, u) in s.unshot.iter().enumerate() {
+            let u = u.max_element();
             if patches.is_patch(i) && u > level {
                 (best, level) = (Some(i), u);
             }
@@ -648,11 +648,11 @@ pub fn simulate(
     let lattice = &os.subspaces.lattice;
     let mut pe_patches: Vec<Vec<u32>> = vec![Vec::new(); pes];
     let mut patch_pe = vec![u32::MAX; patches.area.len()];
-    for i in 0..patches.area.len() {
+    for (i, patch_pe) in patch_pe.iter_mut().enumerate() {
         if patches.is_patch(i) {
             let s = lattice.index(lattice.cell_of(patches.origin(i)));
             let pe = owner[s];
-            patch_pe[i] = pe;
+            *patch_pe = pe;
             pe_patches[pe as usize].push(i as u32);
         }
     }

@@ -6,7 +6,7 @@
 
 use super::params::{Param, MAX_PES, SCENES, SIZE, THREADS};
 use super::yamauchi_radiosity::{ROOM, THRESHOLD};
-use super::{Ctx, Image};
+use super::{Checkpoint, Ctx, Image};
 use crate::error::{input, Result};
 use crate::source::Source;
 use crate::workload::{self, pass_003};
@@ -269,8 +269,78 @@ pub fn machine(pes: u32, dims: u8, allocation: Allocation, rp_blocks: u32) -> Ma
 }
 
 /// Simulates each machine on `t` (in parallel over machines) with the given frame buffer (the
-/// radiosity pass sends no intensity packets): each run's result and its wall time.
-pub fn run_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f64)> {
+/// radiosity pass sends no intensity packets): each run's result and its wall time. Each finished
+/// machine is saved in `checkpoint` and, resumed (`--resume`), loaded instead of simulated again,
+/// so that the full room's machines (each up to 5 × 10⁸ packet events) run in pieces.
+pub fn run_all(
+    t: &Traced,
+    machines: &[(Machine, FrameBuffer)],
+    checkpoint: &Checkpoint,
+) -> Result<Vec<(SimResult, f64)>> {
+    let keys: Vec<String> = machines
+        .iter()
+        .map(|(m, fb)| machine_key(t, m, fb))
+        .collect();
+    let mut done: Vec<Option<(SimResult, f64)>> = Vec::with_capacity(machines.len());
+    for k in &keys {
+        done.push(checkpoint.load(k)?);
+    }
+    let todo: Vec<usize> = (0..machines.len()).filter(|&i| done[i].is_none()).collect();
+    if todo.len() < machines.len() {
+        eprintln!(
+            "{}: {} of {} machines loaded from saved steps",
+            t.label,
+            machines.len() - todo.len(),
+            machines.len()
+        );
+    }
+    let fresh: Vec<(usize, Result<(SimResult, f64)>)> = todo
+        .par_iter()
+        .map(|&i| {
+            let r = simulate_all(t, &machines[i..i + 1]).remove(0);
+            let saved = checkpoint.save(&keys[i], &r);
+            (i, saved.map(|_| r))
+        })
+        .collect();
+    for (i, r) in fresh {
+        done[i] = Some(r?);
+    }
+    Ok(done
+        .into_iter()
+        .map(|r| r.expect("every machine run"))
+        .collect())
+}
+
+/// A saved machine's key: everything its run depends on (scene, pass, threshold, image size,
+/// unit costs, the machine and its frame buffer).
+fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    format!("{:?}", t.os.config().costs).hash(&mut h);
+    let fb = match fb {
+        FrameBuffer::Direct => "direct".to_string(),
+        FrameBuffer::Cached { m } => format!("cfbs{m}"),
+        FrameBuffer::WriteBuffer { m } => format!("wb{m}"),
+    };
+    let threshold = t
+        .radiosity
+        .as_ref()
+        .map(|r| format!("-t{}", r.threshold))
+        .unwrap_or_default();
+    format!(
+        "{}{threshold}-s{}-c{:016x}-{}d-{}-{}-r{}-{fb}",
+        t.label,
+        t.pass.size,
+        h.finish(),
+        m.dims,
+        m.allocation.name(),
+        m.pes_label(),
+        m.rp_blocks
+    )
+}
+
+/// [`run_all`] without saving: every machine simulated.
+fn simulate_all(t: &Traced, machines: &[(Machine, FrameBuffer)]) -> Vec<(SimResult, f64)> {
     let paths: Vec<(Machine, FbPath)> = machines
         .iter()
         .map(|&(m, kind)| {

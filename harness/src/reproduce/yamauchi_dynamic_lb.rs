@@ -5,7 +5,7 @@
 
 use super::object_space_pass::{self as osp, PassRecord, Published, SimRecord, Traced};
 use super::published;
-use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::Result;
 use crate::workload;
 use rtbench_engines::object_space::config::FrameBuffer;
@@ -134,7 +134,12 @@ struct Result_ {
 }
 
 /// Simulates 1 PE × 1 RP block, then every (PEs, R) on the 2D skewed torus.
-fn measure(t: &Traced, pe_counts: &[u32], blocks: &[u32]) -> Measured {
+fn measure(
+    t: &Traced,
+    pe_counts: &[u32],
+    blocks: &[u32],
+    checkpoint: &Checkpoint,
+) -> Result<Measured> {
     let mut keys = vec![(1u32, 1u32)];
     keys.extend(
         pe_counts
@@ -154,7 +159,7 @@ fn measure(t: &Traced, pe_counts: &[u32], blocks: &[u32]) -> Measured {
         })
         .collect();
     eprintln!("{}: simulating {} machines …", t.label, machines.len());
-    let results = osp::run_all(t, &machines);
+    let results = osp::run_all(t, &machines, checkpoint)?;
     let t1 = results[0].0.clocks;
     let runs = keys
         .iter()
@@ -165,11 +170,11 @@ fn measure(t: &Traced, pe_counts: &[u32], blocks: &[u32]) -> Measured {
             rp_blocks,
         })
         .collect();
-    Measured {
+    Ok(Measured {
         pass: t.record(),
         t1_clocks: t1,
         runs,
-    }
+    })
 }
 
 fn run(ctx: &Ctx) -> Result<Output> {
@@ -187,8 +192,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let pool = workload::pool(ctx.params.threads()?)?;
     let measured: Vec<Measured> = traced
         .iter()
-        .map(|t| pool.install(|| measure(t, &pe_counts, &blocks)))
-        .collect();
+        .map(|t| pool.install(|| measure(t, &pe_counts, &blocks, ctx.checkpoint)))
+        .collect::<Result<_>>()?;
     let findings: Vec<Findings> = measured
         .iter()
         .map(|m| findings(m, &pe_counts, &blocks))

@@ -18,7 +18,10 @@ use rtbench_engines::object_space::radiosity::{self, Patches, Solution};
 use rtbench_engines::object_space::sim;
 use rtbench_engines::object_space::ObjectSpace;
 use rtbench_reports::{Document, Table as DocTable};
-use serde::Serialize;
+use rayon::prelude::*;
+use rtbench_engines::object_space::sim::SimResult;
+use rtbench_engines::object_space::trace::Trace;
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 pub const ROOM: Param = Param {
@@ -190,6 +193,61 @@ impl Room {
     }
 }
 
+/// One PE count's machine, both passes, as measured (saved as a step of the checkpoint).
+#[derive(Serialize, Deserialize)]
+struct PeStep {
+    pes: u32,
+    radiosity: SimResult,
+    radiosity_wall_s: f64,
+    shots: u64,
+    delta_rays: u64,
+    max_abs_difference: f64,
+    max_relative_difference: f64,
+    mean_relative_difference: f64,
+    max_unshot_left: f32,
+    ray_tracing: SimResult,
+    ray_tracing_wall_s: f64,
+    repeat_identical: Option<bool>,
+}
+
+/// Both passes on `n` PEs (2D skewed, 1 RP block), the radiosity against the reference; at 16
+/// PEs the radiosity pass again (determinism).
+fn pe_step(room: &Room, trace: &Trace, n: u32, size: u32) -> PeStep {
+    let m = osp::machine(n, 2, Allocation::Skewed, 1);
+    let owner = m.owner_map(room.os.config().subspaces);
+    let costs = &room.os.config().costs;
+    eprintln!("{}: radiosity pass on {} PEs …", room.label, n);
+    let t = Instant::now();
+    let r = radiosity::simulate(&room.os, &room.patches, &m, &owner, costs, room.threshold);
+    let wall = t.elapsed().as_secs_f64();
+    eprintln!(
+        "{}: {} PEs: radiosity pass {} clocks, {} packet events in {wall:.1} s",
+        room.label, n, r.clocks, r.events
+    );
+    let t = Instant::now();
+    let rt = sim::simulate(trace, &m, &owner, costs, FrameBuffer::Direct, size);
+    let rt_wall = t.elapsed().as_secs_f64();
+    let repeat_identical = (n == 16).then(|| {
+        let again = radiosity::simulate(&room.os, &room.patches, &m, &owner, costs, room.threshold);
+        again.clocks == r.clocks && again.solution.radiosity == r.solution.radiosity
+    });
+    let s = &r.solution;
+    PeStep {
+        pes: n,
+        radiosity: osp::as_sim(&r),
+        radiosity_wall_s: wall,
+        shots: s.shots,
+        delta_rays: s.rays,
+        max_abs_difference: s.max_abs_difference(&room.reference),
+        max_relative_difference: s.max_difference_above(&room.reference, room.threshold),
+        mean_relative_difference: s.mean_relative_difference(&room.reference),
+        max_unshot_left: s.unshot.iter().map(|u| u.max_element()).fold(0.0, f32::max),
+        ray_tracing: rt,
+        ray_tracing_wall_s: rt_wall,
+        repeat_identical,
+    }
+}
+
 #[derive(Serialize)]
 struct PeRun {
     pes: u32,
@@ -244,65 +302,61 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let pass = pool.install(|| pass_003::trace_pass(&room.os, &room.scene, size, Some(&diffuse)));
     let trace_s = t.elapsed().as_secs_f64();
     let (patches, per_subspace, at_most_one) = room.occupancy();
-    let mut runs = Vec::new();
-    let (mut t1_rad, mut t1_rt) = (0u64, 0u64);
-    for &n in &pes {
-        let m = osp::machine(n, 2, Allocation::Skewed, 1);
-        let owner = m.owner_map(room.os.config().subspaces);
-        eprintln!("{}: radiosity pass on {} PEs …", room.label, n);
-        let t = Instant::now();
-        let r = radiosity::simulate(
-            &room.os,
-            &room.patches,
-            &m,
-            &owner,
-            &room.os.config().costs,
-            room.threshold,
-        );
-        let wall = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let rt = sim::simulate(
-            &pass.trace,
-            &m,
-            &owner,
-            &room.os.config().costs,
-            FrameBuffer::Direct,
-            size,
-        );
-        let rt_wall = t.elapsed().as_secs_f64();
-        if n == 1 {
-            (t1_rad, t1_rt) = (r.clocks, rt.clocks);
-        }
-        let repeat_identical = (n == 16).then(|| {
-            let again = radiosity::simulate(
-                &room.os,
-                &room.patches,
-                &m,
-                &owner,
-                &room.os.config().costs,
-                room.threshold,
-            );
-            again.clocks == r.clocks && again.solution.radiosity == r.solution.radiosity
-        });
-        let s = &r.solution;
-        runs.push(PeRun {
-            pes: n,
-            shape: m.pes_label(),
-            radiosity: osp::SimRecord::new(&osp::as_sim(&r), t1_rad.max(1), n as u64, wall),
-            shots: s.shots,
-            delta_rays: s.rays,
-            max_abs_difference: s.max_abs_difference(&room.reference),
-            max_relative_difference: s.max_difference_above(&room.reference, room.threshold),
-            mean_relative_difference: s.mean_relative_difference(&room.reference),
-            max_unshot_left: s
-                .unshot
-                .iter()
-                .map(|u| u.max_element())
-                .fold(0.0, f32::max),
-            ray_tracing: osp::SimRecord::new(&rt, t1_rt.max(1), n as u64, rt_wall),
-            repeat_identical,
-        });
-    }
+    // The PE counts are independent machines: run side by side on the pool's threads, each
+    // saved when finished (`--resume` loads it: the full room's 1- and 16-PE machines are each
+    // about 5 × 10⁸ packet events).
+    let steps: Vec<Result<PeStep>> = pool.install(|| {
+        pes.par_iter()
+            .map(|&n| {
+                let key = format!(
+                    "{}-t{}-s{size}-{n}pes",
+                    room.label, room.threshold
+                );
+                if let Some(step) = ctx.checkpoint.load::<PeStep>(&key)? {
+                    eprintln!("{}: {n} PEs loaded from its saved step", room.label);
+                    return Ok(step);
+                }
+                let step = pe_step(&room, &pass.trace, n, size);
+                ctx.checkpoint.save(&key, &step)?;
+                Ok(step)
+            })
+            .collect()
+    });
+    let steps: Vec<PeStep> = steps.into_iter().collect::<Result<_>>()?;
+    let (t1_rad, t1_rt) = steps
+        .iter()
+        .find(|s| s.pes == 1)
+        .map(|s| (s.radiosity.clocks, s.ray_tracing.clocks))
+        .unwrap_or((0, 0));
+    let runs: Vec<PeRun> = steps
+        .into_iter()
+        .map(|s| {
+            let m = osp::machine(s.pes, 2, Allocation::Skewed, 1);
+            PeRun {
+                pes: s.pes,
+                shape: m.pes_label(),
+                radiosity: osp::SimRecord::new(
+                    &s.radiosity,
+                    t1_rad.max(1),
+                    s.pes as u64,
+                    s.radiosity_wall_s,
+                ),
+                shots: s.shots,
+                delta_rays: s.delta_rays,
+                max_abs_difference: s.max_abs_difference,
+                max_relative_difference: s.max_relative_difference,
+                mean_relative_difference: s.mean_relative_difference,
+                max_unshot_left: s.max_unshot_left,
+                ray_tracing: osp::SimRecord::new(
+                    &s.ray_tracing,
+                    t1_rt.max(1),
+                    s.pes as u64,
+                    s.ray_tracing_wall_s,
+                ),
+                repeat_identical: s.repeat_identical,
+            }
+        })
+        .collect();
     let image = format!("images/{}-radiosity.png", room.label);
     let measured = Measured {
         scene: room.label.clone(),

@@ -5,7 +5,7 @@
 
 use super::object_space_pass::{self as osp, PassRecord, Published, SimRecord, Traced};
 use super::published;
-use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::Result;
 use crate::workload;
 use rtbench_engines::object_space::config::FrameBuffer;
@@ -162,7 +162,7 @@ fn cap(dims: u8, max_pes: u32) -> u32 {
 }
 
 /// Simulates every machine on one traced scene.
-fn measure(t: &Traced, max_pes: u32) -> Measured {
+fn measure(t: &Traced, max_pes: u32, checkpoint: &Checkpoint) -> Result<Measured> {
     let mut keys = vec![(1u8, Allocation::Block, 1u32)];
     for dims in 1..=3u8 {
         for (d, alloc) in COLUMNS {
@@ -182,7 +182,7 @@ fn measure(t: &Traced, max_pes: u32) -> Measured {
         .map(|&(d, a, p)| (osp::machine(p, d, a, 1), FrameBuffer::Direct))
         .collect();
     eprintln!("{}: simulating {} machines …", t.label, machines.len());
-    let results = osp::run_all(t, &machines);
+    let results = osp::run_all(t, &machines, checkpoint)?;
     let t1 = results[0].0.clocks;
     let runs = keys
         .iter()
@@ -195,11 +195,11 @@ fn measure(t: &Traced, max_pes: u32) -> Measured {
             shape: osp::machine(pes, dims, alloc, 1).pes_label(),
         })
         .collect();
-    Measured {
+    Ok(Measured {
         pass: t.record(),
         t1_clocks: t1,
         runs,
-    }
+    })
 }
 
 fn run(ctx: &Ctx) -> Result<Output> {
@@ -208,8 +208,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let pool = workload::pool(ctx.params.threads()?)?;
     let measured: Vec<Measured> = traced
         .iter()
-        .map(|t| pool.install(|| measure(t, max_pes)))
-        .collect();
+        .map(|t| pool.install(|| measure(t, max_pes, ctx.checkpoint)))
+        .collect::<Result<_>>()?;
     let above = p.value("2d-256-above-60");
     let findings: Vec<Findings> = measured
         .iter()
