@@ -57,6 +57,14 @@
 //! `bh_level_K_read`, and for K ≥ 1 `bh_level_K_skipped` (boxes whose subtree was passed),
 //! `bh_level_K_objects_skipped`, `bh_level_K_ray_tests`; `bh_objects_skipped` in all; in the
 //! build stats `bh_levels`, `bh_level_K_boxes`, `bh_build_s` (0 when the store had it).
+//! With `grid=two-level` ([`hires`]): `hr_traversals`, `hr_blocks_read`, `hr_voxels_read`,
+//! `hr_grid_bytes_read`, `hr_grid_read_calls`, `hr_grid_seeks` (the on-disk grid's reads, also in
+//! `io_*`), `hr_lower_registrations` and `hr_direct_registrations` (rays sent directly to the
+//! upper grid), `hr_lower_grids_used` (summed over passes), `hr_direct_misses` (direct
+//! registrations a box's range check turned away); in the build stats the plan (`res_*`,
+//! `hr_upper_*`, `hr_lower`, `hr_levels`, `hr_pool`, `hr_block_slices`) and the preprocessing
+//! (`hr_subspace_side`, `hr_subspaces`, `hr_build_boxes_read`, `hr_build_nodes_culled`,
+//! `hr_build_objects_culled`, `hr_build_bytes_written`, `hr_build_s`).
 
 pub mod config;
 pub mod hierarchy;

@@ -10,8 +10,9 @@
 //! overhead its inverse, beside the text's 1.1–1.3×. The exact counters (direct registrations and
 //! the range checks they cost, lower grids used) show where the overhead comes from.
 //!
-//! `--quick` traces one small row per scene with the cap scaled to 16 (8/2 and 4/4), so that the
-//! small scenes' Klimaszewski resolutions exceed it as the thesis's large ones exceed 128.
+//! `--quick` traces one small row per scene at 128×128 with the cap scaled to 32 (16/2 and 8/4),
+//! so that the small scenes' Klimaszewski resolutions exceed it as the thesis's large ones exceed
+//! 128.
 //! `--set rows=…`, `--set cap=N` (two-level: N/2 over 2 and N/4 over 4). Rows are saved as they
 //! finish (`--resume`).
 
@@ -30,11 +31,11 @@ const ROWS: Param = Param {
 };
 const CAP: Param = Param {
     key: "cap",
-    help: "single-level cap per axis (default 128, 16 with --quick); two-level: cap/2 over 2 and cap/4 over 4",
+    help: "single-level cap per axis (default 128, 32 with --quick); two-level: cap/2 over 2 and cap/4 over 4",
 };
 const SIZE: Param = Param {
     key: "size",
-    help: "image size (default 512, 64 with --quick)",
+    help: "image size (default 512, 128 with --quick)",
 };
 const MEMORY: Param = Param {
     key: "memory",
@@ -63,7 +64,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "two-level-ratio",
             fidelity: Fidelity::Substituted,
-            why: "another machine (2 cores, shared, page cache dropped by posix_fadvise in place of a 256 MB machine); the pool of lower grids is sized by us (the thesis does not give it: 1/16 of the budget); Klimaszewski's resolution is our reading; --quick rows are smaller scenes with the cap scaled to 16",
+            why: "another machine (2 cores, shared, page cache dropped by posix_fadvise in place of a 256 MB machine); the pool of lower grids is sized by us (the thesis does not give it: 1/16 of the budget); Klimaszewski's resolution is our reading; --quick rows are smaller scenes with the cap scaled to 32",
         },
         Claim {
             key: "overhead",
@@ -129,15 +130,16 @@ struct Result_ {
 
 const SCENES: &[&str] = &["balls", "gears", "mount", "rings", "teapot", "tetra", "tree"];
 
-/// `--quick`: one small row per scene whose Klimaszewski resolution passes 16.
+/// `--quick`: one small row per scene (about 3·10^4 to 7·10^4 objects), whose Klimaszewski
+/// resolution passes the quick cap of 32 along its longest axis.
 const QUICK: &[(&str, u32)] = &[
-    ("balls", 3),
-    ("gears", 3),
-    ("mount", 6),
-    ("rings", 4),
-    ("teapot", 12),
-    ("tetra", 6),
-    ("tree", 12),
+    ("balls", 5),
+    ("gears", 5),
+    ("mount", 7),
+    ("rings", 8),
+    ("teapot", 30),
+    ("tetra", 8),
+    ("tree", 16),
 ];
 
 fn measure_row(scene: &str, sf: u32, thesis_row: bool, cap: u32, s: &Setup) -> Result<Measured> {
@@ -180,12 +182,12 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let size = ctx
         .params
         .number::<u32>(SIZE.key, 1)?
-        .unwrap_or(if ctx.quick { 64 } else { 512 });
+        .unwrap_or(if ctx.quick { 128 } else { 512 });
     crate::workload::check_size(size)?;
     let cap = ctx
         .params
         .number::<u32>(CAP.key, 4)?
-        .unwrap_or(if ctx.quick { 16 } else { 128 });
+        .unwrap_or(if ctx.quick { 32 } else { 128 });
     let setup = Setup {
         size,
         memory: ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string(),
