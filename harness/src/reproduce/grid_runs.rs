@@ -201,7 +201,10 @@ mod tests {
     fn the_slope_of_a_power_law_is_its_exponent() {
         let lin: Vec<(f64, f64)> = [1e3, 1e4, 1e5].iter().map(|&x| (x, 3.0 * x)).collect();
         assert!((log_slope(&lin).unwrap() - 1.0).abs() < 1e-9);
-        let root: Vec<(f64, f64)> = [1e3, 1e4, 1e5].iter().map(|&x| (x, x.powf(0.3))).collect();
+        let root: Vec<(f64, f64)> = [1e3f64, 1e4, 1e5]
+            .iter()
+            .map(|&x| (x, x.powf(0.3)))
+            .collect();
         assert!((log_slope(&root).unwrap() - 0.3).abs() < 1e-9);
         assert!(log_slope(&lin[..1]).is_none());
     }
