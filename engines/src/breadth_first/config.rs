@@ -139,6 +139,9 @@ pub struct BreadthFirstConfig {
     /// Drop the store's files from the page cache after preprocessing and after every sweep
     /// (`cache=cold`), so that each sweep reads the disk as on the thesis's 256 MB machine.
     pub cold: bool,
+    /// The grid rays are registered in (`grid=cuberoot|single|two-level` and its constants;
+    /// seed 000 §4.3).
+    pub grid: super::hires::config::GridKind,
 }
 
 /// Hierarchy constants set by the user (`None`: the thesis's for the scene).
@@ -306,6 +309,7 @@ impl BreadthFirstConfig {
             "cold" => true,
             v => return Err(bad("cache", v, "warm or cold")),
         };
+        let grid = super::hires::config::GridKind::from_settings(&mut s)?;
         s.finish()?;
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
@@ -347,6 +351,7 @@ impl BreadthFirstConfig {
             hierarchy,
             bh,
             cold,
+            grid,
         })
     }
 }

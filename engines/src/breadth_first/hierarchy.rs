@@ -202,6 +202,13 @@ impl Work {
             lt.ray_tests += 1;
             aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_some()
         };
+        if let Some(h) = &self.hires {
+            // The two-level registration grid (§4.3.3).
+            return h
+                .reg
+                .for_each(a, z, |slot| Ok::<bool, ()>(hits(slot)))
+                .unwrap_or(false);
+        }
         let cells: u64 = (0..3).map(|i| (z[i] - a[i] + 1) as u64).product();
         if cells > self.regs.len() as u64 {
             let [rx, ry, _] = g.lattice.res;

@@ -32,7 +32,7 @@ use crate::store::{BboxRecord, IoCounters, ObjectRecord, SceneReader};
 use std::io;
 
 #[inline]
-fn face_bit_of(entered: u8) -> u8 {
+pub(super) fn face_bit_of(entered: u8) -> u8 {
     face_bit((entered / 2) as usize, entered % 2 == 1)
 }
 
@@ -63,6 +63,9 @@ pub struct Work {
     pub(super) tree: Option<super::hierarchy::Tree>,
     /// Drop the store from the page cache after every sweep (`cache=cold`).
     pub(super) cold: bool,
+    /// The high-resolution grid (`grid=two-level`, §4.3): its flags on disk, rays registered in
+    /// its two-level grid; `voxels` then holds the grid's frame only, and `head` nothing.
+    pub(super) hires: Option<super::hires::HiRes>,
 }
 
 impl Work {
@@ -70,6 +73,9 @@ impl Work {
         let mut io = self.scene.io();
         if let Some(t) = &self.tree {
             io.add(&t.io());
+        }
+        if let Some(h) = &self.hires {
+            io.add(&h.grid.io);
         }
         io
     }
@@ -79,6 +85,9 @@ impl Work {
         self.scene.drop_cache();
         if let Some(t) = &self.tree {
             t.drop_cache();
+        }
+        if let Some(h) = &self.hires {
+            h.grid.drop_cache();
         }
     }
 }
@@ -98,23 +107,23 @@ pub struct Tally {
 /// One ray in memory (seed 000 §1.3's per-ray data).
 #[derive(Clone, Copy)]
 pub struct Slot {
-    id: u32,
+    pub(super) id: u32,
     pub(super) ray: Ray,
     pub(super) slab: SlabRay,
     wt: WatertightRay,
-    dda: Dda,
+    pub(super) dda: Dda,
     /// Nearest hit so far; `t` also ends the segment still searched.
     pub(super) best: Hit,
     pub(super) best_t: f32,
     /// Last object tested (the mailbox, on the ray's side).
     mailbox: u32,
     /// The last voxel registered in the previous pass, and in this one (`[u32::MAX; 3]`: none).
-    prev: [u32; 3],
-    last: [u32; 3],
+    pub(super) prev: [u32; 3],
+    pub(super) last: [u32; 3],
     /// The walk is swept up to here once this pass's sweep is done.
-    covered: f32,
+    pub(super) covered: f32,
     /// The walk ended (left the grid or the segment) during registration.
-    exhausted: bool,
+    pub(super) exhausted: bool,
 }
 
 /// One registration of a ray in a voxel: a link of that voxel's list.
@@ -165,6 +174,9 @@ impl Work {
         out: &mut dyn FnMut(u32, Hit),
         c: &mut Counters,
     ) -> io::Result<()> {
+        if self.hires.is_some() {
+            return self.trace_hires(rays, any, test, out, c);
+        }
         let mut input_left = true;
         let mut pass = 0usize;
         loop {
@@ -176,53 +188,16 @@ impl Work {
                     input_left = false;
                     break;
                 };
-                c.rays += 1;
-                let wt = WatertightRay::new(ray.dir);
-                // The floor group first: a near floor hit shortens the walk.
-                let mut best = Hit::MISS;
-                let mut seg = ray;
-                'floor: for (fid, rec) in &self.floor {
-                    for prim in &rec.prims {
-                        c.primitive_tests += 1;
-                        *c.extra.entry("bf_floor_tests".into()).or_insert(0) += 1;
-                        if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
-                            c.primitive_hits += 1;
-                            seg.tmax = t;
-                            best = Hit {
-                                t,
-                                object: *fid,
-                                u,
-                                v,
-                            };
-                            if any {
-                                break 'floor;
-                            }
+                match self.admit(id, ray, any, test, c) {
+                    Err(best) => out(id, best),
+                    Ok(mut slot) => {
+                        let g = &self.voxels;
+                        if first_candidate(g, &mut slot.dda, self.boundary, c) {
+                            self.slots.push(slot);
+                        } else {
+                            out(id, slot.best);
                         }
                     }
-                }
-                let g = &self.voxels;
-                let found = if any && best.is_hit() {
-                    None
-                } else {
-                    Dda::start(&seg, &g.lattice)
-                        .and_then(|mut d| first_candidate(g, &mut d, self.boundary, c).then_some(d))
-                };
-                match found {
-                    None => out(id, best),
-                    Some(dda) => self.slots.push(Slot {
-                        id,
-                        ray,
-                        slab: SlabRay::new(&ray, self.extent),
-                        wt,
-                        dda,
-                        best,
-                        best_t: seg.tmax,
-                        mailbox: u32::MAX,
-                        prev: [u32::MAX; 3],
-                        last: [u32::MAX; 3],
-                        covered: f32::NEG_INFINITY,
-                        exhausted: false,
-                    }),
                 }
             }
             if self.slots.is_empty() {
@@ -240,8 +215,64 @@ impl Work {
         }
     }
 
+    /// A ray entering memory: the floor group is tested first (a near floor hit shortens the
+    /// walk), then its walk starts where it enters the grid. `Err(best)`: the ray leaves now
+    /// (an any-hit query met the floor, or the segment misses the grid).
+    pub(super) fn admit(
+        &self,
+        id: u32,
+        ray: Ray,
+        any: bool,
+        test: TriangleTest,
+        c: &mut Counters,
+    ) -> Result<Slot, Hit> {
+        c.rays += 1;
+        let wt = WatertightRay::new(ray.dir);
+        let mut best = Hit::MISS;
+        let mut seg = ray;
+        'floor: for (fid, rec) in &self.floor {
+            for prim in &rec.prims {
+                c.primitive_tests += 1;
+                *c.extra.entry("bf_floor_tests".into()).or_insert(0) += 1;
+                if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
+                    c.primitive_hits += 1;
+                    seg.tmax = t;
+                    best = Hit {
+                        t,
+                        object: *fid,
+                        u,
+                        v,
+                    };
+                    if any {
+                        break 'floor;
+                    }
+                }
+            }
+        }
+        if any && best.is_hit() {
+            return Err(best);
+        }
+        let Some(dda) = Dda::start(&seg, &self.voxels.lattice) else {
+            return Err(best);
+        };
+        Ok(Slot {
+            id,
+            ray,
+            slab: SlabRay::new(&ray, self.extent),
+            wt,
+            dda,
+            best,
+            best_t: seg.tmax,
+            mailbox: u32::MAX,
+            prev: [u32::MAX; 3],
+            last: [u32::MAX; 3],
+            covered: f32::NEG_INFINITY,
+            exhausted: false,
+        })
+    }
+
     /// Registrations per ray this pass.
-    fn registration_count(&self, in_memory: usize) -> usize {
+    pub(super) fn registration_count(&self, in_memory: usize) -> usize {
         let fixed = self.initial_count as usize;
         if self.inverse {
             (self.regs_capacity / in_memory.max(1)).max(fixed)
@@ -294,7 +325,12 @@ impl Work {
 
     /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects"), or of
     /// the bounding-box hierarchy when the store has one and `hierarchy=on` (§4.2.2, "B").
-    fn sweep(&mut self, any: bool, test: TriangleTest, c: &mut Counters) -> io::Result<()> {
+    pub(super) fn sweep(
+        &mut self,
+        any: bool,
+        test: TriangleTest,
+        c: &mut Counters,
+    ) -> io::Result<()> {
         self.scene.rewind()?;
         let mut t = Tally::default();
         if self.tree.is_some() {
@@ -315,6 +351,9 @@ impl Work {
             self.head[reg.voxel as usize] = NONE;
         }
         self.regs.clear();
+        if let Some(h) = self.hires.as_mut() {
+            h.reg.clear();
+        }
         if self.cold {
             self.drop_cache();
         }
@@ -348,6 +387,55 @@ impl Work {
         let (a, z) = g.range(b.lo, b.hi);
         let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
         let mut loaded = read;
+        let (scene, record, slots) = (&mut self.scene, &mut self.record, &mut self.slots);
+        let mut visit = |slot: u32| -> io::Result<bool> {
+            let s = &mut slots[slot as usize];
+            if any && s.best.is_hit() {
+                return Ok(false);
+            }
+            if s.mailbox == id {
+                c.mailbox_skips += 1;
+                return Ok(false);
+            }
+            s.mailbox = id;
+            let p = s.prev;
+            if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
+                t.prev_skips += 1;
+                return Ok(false);
+            }
+            c.box_tests += 1;
+            if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
+                return Ok(false);
+            }
+            if !loaded {
+                scene.load(b, record)?;
+                loaded = true;
+                t.loads += 1;
+            }
+            let mut seg = s.ray;
+            for prim in &record.prims {
+                seg.tmax = s.best_t;
+                c.primitive_tests += 1;
+                if let Some((th, u, v)) = prim.intersect(&seg, test, &s.wt) {
+                    c.primitive_hits += 1;
+                    s.best_t = th;
+                    s.best = Hit {
+                        t: th,
+                        object: id,
+                        u,
+                        v,
+                    };
+                    if any {
+                        break;
+                    }
+                }
+            }
+            Ok(false)
+        };
+        if let Some(h) = &self.hires {
+            h.reg.for_each(a, z, visit)?;
+            return Ok(());
+        }
         for cz in a[2]..=z[2] {
             for cy in a[1]..=z[1] {
                 let row = g.lattice.index([0, cy, cz]);
@@ -356,47 +444,7 @@ impl Work {
                     while r != NONE {
                         let reg = self.regs[r as usize];
                         r = reg.next;
-                        let s = &mut self.slots[reg.slot as usize];
-                        if any && s.best.is_hit() {
-                            continue;
-                        }
-                        if s.mailbox == id {
-                            c.mailbox_skips += 1;
-                            continue;
-                        }
-                        s.mailbox = id;
-                        let p = s.prev;
-                        if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
-                            t.prev_skips += 1;
-                            continue;
-                        }
-                        c.box_tests += 1;
-                        if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
-                            continue;
-                        }
-                        if !loaded {
-                            self.scene.load(b, &mut self.record)?;
-                            loaded = true;
-                            t.loads += 1;
-                        }
-                        let mut seg = s.ray;
-                        for prim in &self.record.prims {
-                            seg.tmax = s.best_t;
-                            c.primitive_tests += 1;
-                            if let Some((th, u, v)) = prim.intersect(&seg, test, &s.wt) {
-                                c.primitive_hits += 1;
-                                s.best_t = th;
-                                s.best = Hit {
-                                    t: th,
-                                    object: id,
-                                    u,
-                                    v,
-                                };
-                                if any {
-                                    break;
-                                }
-                            }
-                        }
+                        visit(reg.slot)?;
                     }
                 }
             }

@@ -36,6 +36,13 @@
 //! | `hierarchy` | `on`, `off` | `off` | sweep through the store's bounding-box hierarchy, skipping whole subtrees no ray needs (Ch.4 "B", §4.2.2; [`hierarchy`]); built at preprocessing (and counted in it) when the store has none of these constants. Needs `split` |
 //! | `bh_s`, `bh_m`, `bh_l`, `bh_t` | numbers | the thesis's: 3, 1000, 4, t = 0.5 for balls/gears/tree, else 1.0 | the hierarchy's constants ([`crate::store::hierarchy`]) |
 //! | `cache` | `warm`, `cold` | `warm` | `cold`: the store's files are dropped from the page cache (`posix_fadvise DONTNEED`) after preprocessing and after every sweep, so each sweep reads the disk |
+//! | `grid` | `cuberoot`, `single`, `two-level` | `cuberoot` | the grid rays are registered in: the basic method's in-memory grid (⌊n^(1/3) + 0.5⌋, fitted to half the budget); `single`: in memory at Klimaszewski's resolution capped at `cap` (the thesis's "-l"); `two-level`: the high-resolution grid of §4.3 ([`hires`]) |
+//! | `cap` | cells per axis | 128 (`single`), none (`two-level`) | cap on Klimaszewski's resolution |
+//! | `upper`, `lower` | cells per axis | 256, 4 | R_u and R_l of §4.3.3's rule (`two-level`) |
+//! | `pool` | a count | what 1/16 of `memory` holds | lower grids in the pool (`two-level`) |
+//! | `block` | bytes | 1/8 of `memory` | one X-slab block of the on-disk grid (`two-level`) |
+//! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
+//! | `hrgrid` | `build`, `reuse` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -50,15 +57,26 @@
 //! `bh_level_K_read`, and for K ≥ 1 `bh_level_K_skipped` (boxes whose subtree was passed),
 //! `bh_level_K_objects_skipped`, `bh_level_K_ray_tests`; `bh_objects_skipped` in all; in the
 //! build stats `bh_levels`, `bh_level_K_boxes`, `bh_build_s` (0 when the store had it).
+//! With `grid=two-level` ([`hires`]): `hr_traversals`, `hr_blocks_read`, `hr_voxels_read`,
+//! `hr_grid_bytes_read`, `hr_grid_read_calls`, `hr_grid_seeks` (the on-disk grid's reads, also in
+//! `io_*`), `hr_lower_registrations` and `hr_direct_registrations` (rays sent directly to the
+//! upper grid), `hr_lower_grids_used` (summed over passes), `hr_direct_misses` (direct
+//! registrations a box's range check turned away); in the build stats the plan (`res_*`,
+//! `hr_upper_*`, `hr_lower`, `hr_levels`, `hr_pool`, `hr_block_slices`) and the preprocessing
+//! (`hr_subspace_side`, `hr_subspaces`, `hr_build_boxes_read`, `hr_build_nodes_culled`,
+//! `hr_build_objects_culled`, `hr_build_bytes_written`, `hr_build_s`).
 
 pub mod config;
 pub mod hierarchy;
+pub mod hires;
 pub mod intersect;
 pub mod spill;
 pub mod voxels;
 
 #[cfg(test)]
 mod hierarchy_tests;
+#[cfg(test)]
+mod hires_tests;
 #[cfg(test)]
 mod tests;
 
@@ -68,6 +86,7 @@ use crate::ray::{Hit, Ray};
 use crate::store::{ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface};
 use config::{BreadthFirstConfig, Count, Floor, Registration};
 use glam::Vec3;
+use hires::config::GridKind;
 use intersect::Work;
 use spill::SpillDir;
 use std::collections::BTreeMap;
@@ -175,7 +194,7 @@ impl BreadthFirst {
         };
         // Ch.4's "B": the hierarchy, built now (inside preprocessing) when the store lacks it.
         let mut bh_stats = BTreeMap::new();
-        let tree = if config.hierarchy {
+        let mut tree = if config.hierarchy {
             let constants = config.bh.resolve(&header.name);
             let (info, built) =
                 hierarchy::prepare(&header, constants, config.buffer as usize).map_err(open_err)?;
@@ -210,6 +229,8 @@ impl BreadthFirst {
         // The floor group, and the box and primitive count of the rest (one sweep).
         let (mut floor, mut bounds, mut grid_prims) =
             (Vec::new(), header.bounds, header.primitives);
+        // The mean box extent, which shapes Klimaszewski's cells (`grid=single|two-level`).
+        let (mut extent_sum, mut extent_n) = (glam::DVec3::ZERO, 0u64);
         if config.floor == Floor::Out {
             let ext = header.bounds[1] - header.bounds[0];
             let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
@@ -227,6 +248,10 @@ impl BreadthFirst {
                 }
                 lo = lo.min(b.lo);
                 hi = hi.max(b.hi);
+                if b.lo.is_finite() && b.hi.is_finite() {
+                    extent_sum += (b.hi - b.lo).as_dvec3();
+                    extent_n += 1;
+                }
             }
             bounds = [lo, hi];
             scene.rewind().map_err(open_err)?;
@@ -235,13 +260,62 @@ impl BreadthFirst {
             Count::Prims => grid_prims,
             Count::Objects => header.objects - floor.len() as u64,
         };
+        let klim = !matches!(config.grid, GridKind::CubeRoot);
+        if klim && config.floor == Floor::In {
+            let mut rec = ObjectRecord::default();
+            while let Some((_, b, _)) = scene.next(&mut rec).map_err(open_err)? {
+                if b.lo.is_finite() && b.hi.is_finite() {
+                    extent_sum += (b.hi - b.lo).as_dvec3();
+                    extent_n += 1;
+                }
+            }
+            scene.rewind().map_err(open_err)?;
+        }
+        let mean_extent = (extent_sum / extent_n.max(1) as f64).to_array();
+        let klimaszewski = |ext: [f64; 3]| {
+            crate::grid::resolution::klimaszewski_uncapped(ext, grid_n as usize, 1.0, mean_extent)
+        };
+        let mut plan = None;
+        let mut hr_stats = BTreeMap::new();
         // The grid takes about one voxel per primitive (5 bytes each: flags and a list head).
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
         // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
         let voxel_target = grid_n.min(config.memory / 2 / 5).max(1);
-        let mut voxels = Voxels::with_res(bounds, voxel_target, config.res);
-        let nvox = voxels.count() as u64;
-        let grid_bytes = nvox * 5;
+        let mut voxels = match config.grid {
+            GridKind::CubeRoot => Voxels::with_res(bounds, voxel_target, config.res),
+            GridKind::Single { cap } => Voxels::shaped(bounds, grid_n.max(1), |ext| {
+                klimaszewski(ext).map(|r| r.min(cap))
+            }),
+            GridKind::TwoLevel(tl) => Voxels::frame(bounds, grid_n.max(1), |ext| {
+                let p = hires::config::plan(klimaszewski(ext), &tl);
+                plan = Some(p);
+                p.res
+            }),
+        };
+        let res3 = voxels.lattice.res;
+        let nvox = res3.iter().map(|&r| r as u64).product::<u64>();
+        let (grid_bytes, reg_bytes) = match (config.grid, plan) {
+            (GridKind::TwoLevel(tl), Some(p)) => {
+                let pool = tl.pool.unwrap_or_else(|| {
+                    (config.memory / 16 / (4 * (p.lower as u64).pow(3)).max(1)).max(1)
+                });
+                let block = tl.block.unwrap_or(config.memory / 8);
+                hr_stats.insert("hr_pool".into(), pool as f64);
+                hr_stats.insert("hr_block_bytes".into(), block as f64);
+                (
+                    hires::two_level::TwoLevel::bytes(p.upper, p.lower, pool)
+                        + hires::blocks::Blocks::bytes(res3, block),
+                    hires::reg_bytes(),
+                )
+            }
+            _ => (nvox * 5, intersect::reg_bytes()),
+        };
+        if grid_bytes > config.memory {
+            return Err(err(format!(
+                "memory={} B is too small for the grid: {} B ({:?} cells; set cap= or a lower upper=)",
+                config.memory, grid_bytes, res3
+            )));
+        }
         let buffers = match config.layout {
             config::Layout::Split => 2 * config.buffer,
             config::Layout::Basic => config.buffer,
@@ -249,7 +323,13 @@ impl BreadthFirst {
             .as_ref()
             .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
-        let per_ray = intersect::slot_bytes() + initial as u64 * intersect::reg_bytes();
+        let per_ray = intersect::slot_bytes()
+            + initial as u64 * reg_bytes
+            + if plan.is_some() {
+                hires::walk_bytes()
+            } else {
+                0
+            };
         let left = config.memory.saturating_sub(grid_bytes + buffers);
         let capacity = (left / per_ray).min(config.max_rays.unwrap_or(u64::MAX)) as usize;
         if capacity == 0 {
@@ -262,13 +342,70 @@ impl BreadthFirst {
                 per_ray
             )));
         }
-        let mut next_floor = floor.iter().map(|f| f.0).peekable();
-        let mut rec = ObjectRecord::default();
-        while let Some((id, b, _)) = scene.next(&mut rec).map_err(open_err)? {
-            if next_floor.next_if_eq(&id).is_none() {
-                voxels.mark(b.lo, b.hi);
+        let floor_ids: Vec<u32> = floor.iter().map(|f| f.0).collect();
+        let hires = match (config.grid, plan) {
+            (GridKind::TwoLevel(tl), Some(p)) => {
+                let tb = Instant::now();
+                if !tl.reuse {
+                    // The subspace: a cube whose flags fit in 1/4 of the budget (§4.3.1).
+                    let side = tl.subspace.unwrap_or_else(|| {
+                        ((config.memory / 4) as f64).cbrt().floor().max(1.0) as u32
+                    });
+                    let st = hires::disk_grid::DiskGrid::build(
+                        dir,
+                        &voxels,
+                        side,
+                        &mut scene,
+                        tree.as_mut(),
+                        &floor_ids,
+                    )
+                    .map_err(|e| err(e.to_string()))?;
+                    hr_stats.insert("hr_subspace_side".into(), st.side as f64);
+                    hr_stats.insert("hr_subspaces".into(), st.subspaces as f64);
+                    hr_stats.insert("hr_build_boxes_read".into(), st.boxes_read as f64);
+                    hr_stats.insert("hr_build_nodes_culled".into(), st.nodes_culled as f64);
+                    hr_stats.insert("hr_build_objects_culled".into(), st.objects_culled as f64);
+                    hr_stats.insert("hr_build_bytes_written".into(), st.io.bytes_written as f64);
+                    hr_stats.insert("hr_build_write_calls".into(), st.io.write_calls as f64);
+                    hr_stats.insert("marked_voxels".into(), st.marked as f64);
+                }
+                hr_stats.insert("hr_build_s".into(), tb.elapsed().as_secs_f64());
+                let grid = hires::disk_grid::DiskGrid::open(dir, &voxels, floor.len() as u64)
+                    .map_err(|e| err(e.to_string()))?;
+                hr_stats.insert(
+                    "hr_grid_file_bytes".into(),
+                    (hires::disk_grid::HEADER + hires::disk_grid::flag_bytes(res3)) as f64,
+                );
+                hr_stats.insert("hr_levels".into(), if p.lower > 1 { 2.0 } else { 1.0 });
+                hr_stats.insert("hr_lower".into(), p.lower as f64);
+                for (i, a) in ["x", "y", "z"].iter().enumerate() {
+                    hr_stats.insert(format!("hr_upper_{a}"), p.upper[i] as f64);
+                }
+                let pool = hr_stats["hr_pool"] as usize;
+                let block = hr_stats["hr_block_bytes"] as u64;
+                let blocks = hires::blocks::Blocks::new(res3, block);
+                hr_stats.insert("hr_block_slices".into(), blocks.width as f64);
+                Some(hires::HiRes {
+                    grid,
+                    reg: hires::two_level::TwoLevel::new(p.upper, p.lower, pool),
+                    blocks,
+                    walks: Vec::with_capacity(capacity),
+                    cands: Vec::new(),
+                    io_reported: Default::default(),
+                })
             }
-        }
+            _ => {
+                let mut next_floor = floor.iter().map(|f| f.0).peekable();
+                let mut rec = ObjectRecord::default();
+                while let Some((id, b, _)) = scene.next(&mut rec).map_err(open_err)? {
+                    if next_floor.next_if_eq(&id).is_none() {
+                        voxels.mark(b.lo, b.hi);
+                    }
+                }
+                hr_stats.insert("marked_voxels".into(), voxels.marked_count() as f64);
+                None
+            }
+        };
         let pre_io = scene.take_io();
         if config.cold {
             scene.drop_cache();
@@ -279,12 +416,12 @@ impl BreadthFirst {
         let preprocess_s = t.elapsed().as_secs_f64();
 
         let mut stats = bh_stats;
+        stats.extend(hr_stats);
         stats.insert("preprocess_s".into(), preprocess_s);
         stats.insert("res_x".into(), voxels.lattice.res[0] as f64);
         stats.insert("res_y".into(), voxels.lattice.res[1] as f64);
         stats.insert("res_z".into(), voxels.lattice.res[2] as f64);
         stats.insert("voxels".into(), nvox as f64);
-        stats.insert("marked_voxels".into(), voxels.marked_count() as f64);
         stats.insert("objects".into(), header.objects as f64);
         stats.insert("primitives".into(), header.primitives as f64);
         stats.insert("memory_budget_bytes".into(), config.memory as f64);
@@ -312,11 +449,16 @@ impl BreadthFirst {
             .abs()
             .max(header.bounds[1].abs())
             .max_element();
+        let is_hr = hires.is_some();
         let work = Work {
             extent: if extent.is_finite() { extent } else { 0.0 },
-            head: vec![u32::MAX; voxels.count()],
+            head: vec![u32::MAX; if is_hr { 0 } else { voxels.count() }],
             voxels,
-            regs: Vec::with_capacity(capacity * initial as usize),
+            regs: Vec::with_capacity(if is_hr {
+                0
+            } else {
+                capacity * initial as usize
+            }),
             regs_capacity: capacity * initial as usize,
             slots: Vec::with_capacity(capacity),
             capacity,
@@ -333,6 +475,7 @@ impl BreadthFirst {
             floor,
             tree,
             cold: config.cold,
+            hires,
         };
         Ok(BreadthFirst {
             config,
@@ -371,6 +514,9 @@ impl BreadthFirst {
         // Rays left in memory by an error are dropped: their answers are MISS.
         w.slots.clear();
         let after = w.io();
+        if let Some(h) = w.hires.as_mut() {
+            hires::report(h, c);
+        }
         let e = &mut c.extra;
         *e.entry("io_bytes_read".into()).or_insert(0) += after.bytes_read - before.bytes_read;
         *e.entry("io_read_calls".into()).or_insert(0) += after.read_calls - before.read_calls;

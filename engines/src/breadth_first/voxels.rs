@@ -38,6 +38,22 @@ impl Voxels {
 
     /// As [`Voxels::new`], with `res` cells per axis when given.
     pub fn with_res(bounds: [Vec3; 2], n: u64, res: Option<u32>) -> Voxels {
+        Self::shaped(bounds, n, |extent| match res {
+            Some(r) => [r; 3],
+            None => cells_per_axis(Resolution::CubeRoot, extent, n as usize, 1.0, [0.0; 3]),
+        })
+    }
+
+    /// The grid's box and pad for a resolution chosen from the padded box's sides by `res`,
+    /// without the flags (the on-disk grid of seed 000 §4.3 keeps them in a file).
+    pub fn frame(bounds: [Vec3; 2], n: u64, res: impl FnOnce([f64; 3]) -> [u32; 3]) -> Voxels {
+        let mut v = Self::shaped(bounds, n, res);
+        v.flags = Vec::new();
+        v
+    }
+
+    /// As [`Voxels::with_res`], the resolution chosen from the padded box's sides by `res`.
+    pub fn shaped(bounds: [Vec3; 2], n: u64, res: impl FnOnce([f64; 3]) -> [u32; 3]) -> Voxels {
         let [mut lo, mut hi] = bounds;
         if !(lo.is_finite() && hi.is_finite()) || n == 0 {
             // No primitive: one empty voxel that no ray is registered in.
@@ -52,10 +68,7 @@ impl Voxels {
         lo -= Vec3::splat(pad0);
         hi += Vec3::splat(pad0);
         let extent = (hi - lo).as_dvec3().to_array();
-        let res = match res {
-            Some(r) => [r; 3],
-            None => cells_per_axis(Resolution::CubeRoot, extent, n as usize, 1.0, [0.0; 3]),
-        };
+        let res = res(extent);
         let lattice = Lattice::new(lo, hi, res);
         let cell = lattice.cell;
         Voxels {

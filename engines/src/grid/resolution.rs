@@ -61,6 +61,28 @@ pub fn cells_per_axis(
     cap(r.map(|v| v.clamp(1.0, u32::MAX as f64) as u32))
 }
 
+/// Klimaszewski's resolution (our reading, above) without the [`MAX_CELLS`] cap: the
+/// breadth-first engine's on-disk grid (seed 000 §4.3) is not bound by memory.
+pub fn klimaszewski_uncapped(
+    extent: [f64; 3],
+    n: usize,
+    density: f64,
+    mean_prim_extent: [f64; 3],
+) -> [u32; 3] {
+    let cells = density * n.max(1) as f64;
+    let emax = mean_prim_extent.iter().cloned().fold(0.0, f64::max);
+    let r = if emax <= 0.0 || !emax.is_finite() {
+        shaped(extent, [1.0; 3], cells)
+    } else {
+        shaped(
+            extent,
+            mean_prim_extent.map(|e| e.max(emax / MAX_ASPECT)),
+            cells,
+        )
+    };
+    r.map(|v| v.clamp(1.0, u32::MAX as f64) as u32)
+}
+
 /// About `cells` cells over a box of sides `extent`, each cell's sides proportional to `shape`:
 /// along axis i, round(d_i / (s·shape_i)) cells with s such that the product is `cells`.
 fn shaped(extent: [f64; 3], shape: [f64; 3], cells: f64) -> [f64; 3] {

@@ -18,6 +18,7 @@ mod table;
 mod writer;
 
 mod engine_timing;
+mod grid_runs;
 mod object_space_pass;
 
 pub use checkpoint::Checkpoint;
@@ -51,6 +52,8 @@ registry! {
     nakamaru_3_2,
     nakamaru_3_3,
     nakamaru_4_1,
+    nakamaru_4_2,
+    nakamaru_fig4_4,
     nakamaru_fig3_2,
     nakamaru_fig3_3,
     yamauchi_static_lb,

@@ -1,0 +1,206 @@
+//! The high-resolution grid (seed 000 §4.3) changes where rays are registered, never the
+//! answers: the capped single-level grid and the two-level grid (with lower grids, with a pool
+//! too small so that rays go directly to the upper grid, with one-slice blocks and small
+//! subspaces, with the hierarchy) answer exactly as the basic in-memory grid; each block is read
+//! at most twice per traversal; a truncated or foreign on-disk grid is refused in one line, and a
+//! build that fails leaves no file.
+
+use super::hires::disk_grid::FILE_NAME;
+use super::*;
+use crate::geometry::Geometry;
+use crate::store::tests::TempDir;
+use crate::{build_engine, Counters, Engine, Hit, Ray};
+use rtbench_scenes::generate_scene;
+use rtbench_scenes::spd::{Options, Program};
+use std::sync::Arc;
+
+fn spd(program: Program, sf: u32) -> BuildInput {
+    let scene = generate_scene(
+        program,
+        &Options {
+            size_factor: sf,
+            ..Options::standard(program)
+        },
+    )
+    .unwrap();
+    BuildInput {
+        geometry: Arc::new(Geometry::from_scene(&scene)),
+        scene: Arc::new(scene),
+    }
+}
+
+fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+fn rays(g: &Geometry, n: usize) -> (Vec<Ray>, Vec<Ray>) {
+    let (lo, hi) = (g.bounds_min, g.bounds_max);
+    let mut s = 987654321u64;
+    let mut unit = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut pt = |a: Vec3, b: Vec3| a + (b - a) * Vec3::new(unit(), unit(), unit());
+    let c = (lo + hi) * 0.5;
+    let h = (hi - lo) * 0.5;
+    let (mut closest, mut any) = (Vec::new(), Vec::new());
+    for _ in 0..n {
+        let o = pt(c - h * 1.5, c + h * 1.5);
+        let t = pt(lo, hi);
+        closest.push(Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY));
+        let a = pt(lo, hi);
+        let d = pt(lo, hi) - a;
+        any.push(Ray::new(a, d / d.length(), 0.0, d.length()));
+    }
+    (closest, any)
+}
+
+fn answers(e: &dyn Engine, r: &(Vec<Ray>, Vec<Ray>), c: &mut Counters) -> (Vec<Hit>, Vec<bool>) {
+    let mut hits = vec![Hit::MISS; r.0.len()];
+    let mut occ = vec![false; r.1.len()];
+    e.intersect(&r.0, &mut hits, c);
+    e.occluded(&r.1, &mut occ, c);
+    (hits, occ)
+}
+
+#[test]
+fn every_grid_answers_as_the_basic_one() {
+    let (mut lower, mut direct, mut culled) = (0, 0, 0.0);
+    for (program, sf) in [
+        (Program::Tetra, 5),
+        (Program::Mount, 5),
+        (Program::Rings, 3),
+        (Program::Balls, 3),
+    ] {
+        let input = spd(program, sf);
+        let r = rays(&input.geometry, 1500);
+        let base = build_engine("breadth-first", &input, vec![]).unwrap();
+        let want = answers(base.as_ref(), &r, &mut Counters::default());
+        for settings in [
+            vec![("grid", "single"), ("cap", "8")],
+            vec![("grid", "two-level")],
+            vec![("grid", "two-level"), ("upper", "4"), ("lower", "4")],
+            // A pool of 2: most rays go directly to the upper grid.
+            vec![
+                ("grid", "two-level"),
+                ("upper", "4"),
+                ("lower", "2"),
+                ("pool", "2"),
+                ("block", "64"),
+                ("subspace", "3"),
+                ("memory", "2MiB"),
+            ],
+            vec![
+                ("grid", "two-level"),
+                ("upper", "8"),
+                ("lower", "2"),
+                ("hierarchy", "on"),
+                ("subspace", "5"),
+            ],
+        ] {
+            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
+            let mut c = Counters::default();
+            let got = answers(e.as_ref(), &r, &mut c);
+            assert!(e.failure().is_none(), "{:?}", e.failure());
+            let same = got
+                .0
+                .iter()
+                .zip(&want.0)
+                .all(|(a, b)| a.object == b.object && a.t == b.t);
+            assert!(same && got.1 == want.1, "{program:?} {settings:?}");
+            if settings[0].1 == "two-level" {
+                let s = e.build_stats();
+                let x = s["res_x"] as u64;
+                let slices = s["hr_block_slices"] as u64;
+                // Each block read at most twice per traversal (once each way).
+                let blocks = x.div_ceil(slices);
+                assert!(c.extra["hr_blocks_read"] <= 2 * blocks * c.extra["hr_traversals"]);
+                assert!(
+                    c.extra["hr_voxels_read"]
+                        <= 2 * (s["voxels"] as u64) * c.extra["hr_traversals"]
+                );
+                assert_eq!(
+                    c.extra["hr_lower_registrations"] + c.extra["hr_direct_registrations"],
+                    c.extra["bf_registrations"]
+                );
+                lower += c.extra["hr_lower_registrations"];
+                direct += c.extra["hr_direct_registrations"];
+                culled += s.get("hr_build_nodes_culled").copied().unwrap_or(0.0);
+            }
+        }
+    }
+    assert!(lower > 0 && direct > 0, "lower {lower}, direct {direct}");
+    assert!(culled > 0.0, "no hierarchy node was culled from a subspace");
+}
+
+fn open_hr(dir: &std::path::Path, reuse: bool) -> Result<BreadthFirst, EngineError> {
+    let s = Settings::new(
+        "breadth-first",
+        kv(&[
+            ("grid", "two-level"),
+            ("upper", "4"),
+            ("hrgrid", if reuse { "reuse" } else { "build" }),
+        ]),
+    );
+    BreadthFirst::open(dir, BreadthFirstConfig::from_settings(s).unwrap())
+}
+
+#[test]
+fn a_truncated_or_foreign_grid_is_refused_and_a_failed_build_leaves_nothing() {
+    let input = spd(Program::Tetra, 4);
+    let dir = TempDir::new("hr-bad");
+    StoreWriter::create(&dir.0, "tetra4")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let r = rays(&input.geometry, 200);
+    let e = open_hr(&dir.0, false).unwrap();
+    let want = answers(&e, &r, &mut Counters::default());
+    drop(e);
+    let path = dir.0.join(FILE_NAME);
+    let good = std::fs::read(&path).unwrap();
+    // Reused whole: the same answers.
+    let e = open_hr(&dir.0, true).unwrap();
+    assert_eq!(answers(&e, &r, &mut Counters::default()).1, want.1);
+    drop(e);
+    // Truncated.
+    std::fs::write(&path, &good[..good.len() - 5]).unwrap();
+    let err = open_hr(&dir.0, true).err().unwrap().to_string();
+    assert!(
+        err.contains("truncated") && err.contains(FILE_NAME) && !err.contains('\n'),
+        "{err}"
+    );
+    // Truncated while tracing: the engine reports a failure, it does not panic.
+    std::fs::write(&path, &good).unwrap();
+    let e = open_hr(&dir.0, true).unwrap();
+    std::fs::write(&path, &good[..100]).unwrap();
+    let _ = answers(&e, &r, &mut Counters::default());
+    let f = e.failure().expect("a failure");
+    assert!(f.contains("truncated") && !f.contains('\n'), "{f}");
+    drop(e);
+    // A grid of another resolution.
+    std::fs::write(&path, &good).unwrap();
+    let s = Settings::new(
+        "breadth-first",
+        kv(&[("grid", "two-level"), ("cap", "3"), ("hrgrid", "reuse")]),
+    );
+    let err = BreadthFirst::open(&dir.0, BreadthFirstConfig::from_settings(s).unwrap())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("another"), "{err}");
+    // A build that fails (the store's directory made read-only is not enough as root, so the
+    // temporary's name is taken by a directory) leaves no grid and no temporary.
+    std::fs::remove_file(&path).unwrap();
+    let tmp = dir.0.join(format!("{FILE_NAME}.tmp"));
+    std::fs::create_dir(&tmp).unwrap();
+    let err = open_hr(&dir.0, false).err().unwrap().to_string();
+    assert!(err.contains("on-disk grid") && !err.contains('\n'), "{err}");
+    assert!(!path.exists());
+    std::fs::remove_dir(&tmp).unwrap();
+}
