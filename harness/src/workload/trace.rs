@@ -309,11 +309,10 @@ pub(crate) fn shade_hit(
     ambient
 }
 
-/// Pixel corners whose ray trees one chunk of the wavefront traces to the end before the next
-/// chunk starts ([`render_chunked`]). One engine batch ([`rtbench_engines::DEFAULT_BATCH`]) of
-/// eye rays: a chunk's generations then hold about 1 MB (rays, paths, hits, shadow rays) where a
-/// whole 512² generation held 32–96 MB, and its eye rays are answered in the same batches as
-/// before.
+/// Pixel corners (rounded down to whole rows, at least one) whose ray trees one band of the
+/// wavefront traces to the end before its thread starts another ([`render_chunked`]): one engine
+/// batch ([`rtbench_engines::engine::DEFAULT_BATCH`]) of eye rays, so a band's generations hold
+/// about 1 MB (rays, paths, hits, shadow rays) where a whole 512² generation held 32–96 MB.
 pub const DEFAULT_CHUNK: usize = 4096;
 
 /// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels, in chunks of
