@@ -409,6 +409,10 @@ pub struct RenderArgs {
     pub png: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
+    /// Pixel corners whose ray trees are traced to the end before the next chunk starts (in-memory
+    /// engines; 0: whole generations at once). Bounds the wavefront's memory; changes no answer.
+    #[arg(long, value_name = "CORNERS", default_value_t = crate::workload::trace::DEFAULT_CHUNK)]
+    pub chunk: usize,
     /// Trace only the K-th of N tile sets (bands of pixel-corner rows) of a scene store's image,
     /// into --out DIR; `rtbench merge` joins the N tiles (scripts/slurm/).
     #[arg(long, value_name = "K/N", requires = "out")]

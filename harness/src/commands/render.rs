@@ -28,7 +28,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
-    let r = pool.install(|| trace::render(&prepared.input.scene, engine.as_ref(), a.size, None));
+    let r = pool.install(|| {
+        trace::render_chunked(
+            &prepared.input.scene,
+            engine.as_ref(),
+            a.size,
+            a.chunk,
+            false,
+            None,
+        )
+    });
     if let Some(f) = engine.failure() {
         return Err(input(f));
     }
@@ -50,6 +59,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "lights": scene.lights.len(),
         },
         "threads": pool.current_num_threads(),
+        "chunk": a.chunk,
         "rays": r.stats,
         "time_s": {
             "generate": prepared.generate_s,

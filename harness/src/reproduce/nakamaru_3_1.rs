@@ -154,7 +154,7 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
     Ok(Timed {
         s: [pre + r.trace_s, pre, r.intersect_s, r.shade_s],
         tests: r.counters.primitive_tests,
-        image: r.pixels(),
+        image: r.pixels().to_vec(),
         res: e.build_stats().get("res_x").copied().unwrap_or(0.0),
     })
 }
@@ -184,7 +184,7 @@ fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed
     Ok(Timed {
         s: [pre + r.trace_s, pre, r.intersect_s, r.shade_s],
         tests: r.counters.box_tests + floor_tests,
-        image: r.pixels(),
+        image: r.pixels().to_vec(),
         res: rtbench_engines::Engine::build_stats(&engine).get("res_x").copied().unwrap_or(0.0),
     })
 }

@@ -145,7 +145,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             let image = format!("{}{}-{engine}.png", row.scene, row.sf);
             images.push(Image {
                 path: format!("images/{image}"),
-                pixels: r.pixels(),
+                pixels: r.pixels().to_vec(),
                 size: SIZE,
             });
             let compare = compare(&p, row, &r.stats);

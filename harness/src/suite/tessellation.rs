@@ -65,7 +65,14 @@ fn input(p: Program, sf: u32, tessellate: Option<u32>) -> BuildInput {
 /// time, for the budget).
 fn timed(input: &BuildInput, name: &str, size: u32) -> Result<(Vec<glam::Vec3>, f64, f64)> {
     let e = build_engine(name, input, vec![])?;
-    let r = trace::render(&input.scene, e.as_ref(), size, None);
+    let r = trace::render_chunked(
+        &input.scene,
+        e.as_ref(),
+        size,
+        trace::DEFAULT_CHUNK,
+        true,
+        None,
+    );
     let (mut best, wall) = (r.intersect_s, r.trace_s);
     if wall < 1.0 {
         for _ in 1..REPEATS {

@@ -461,7 +461,7 @@ pub fn render_tile(
     io_total.add(&scene.io());
     Ok(OutOfCoreRender {
         render: Render {
-            size,
+            pixels: super::trace::pixels_of(size, &corners),
             corners,
             stats,
             counters,

@@ -115,9 +115,11 @@ pub struct Recording {
 }
 
 pub struct Render {
-    pub size: u32,
-    /// Colour at each of the (size+1)² corners, row by row from the top.
+    /// Colour at each of the (size+1)² corners, row by row from the top; empty unless asked for
+    /// ([`render_chunked`]'s `keep_corners`; the out-of-core tracer always keeps them).
     pub corners: Vec<Vec3>,
+    /// The image ([`pixels_of`] of the corners), made band by band as the chunks finish.
+    pub pixels: Vec<u8>,
     pub stats: RayStats,
     pub counters: Counters,
     pub intersect_s: f64,
@@ -129,8 +131,8 @@ pub struct Render {
 
 impl Render {
     /// The image: each pixel the average of its four corners, 8-bit sRGB-less RGB.
-    pub fn pixels(&self) -> Vec<u8> {
-        pixels_of(self.size, &self.corners)
+    pub fn pixels(&self) -> &[u8] {
+        &self.pixels
     }
 }
 
@@ -139,31 +141,25 @@ impl Render {
 pub fn pixels_of(size: u32, corners: &[Vec3]) -> Vec<u8> {
     let n = size as usize;
     let w = n + 1;
-    let mut out = Vec::with_capacity(n * n * 3);
-    for j in 0..n {
-        for i in 0..n {
-            let c = (corners[j * w + i]
-                + corners[j * w + i + 1]
-                + corners[(j + 1) * w + i]
-                + corners[(j + 1) * w + i + 1])
-                * 0.25;
-            for x in [c.x, c.y, c.z] {
-                out.push((x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
-            }
-        }
+    let mut out = vec![0; n * n * 3];
+    for (j, row) in out.chunks_exact_mut(n * 3).enumerate() {
+        pixel_row(
+            &corners[j * w..(j + 1) * w],
+            &corners[(j + 1) * w..(j + 2) * w],
+            row,
+        );
     }
     out
 }
 
-/// CPU seconds spent by pool threads other than the render's own (whose time the render
-/// measures as a whole), so nothing is counted twice.
-fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
-    let c0 = super::thread_cpu_seconds();
-    work();
-    if rayon::current_thread_index() != me {
-        super::thread_cpu_seconds() - c0
-    } else {
-        0.0
+/// One row of pixels from the corner rows above (`top`) and below it: each pixel the average
+/// of its four corners.
+fn pixel_row(top: &[Vec3], bottom: &[Vec3], out: &mut [u8]) {
+    for (i, px) in out.chunks_exact_mut(3).enumerate() {
+        let c = (top[i] + top[i + 1] + bottom[i] + bottom[i + 1]) * 0.25;
+        for (o, x) in px.iter_mut().zip([c.x, c.y, c.z]) {
+            *o = (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+        }
     }
 }
 
@@ -171,7 +167,6 @@ fn other_thread_cpu(me: Option<usize>, work: impl FnOnce()) -> f64 {
 /// `batch` rays (the engine's [`Engine::batch_hint`]; `None`: all in one call, for engines that
 /// answer a whole generation at once) over the pool's threads, each chunk with its own
 /// counters, summed into `counters`. `out` is resized to the batch and filled with `fill` first.
-/// Returns the CPU seconds used on threads other than the caller's.
 pub(crate) fn query_all<T: Clone + Send>(
     batch: Option<usize>,
     rays: &[Ray],
@@ -179,26 +174,22 @@ pub(crate) fn query_all<T: Clone + Send>(
     fill: T,
     counters: &mut Counters,
     query: impl Fn(&[Ray], &mut [T], &mut Counters) + Sync,
-) -> f64 {
+) {
     out.clear();
     out.resize(rays.len(), fill);
-    let me = rayon::current_thread_index();
     let chunk = batch.unwrap_or(rays.len()).max(1);
-    let sums: Vec<(Counters, f64)> = rays
+    let sums: Vec<Counters> = rays
         .par_chunks(chunk)
         .zip(out.par_chunks_mut(chunk))
         .map(|(r, o)| {
             let mut c = Counters::default();
-            let cpu = other_thread_cpu(me, || query(r, o, &mut c));
-            (c, cpu)
+            query(r, o, &mut c);
+            c
         })
         .collect();
-    let mut cpu = 0.0;
-    for (c, t) in &sums {
+    for c in &sums {
         counters.add(c);
-        cpu += t;
     }
-    cpu
 }
 
 /// A secondary ray's origin: `p` moved off the surface along `n` (the self-intersection policy).
@@ -318,133 +309,318 @@ pub(crate) fn shade_hit(
     ambient
 }
 
-/// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels. With `record`,
-/// every query and its answer is kept.
+/// Pixel corners (rounded down to whole rows, at least one) whose ray trees one band of the
+/// wavefront traces to the end before its thread starts another ([`render_chunked`]): one engine
+/// batch ([`rtbench_engines::engine::DEFAULT_BATCH`]) of eye rays, so a band's generations hold
+/// about 1 MB (rays, paths, hits, shadow rays) where a whole 512² generation held 32–96 MB.
+pub const DEFAULT_CHUNK: usize = 4096;
+
+/// Traces the SPD workload of `scene` with `engine` at `size`×`size` pixels, in chunks of
+/// [`DEFAULT_CHUNK`] corners. With `record`, every query and its answer is kept.
 pub fn render(
     scene: &Scene,
     engine: &dyn Engine,
     size: u32,
+    record: Option<&mut Recording>,
+) -> Render {
+    render_chunked(scene, engine, size, DEFAULT_CHUNK, false, record)
+}
+
+/// The buffers of one chunk's generations, reused from chunk to chunk on a thread.
+#[derive(Default)]
+struct Wavefront {
+    /// The colours of the band's corners.
+    corners: Vec<Vec3>,
+    rays: Vec<Ray>,
+    paths: Vec<Path>,
+    hits: Vec<Hit>,
+    blocked: Vec<bool>,
+    shadow_rays: Vec<Ray>,
+    shadow_gain: Vec<(u32, Vec3)>,
+    next_rays: Vec<Ray>,
+    next_paths: Vec<Path>,
+}
+
+/// What one chunk measured.
+#[derive(Default)]
+struct Part {
+    stats: RayStats,
+    counters: Counters,
+    intersect_s: f64,
+    shade_s: f64,
+    /// Wall seconds of the whole chunk (to share the render's wall time among the phases when
+    /// chunks run on several threads).
+    wall_s: f64,
+    record: Option<Recording>,
+    /// The band's first and last rows of corner colours (for the pixel rows between bands), and
+    /// all of them when kept.
+    first_row: Vec<Vec3>,
+    last_row: Vec<Vec3>,
+    corners: Vec<Vec3>,
+}
+
+/// What every chunk of one render reads.
+struct Setup<'a> {
+    scene: &'a Scene,
+    engine: &'a dyn Engine,
+    camera: Camera,
+    surfaces: Surfaces,
+    lights: Vec<(Vec3, Vec3)>,
+    background: Vec3,
+    size: u32,
+    batch: Option<usize>,
+}
+
+/// Traces the SPD workload like [`render`], in bands of whole rows of pixel corners of about
+/// `chunk` corners (at least one row; 0: all rows at once, whole generations as the SPD
+/// procedure reads). A band's ray trees are traced generation by generation to the end, so only
+/// one band's generations are held per thread, and its rows of pixels are made as it finishes;
+/// bands run on the pool's threads. Engines that answer whole generations at once
+/// ([`Engine::batch_hint`] `None`, the breadth-first engine) always get whole generations. The
+/// corner colours are kept (3.2 MB at 512²) only with `keep_corners`.
+///
+/// Chunking changes no answer and no colour: a corner's colour is the sum of its own ray tree's
+/// terms, added in the same order (generation by generation, shading before shadows) whatever
+/// else is traced, and the per-ray counters add up to the same totals. What can change is a
+/// counter of state an engine keeps per batch (the grid's shadow cache starts empty in every
+/// batch, and batches of later generations now start at band boundaries).
+pub fn render_chunked(
+    scene: &Scene,
+    engine: &dyn Engine,
+    size: u32,
+    chunk: usize,
+    keep_corners: bool,
     mut record: Option<&mut Recording>,
 ) -> Render {
     let start = Instant::now();
-    let cpu_start = super::thread_cpu_seconds();
-    let mut other_cpu = 0.0;
+    let cpu_start = pool_cpu_seconds();
     let batch = engine.batch_hint();
-    let camera = Camera::new(&scene.view);
-    let surfaces = Surfaces::new(scene);
-    let w = size + 1;
-    let n_corners = (w as usize) * (w as usize);
-    let mut corners = vec![Vec3::ZERO; n_corners];
-    let background = scene.background.as_vec3();
-    let lights = scaled_lights(&scene.lights);
-
-    let mut rays: Vec<Ray> = Vec::with_capacity(n_corners);
-    let mut paths: Vec<Path> = Vec::with_capacity(n_corners);
-    for j in 0..w {
-        for i in 0..w {
-            rays.push(camera.corner_ray(i, j, size));
-            paths.push(Path {
-                corner: j * w + i,
-                weight: Vec3::ONE,
-                depth: 1,
-                inside: false,
-            });
-        }
+    let n = size as usize;
+    let w = n + 1;
+    let band_rows = match (batch, chunk) {
+        (None, _) | (_, 0) => w,
+        (_, c) => (c / w).clamp(1, w),
+    };
+    let setup = Setup {
+        scene,
+        engine,
+        camera: Camera::new(&scene.view),
+        surfaces: Surfaces::new(scene),
+        lights: scaled_lights(&scene.lights),
+        background: scene.background.as_vec3(),
+        size,
+        batch,
+    };
+    // Each band writes the pixel rows between its own corner rows; the row between two bands
+    // (the seam) is made afterwards from the first and last corner rows the bands hand back.
+    let mut pixels = vec![0u8; n * n * 3];
+    let mut slices = Vec::new();
+    let mut rest = pixels.as_mut_slice();
+    for j0 in (0..w).step_by(band_rows) {
+        let rows = band_rows.min(n.saturating_sub(j0));
+        let (mine, more) = rest.split_at_mut(rows * n * 3);
+        slices.push((j0, mine));
+        rest = more;
     }
+    let recording = record.is_some();
+    let t = Instant::now();
+    let parts: Vec<Part> = slices
+        .into_par_iter()
+        .map_init(Wavefront::default, |wf, (j0, out)| {
+            let rows = band_rows.min(w - j0);
+            let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
+            for (j, row) in out.chunks_exact_mut(n * 3).take(rows - 1).enumerate() {
+                pixel_row(
+                    &wf.corners[j * w..(j + 1) * w],
+                    &wf.corners[(j + 1) * w..(j + 2) * w],
+                    row,
+                );
+            }
+            part.first_row = wf.corners[..w].to_vec();
+            part.last_row = wf.corners[(rows - 1) * w..rows * w].to_vec();
+            if keep_corners {
+                part.corners = wf.corners.clone();
+            }
+            part
+        })
+        .collect();
+    let region_s = t.elapsed().as_secs_f64();
 
     let mut stats = RayStats::default();
     let mut counters = Counters::default();
-    let mut hits = Vec::new();
-    let mut blocked = Vec::new();
-    let mut shadow_rays: Vec<Ray> = Vec::new();
-    let mut shadow_gain: Vec<(u32, Vec3)> = Vec::new();
-    let mut next_rays = Vec::new();
-    let mut next_paths = Vec::new();
-    let (mut intersect_s, mut shade_s) = (0.0, 0.0);
-    let mut generation = 0;
+    let mut corners = Vec::new();
+    let (mut intersect_s, mut shade_s, mut chunks_s) = (0.0, 0.0, 0.0);
+    for (k, p) in parts.iter().enumerate() {
+        let seam = (k + 1) * band_rows - 1;
+        if let Some(next) = parts.get(k + 1).filter(|_| seam < n) {
+            let row = &mut pixels[seam * n * 3..(seam + 1) * n * 3];
+            pixel_row(&p.last_row, &next.first_row, row);
+        }
+    }
+    for p in parts {
+        stats.add(&p.stats);
+        counters.add(&p.counters);
+        intersect_s += p.intersect_s;
+        shade_s += p.shade_s;
+        chunks_s += p.wall_s;
+        corners.extend(p.corners);
+        if let (Some(rec), Some(r)) = (record.as_deref_mut(), p.record) {
+            rec.closest.extend(r.closest);
+            rec.any.extend(r.any);
+            rec.closest_corner.extend(r.closest_corner);
+            rec.any_corner.extend(r.any_corner);
+        }
+    }
+    // Bands on several threads overlap: their phases' seconds are shared out of the wall time
+    // in proportion (one thread: the sum of the bands' seconds fits the wall time already).
+    let share = if chunks_s > region_s {
+        region_s / chunks_s
+    } else {
+        1.0
+    };
+    Render {
+        corners,
+        pixels,
+        stats,
+        counters,
+        intersect_s: intersect_s * share,
+        shade_s: shade_s * share,
+        trace_s: start.elapsed().as_secs_f64(),
+        trace_cpu_s: pool_cpu_seconds() - cpu_start,
+    }
+}
 
-    while !rays.is_empty() {
+/// CPU seconds used so far by the threads of the current rayon pool, summed. A render's CPU
+/// time is counted on the pool's threads only: a whole-process figure would include the worker
+/// threads of Embree's TBB, which spin on after a build and made Embree's time vary twofold
+/// between runs. Called from outside any pool, the calling thread is counted with the global
+/// pool's.
+fn pool_cpu_seconds() -> f64 {
+    let pool: f64 = rayon::broadcast(|_| super::thread_cpu_seconds())
+        .into_iter()
+        .sum();
+    if rayon::current_thread_index().is_none() {
+        pool + super::thread_cpu_seconds()
+    } else {
+        pool
+    }
+}
+
+/// Traces the ray trees of the corners `first..first + count` to the end, their colours into
+/// `wf.corners`.
+fn trace_chunk(s: &Setup, first: u32, count: usize, wf: &mut Wavefront, recording: bool) -> Part {
+    let t_chunk = Instant::now();
+    let w = s.size + 1;
+    let mut part = Part {
+        record: recording.then(Recording::default),
+        ..Default::default()
+    };
+    wf.corners.clear();
+    wf.corners.resize(count, Vec3::ZERO);
+    let corners = &mut wf.corners;
+    wf.rays.clear();
+    wf.paths.clear();
+    for corner in first..first + count as u32 {
+        wf.rays
+            .push(s.camera.corner_ray(corner % w, corner / w, s.size));
+        wf.paths.push(Path {
+            corner,
+            weight: Vec3::ONE,
+            depth: 1,
+            inside: false,
+        });
+    }
+    let stats = &mut part.stats;
+    let counters = &mut part.counters;
+    let mut generation = 0;
+    while !wf.rays.is_empty() {
         generation += 1;
         let mut g = GenerationStats {
             generation,
-            rays: rays.len() as u64,
+            rays: wf.rays.len() as u64,
             ..Default::default()
         };
         let t0 = Instant::now();
-        other_cpu += query_all(
-            batch,
-            &rays,
-            &mut hits,
+        query_all(
+            s.batch,
+            &wf.rays,
+            &mut wf.hits,
             Hit::MISS,
-            &mut counters,
-            |r, h, c| engine.intersect(r, h, c),
+            counters,
+            |r, h, c| s.engine.intersect(r, h, c),
         );
-        intersect_s += t0.elapsed().as_secs_f64();
-        if let Some(rec) = record.as_deref_mut() {
+        part.intersect_s += t0.elapsed().as_secs_f64();
+        if let Some(rec) = part.record.as_mut() {
             rec.closest
-                .extend(rays.iter().copied().zip(hits.iter().copied()));
-            rec.closest_corner.extend(paths.iter().map(|p| p.corner));
+                .extend(wf.rays.iter().copied().zip(wf.hits.iter().copied()));
+            rec.closest_corner.extend(wf.paths.iter().map(|p| p.corner));
         }
 
         let t1 = Instant::now();
-        shadow_rays.clear();
-        shadow_gain.clear();
-        next_rays.clear();
-        next_paths.clear();
-        for ((ray, hit), path) in rays.iter().zip(&hits).zip(&paths) {
+        wf.shadow_rays.clear();
+        wf.shadow_gain.clear();
+        wf.next_rays.clear();
+        wf.next_paths.clear();
+        for ((ray, hit), path) in wf.rays.iter().zip(&wf.hits).zip(&wf.paths) {
+            let at = (path.corner - first) as usize;
             if !hit.is_hit() {
-                corners[path.corner as usize] += path.weight * background;
+                corners[at] += path.weight * s.background;
                 continue;
             }
             g.hits += 1;
-            let m = &scene.materials[surfaces.material[hit.object as usize] as usize];
+            let m = &s.scene.materials[s.surfaces.material[hit.object as usize] as usize];
             let p = ray.at(hit.t);
-            let normals = surfaces.normals(hit, p);
-            corners[path.corner as usize] += shade_hit(
+            let normals = s.surfaces.normals(hit, p);
+            corners[at] += shade_hit(
                 ray,
                 hit,
                 path,
                 m,
                 normals,
-                &lights,
+                &s.lights,
                 &mut g,
                 &mut |r, corner, gain| {
-                    shadow_rays.push(r);
-                    shadow_gain.push((corner, gain));
+                    wf.shadow_rays.push(r);
+                    wf.shadow_gain.push((corner, gain));
                 },
                 &mut |r, p| {
-                    next_rays.push(r);
-                    next_paths.push(p);
+                    wf.next_rays.push(r);
+                    wf.next_paths.push(p);
                 },
             );
         }
-        shade_s += t1.elapsed().as_secs_f64();
+        part.shade_s += t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
-        other_cpu += query_all(
-            batch,
-            &shadow_rays,
-            &mut blocked,
+        query_all(
+            s.batch,
+            &wf.shadow_rays,
+            &mut wf.blocked,
             false,
-            &mut counters,
-            |r, o, c| engine.occluded(r, o, c),
+            counters,
+            |r, o, c| s.engine.occluded(r, o, c),
         );
-        intersect_s += t2.elapsed().as_secs_f64();
-        if let Some(rec) = record.as_deref_mut() {
-            rec.any
-                .extend(shadow_rays.iter().copied().zip(blocked.iter().copied()));
-            rec.any_corner.extend(shadow_gain.iter().map(|(c, _)| *c));
+        part.intersect_s += t2.elapsed().as_secs_f64();
+        if let Some(rec) = part.record.as_mut() {
+            rec.any.extend(
+                wf.shadow_rays
+                    .iter()
+                    .copied()
+                    .zip(wf.blocked.iter().copied()),
+            );
+            rec.any_corner
+                .extend(wf.shadow_gain.iter().map(|(c, _)| *c));
         }
         let t3 = Instant::now();
-        g.shadow = shadow_rays.len() as u64;
-        for ((corner, gain), b) in shadow_gain.iter().zip(&blocked) {
+        g.shadow = wf.shadow_rays.len() as u64;
+        for ((corner, gain), b) in wf.shadow_gain.iter().zip(&wf.blocked) {
             if *b {
                 g.shadow_blocked += 1;
             } else {
-                corners[*corner as usize] += *gain;
+                corners[(*corner - first) as usize] += *gain;
             }
         }
-        shade_s += t3.elapsed().as_secs_f64();
+        part.shade_s += t3.elapsed().as_secs_f64();
 
         if generation == 1 {
             stats.eye = g.rays;
@@ -456,18 +632,70 @@ pub fn render(
         stats.refract += g.refract;
         stats.total += g.rays + g.shadow;
         stats.generations.push(g);
-        std::mem::swap(&mut rays, &mut next_rays);
-        std::mem::swap(&mut paths, &mut next_paths);
+        std::mem::swap(&mut wf.rays, &mut wf.next_rays);
+        std::mem::swap(&mut wf.paths, &mut wf.next_paths);
+    }
+    part.wall_s = t_chunk.elapsed().as_secs_f64();
+    part
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rtbench_engines::geometry::Geometry;
+    use rtbench_engines::{build_engine, BuildInput};
+    use rtbench_scenes::generate_scene;
+    use rtbench_scenes::spd::{Options, Program};
+    use std::sync::Arc;
+
+    fn input(p: Program, sf: u32) -> BuildInput {
+        let scene = generate_scene(
+            p,
+            &Options {
+                size_factor: sf,
+                ..Options::standard(p)
+            },
+        )
+        .unwrap();
+        BuildInput {
+            geometry: Arc::new(Geometry::from_scene(&scene)),
+            scene: Arc::new(scene),
+        }
     }
 
-    Render {
-        size,
-        corners,
-        stats,
-        counters,
-        intersect_s,
-        shade_s,
-        trace_s: start.elapsed().as_secs_f64(),
-        trace_cpu_s: super::thread_cpu_seconds() - cpu_start + other_cpu,
+    /// Bands of one row, of several rows with a short last band, and whole generations give the
+    /// same image, corner colours to the bit, ray statistics and per-ray counters (balls: a
+    /// reflective scene, so several generations per band).
+    #[test]
+    fn chunks_change_no_colour_and_no_count() {
+        let inp = input(Program::Balls, 1);
+        let e = build_engine("bvh8", &inp, vec![]).unwrap();
+        let size = 40;
+        let whole = render_chunked(&inp.scene, e.as_ref(), size, 0, true, None);
+        assert_eq!(whole.pixels, pixels_of(size, &whole.corners));
+        assert!(whole.stats.generations.len() > 2);
+        for chunk in [1, 41, 3 * 41, 7 * 41 + 5, 100_000] {
+            let r = render_chunked(&inp.scene, e.as_ref(), size, chunk, true, None);
+            assert_eq!(r.corners, whole.corners, "chunk {chunk}");
+            assert_eq!(r.pixels, whole.pixels, "chunk {chunk}");
+            assert_eq!(r.stats, whole.stats, "chunk {chunk}");
+            assert_eq!(r.counters, whole.counters, "chunk {chunk}");
+        }
+        let r = render(&inp.scene, e.as_ref(), size, None);
+        assert!(r.corners.is_empty());
+        assert_eq!(r.pixels, whole.pixels);
+    }
+
+    /// A recording holds every query once, whatever the chunks.
+    #[test]
+    fn chunked_recording_holds_every_query() {
+        let inp = input(Program::Tetra, 2);
+        let e = build_engine("bvh4", &inp, vec![]).unwrap();
+        let mut rec = Recording::default();
+        let r = render_chunked(&inp.scene, e.as_ref(), 24, 50, false, Some(&mut rec));
+        assert_eq!(rec.closest.len() as u64, r.stats.total - r.stats.shadow);
+        assert_eq!(rec.any.len() as u64, r.stats.shadow);
+        assert_eq!(rec.closest_corner.len(), rec.closest.len());
+        assert_eq!(rec.any_corner.len(), rec.any.len());
     }
 }
