@@ -4,61 +4,12 @@
 
 mod common;
 
-use common::{expect_input_error, rtbench};
+use common::{expect_input_error, json, render_breadth_first, rtbench, Dir};
 use serde_json::Value;
-use std::path::PathBuf;
-
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(tag: &str) -> Dir {
-        let d = std::env::temp_dir().join(format!("rtbench-bh-cli-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Dir(d)
-    }
-    fn join(&self, p: &str) -> String {
-        self.0.join(p).to_str().unwrap().to_string()
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = rtbench(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
-fn render(store: &str, sets: &[&str]) -> Value {
-    let mut args = vec![
-        "render",
-        "--scene",
-        store,
-        "--engine",
-        "breadth-first",
-        "--size",
-        "48",
-    ];
-    for s in sets {
-        args.push("--set");
-        args.push(s);
-    }
-    args.push("--json");
-    json(&args)
-}
 
 #[test]
 fn hierarchy_renders_the_same_image_and_skips() {
-    let d = Dir::new("render");
+    let d = Dir::new("bh-cli", "render");
     let store = d.join("mount5");
     let s = json(&[
         "scene",
@@ -72,8 +23,8 @@ fn hierarchy_renders_the_same_image_and_skips() {
         "--json",
     ]);
     assert!(!s["hierarchy_levels"].as_array().unwrap().is_empty());
-    let sg = render(&store, &["memory=2MiB"]);
-    let sgb = render(&store, &["memory=2MiB", "hierarchy=on", "cache=cold"]);
+    let sg = render_breadth_first(&store, &["memory=2MiB"]);
+    let sgb = render_breadth_first(&store, &["memory=2MiB", "hierarchy=on", "cache=cold"]);
     let in_memory = json(&[
         "render",
         "--scene",
@@ -96,14 +47,14 @@ fn hierarchy_renders_the_same_image_and_skips() {
         "built by scene store"
     );
     // Other constants: rebuilt at preprocessing, same image.
-    let other = render(&store, &["memory=2MiB", "hierarchy=on", "bh_s=1.5"]);
+    let other = render_breadth_first(&store, &["memory=2MiB", "hierarchy=on", "bh_s=1.5"]);
     assert!(other["build_stats"]["bh_build_s"].as_f64().unwrap() > 0.0);
     assert_eq!(other["image"]["sha256"], sg["image"]["sha256"]);
 }
 
 #[test]
 fn a_damaged_hierarchy_exits_2() {
-    let d = Dir::new("bad");
+    let d = Dir::new("bh-cli", "bad");
     let store = d.join("tetra4");
     json(&[
         "scene",
@@ -189,7 +140,7 @@ fn a_damaged_hierarchy_exits_2() {
 
 #[test]
 fn nakamaru_4_1_one_tiny_row() {
-    let d = Dir::new("repro");
+    let d = Dir::new("bh-cli", "repro");
     let out = d.join("out");
     let r = rtbench(&[
         "reproduce",

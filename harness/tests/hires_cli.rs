@@ -4,66 +4,18 @@
 
 mod common;
 
-use common::{expect_input_error, rtbench};
+use common::{expect_input_error, json, render_breadth_first, rtbench, Dir};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(tag: &str) -> Dir {
-        let d = std::env::temp_dir().join(format!("rtbench-hr-cli-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Dir(d)
-    }
-    fn join(&self, p: &str) -> String {
-        self.0.join(p).to_str().unwrap().to_string()
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = rtbench(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
-fn render(store: &str, sets: &[&str]) -> Value {
-    let mut args = vec![
-        "render",
-        "--scene",
-        store,
-        "--engine",
-        "breadth-first",
-        "--size",
-        "48",
-    ];
-    for s in sets {
-        args.push("--set");
-        args.push(s);
-    }
-    args.push("--json");
-    json(&args)
-}
+use std::path::Path;
 
 #[test]
 fn every_grid_renders_the_same_image_and_a_truncated_grid_exits_2() {
-    let d = Dir::new("img");
+    let d = Dir::new("hr-cli", "img");
     let store = d.join("mount5");
     json(&[
         "scene", "store", "mount", "--sf", "5", "-o", &store, "--json",
     ]);
-    let base = render(&store, &[]);
+    let base = render_breadth_first(&store, &[]);
     let sha = &base["image"]["sha256"];
     for sets in [
         vec!["grid=single", "cap=8"],
@@ -76,7 +28,7 @@ fn every_grid_renders_the_same_image_and_a_truncated_grid_exits_2() {
             "hierarchy=on",
         ],
     ] {
-        let v = render(&store, &sets);
+        let v = render_breadth_first(&store, &sets);
         assert_eq!(&v["image"]["sha256"], sha, "{sets:?}");
         if sets[0] == "grid=two-level" {
             assert!(v["counters"]["extra"]["hr_blocks_read"].as_u64().unwrap() > 0);
@@ -106,14 +58,14 @@ fn every_grid_renders_the_same_image_and_a_truncated_grid_exits_2() {
     expect_input_error(&args, "truncated");
     assert!(!Path::new(&store).join("hrgrid.bin.tmp").exists());
     // Rebuilt (the default), it renders again.
-    let v = render(&store, &["grid=two-level", "upper=4", "lower=4"]);
+    let v = render_breadth_first(&store, &["grid=two-level", "upper=4", "lower=4"]);
     assert_eq!(&v["image"]["sha256"], sha);
     assert_eq!(std::fs::read(&grid).unwrap(), good);
 }
 
 #[test]
 fn nakamaru_4_2_and_fig4_4_on_tiny_rows() {
-    let d = Dir::new("repro");
+    let d = Dir::new("hr-cli", "repro");
     let out = d.join("out");
     for (id, sets) in [
         (

@@ -4,45 +4,12 @@
 
 mod common;
 
-use common::{expect_input_error, rtbench};
+use common::{expect_input_error, json, rtbench, Dir};
 use serde_json::Value;
-use std::path::PathBuf;
-
-/// A fresh directory for one test, removed at the end.
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(tag: &str) -> Dir {
-        let d =
-            std::env::temp_dir().join(format!("rtbench-store-cli-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Dir(d)
-    }
-    fn join(&self, p: &str) -> String {
-        self.0.join(p).to_str().unwrap().to_string()
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = rtbench(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
 
 #[test]
 fn a_store_renders_out_of_core_as_embree_renders_in_memory() {
-    let d = Dir::new("render");
+    let d = Dir::new("store-cli", "render");
     let store = d.join("rings2");
     let s = json(&[
         "scene", "store", "rings", "--sf", "2", "-o", &store, "--json",
@@ -86,7 +53,7 @@ fn a_store_renders_out_of_core_as_embree_renders_in_memory() {
 
 #[test]
 fn bad_stores_engines_and_spill_directories_exit_2() {
-    let d = Dir::new("errors");
+    let d = Dir::new("store-cli", "errors");
     let store = d.join("tetra1");
     json(&[
         "scene", "store", "tetra", "--sf", "1", "-o", &store, "--json",
@@ -168,7 +135,7 @@ fn bad_stores_engines_and_spill_directories_exit_2() {
 /// `lazy=on` with the basic layout, is refused (exit 2, one line).
 #[test]
 fn basic_and_split_layouts_render_the_same_image() {
-    let d = Dir::new("layouts");
+    let d = Dir::new("store-cli", "layouts");
     let (split, basic) = (d.join("split"), d.join("basic"));
     json(&[
         "scene", "store", "rings", "--sf", "2", "-o", &split, "--json",
@@ -262,7 +229,7 @@ fn basic_and_split_layouts_render_the_same_image() {
 /// corrupted compressed store, and compression with the split layout, exit 2 in one line.
 #[test]
 fn compressed_stores_render_the_plain_image_and_refuse_damage() {
-    let d = Dir::new("gzip");
+    let d = Dir::new("store-cli", "gzip");
     let (plain, gz) = (d.join("plain"), d.join("gz"));
     let p = json(&[
         "scene", "store", "mount", "--sf", "3", "-o", &plain, "--layout", "basic", "--json",

@@ -12,7 +12,7 @@
 use rtbench_engines::geometry::Geometry;
 use rtbench_engines::store::{
     BboxReader, GeometryReader, ObjectRecord, StoreHeader, StoreWriter, BBOX_FILE, GEOMETRY_FILE,
-    HEADER_FILE,
+    HEADER_FILE, MATERIALS_FILE,
 };
 use rtbench_scenes::{nff, SceneCollector};
 use std::panic::AssertUnwindSafe;
@@ -186,7 +186,7 @@ pub fn seeds(target: Target, corpus: &Path, work: &Path) -> Vec<Vec<(String, Vec
                     .and_then(|w| w.write_scene(&c.scene))
                     .expect("seed store");
                 out.push(
-                    [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE]
+                    [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE, MATERIALS_FILE]
                         .iter()
                         .map(|n| (n.to_string(), std::fs::read(dir.join(n)).unwrap()))
                         .collect(),
@@ -257,6 +257,17 @@ pub fn run(target: Target, n: u64, seed: u64, corpus: &Path) -> Outcome {
     std::fs::create_dir_all(&work).expect("fuzz work dir");
     let seeds = seeds(target, corpus, &work);
     assert!(!seeds.is_empty(), "no seeds for {}", target.name());
+    if target == Target::Store {
+        // Every seed store reads as written: otherwise no mutation could be told from the seed.
+        for files in &seeds {
+            for (name, bytes) in files {
+                std::fs::write(work.join(name), bytes).expect("fuzz dir is writable");
+            }
+            if let Err(e) = read_store(&work) {
+                panic!("a seed store does not read: {e}");
+            }
+        }
+    }
     let mut rng = Rng::new(seed);
     let mut o = Outcome::default();
     let start = Instant::now();
@@ -265,7 +276,7 @@ pub fn run(target: Target, n: u64, seed: u64, corpus: &Path) -> Outcome {
     std::panic::set_hook(Box::new(|_| {}));
     for _ in 0..n {
         let s = &seeds[rng.below(seeds.len())];
-        // Store inputs: one file of the three mutated (so that the others stay plausible).
+        // Store inputs: one file of the four mutated (so that the others stay plausible).
         let mut files = s.clone();
         let which = rng.below(files.len());
         files[which].1 = mutate(&files[which].1, &mut rng);

@@ -27,9 +27,12 @@ fn mutated_inputs_never_panic_nor_hang() {
             "{}: a changed store was read as good",
             t.name()
         );
-        // Both answers occur: the mutations reach past the first check.
+        // Both answers occur: the mutations reach past the first check. A store changed in any
+        // byte must be refused (checksums), so only a mutation that left its file as it was can
+        // be accepted, which may not happen in 400 draws; `run` checks that every seed store
+        // reads before mutating it.
         assert!(
-            o.accepted > 0 && o.accepted < n,
+            (o.accepted > 0 || t == Target::Store) && o.accepted < n,
             "{}: {} accepted",
             t.name(),
             o.accepted

@@ -284,7 +284,15 @@ pub fn time_verdict(
     alpha: f64,
     min_change_pct: f64,
 ) -> Option<TimeVerdict> {
-    time_verdict_over(tonight, None, tonight_samples, rounds, nights, alpha, min_change_pct)
+    time_verdict_over(
+        tonight,
+        None,
+        tonight_samples,
+        rounds,
+        nights,
+        alpha,
+        min_change_pct,
+    )
 }
 
 /// The first-night threshold of a two-night rule: a suspect at `√α`, so that a change must
@@ -323,16 +331,15 @@ pub fn time_verdict_over(
         let score = d / (single.spread * (0.5 + 1.0 / k).sqrt());
         let threshold = t_quantile(1.0 - alpha, k - 1.0);
         let change_pct = (d.exp() - 1.0) * 100.0;
-        let direction = if single.direction == 1
-            && score > threshold
-            && change_pct >= min_change_pct
-        {
-            1
-        } else if single.direction == -1 && score < -threshold && change_pct <= -min_change_pct {
-            -1
-        } else {
-            0
-        };
+        let direction =
+            if single.direction == 1 && score > threshold && change_pct >= min_change_pct {
+                1
+            } else if single.direction == -1 && score < -threshold && change_pct <= -min_change_pct
+            {
+                -1
+            } else {
+                0
+            };
         return Some(TimeVerdict {
             direction,
             change_pct,

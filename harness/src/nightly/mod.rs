@@ -1011,7 +1011,11 @@ mod tests {
         let f2 = compare(&two, &slow, &with_suspect, &suspects_of(&f));
         assert_eq!(f2.len(), 1, "{f2:?}");
         assert_eq!(f2[0].verdict, "regression", "{}", f2[0].message);
-        assert!(f2[0].message.contains("the night before"), "{}", f2[0].message);
+        assert!(
+            f2[0].message.contains("the night before"),
+            "{}",
+            f2[0].message
+        );
         // A suspect night followed by an ordinary one is nothing.
         assert!(compare(&two, &[ratio(1.0)], &with_suspect, &suspects_of(&f)).is_empty());
     }

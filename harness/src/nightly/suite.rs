@@ -464,6 +464,9 @@ gate = ["counters", "time_ratio"]
         );
         std::fs::remove_file(&lib).unwrap();
         let e = err(&GOOD.replace("\"bvh4:simd=off\"", "\"plugin:/no/such/lib.so\""));
-        assert!(e.starts_with("s.toml: ") && e.contains("no such file"), "{e}");
+        assert!(
+            e.starts_with("s.toml: ") && e.contains("no such file"),
+            "{e}"
+        );
     }
 }

@@ -1,4 +1,5 @@
-//! Helpers shared by the CLI tests.
+//! Helpers shared by the CLI tests (each test binary uses some of them).
+#![allow(dead_code)]
 
 use std::process::{Command, Output};
 
@@ -32,4 +33,56 @@ pub fn expect_input_error(args: &[&str], needle: &str) {
     );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
     assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout");
+}
+
+/// A scratch directory under the system's temp dir, removed when dropped.
+pub struct Dir(pub std::path::PathBuf);
+
+impl Dir {
+    /// `rtbench-{suite}-{tag}-{pid}`, emptied first.
+    pub fn new(suite: &str, tag: &str) -> Dir {
+        let d = std::env::temp_dir().join(format!("rtbench-{suite}-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Dir(d)
+    }
+    pub fn join(&self, p: &str) -> String {
+        self.0.join(p).to_str().unwrap().to_string()
+    }
+}
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs rtbench, which must succeed, and parses its stdout as JSON.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let out = rtbench(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `render --scene STORE --engine breadth-first --size 48 --set S… --json`.
+pub fn render_breadth_first(store: &str, sets: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "render",
+        "--scene",
+        store,
+        "--engine",
+        "breadth-first",
+        "--size",
+        "48",
+    ];
+    for s in sets {
+        args.push("--set");
+        args.push(s);
+    }
+    args.push("--json");
+    json(&args)
 }
