@@ -272,29 +272,6 @@ pub struct TimeVerdict {
     pub weakest_round_pct: f64,
 }
 
-/// Tonight's value, samples and round medians against the baseline nights' values and samples.
-/// `None` when the baseline has fewer than 3 nights. `alpha` is this metric's share of the
-/// false-alarm budget. (One night; the nightly comparison calls [`time_verdict_over`].)
-#[cfg(test)]
-pub fn time_verdict(
-    tonight: f64,
-    tonight_samples: &[f64],
-    rounds: &[f64],
-    nights: &[(f64, Vec<f64>)],
-    alpha: f64,
-    min_change_pct: f64,
-) -> Option<TimeVerdict> {
-    time_verdict_over(
-        tonight,
-        None,
-        tonight_samples,
-        rounds,
-        nights,
-        alpha,
-        min_change_pct,
-    )
-}
-
 /// The first-night threshold of a two-night rule: a suspect at `√α`, so that a change must
 /// stand out on each night at `√α` and on the two nights' mean at `α` (below). Independent
 /// nights under no change pass both at a rate of at most `α`: the mean test alone bounds it.
@@ -302,7 +279,9 @@ pub fn suspect_alpha(alpha: f64) -> f64 {
     alpha.sqrt()
 }
 
-/// As [`time_verdict`], over two nights when `previous` (the suspect night's value, left out of
+/// Tonight's value, samples and round medians against the baseline nights' values and samples
+/// (`None` when the baseline has fewer than 3 nights; `alpha` is this metric's share of the
+/// false-alarm budget); over two nights when `previous` (the suspect night's value, left out of
 /// `nights`) is given: the centre of tonight's and the previous night's log values is tested
 /// against the baseline with the prediction width of a mean of two, `s·√(1/2 + 1/K)`, and the
 /// change must also stand out tonight alone at [`suspect_alpha`]. The change reported is the
@@ -462,15 +441,15 @@ mod tests {
             .map(|&v| (v, vec![v * 0.99, v, v * 1.01]))
             .collect();
         let slow = [1.07, 1.08, 1.09];
-        let v = time_verdict(1.08, &slow, &slow, &nights, 0.001, 1.0).unwrap();
+        let v = time_verdict_over(1.08, None, &slow, &slow, &nights, 0.001, 1.0).unwrap();
         assert_eq!(v.direction, 1, "{v:?}");
         let same = [0.995, 1.005, 1.01];
-        let v = time_verdict(1.005, &same, &same, &nights, 0.001, 1.0).unwrap();
+        let v = time_verdict_over(1.005, None, &same, &same, &nights, 0.001, 1.0).unwrap();
         assert_eq!(v.direction, 0, "{v:?}");
         let fast = [0.89, 0.9, 0.91];
-        let v = time_verdict(0.9, &fast, &fast, &nights, 0.001, 1.0).unwrap();
+        let v = time_verdict_over(0.9, None, &fast, &fast, &nights, 0.001, 1.0).unwrap();
         assert_eq!(v.direction, -1, "{v:?}");
-        assert!(time_verdict(1.0, &[1.0], &[1.0], &nights[..2], 0.001, 1.0).is_none());
+        assert!(time_verdict_over(1.0, None, &[1.0], &[1.0], &nights[..2], 0.001, 1.0).is_none());
     }
 
     #[test]
@@ -483,11 +462,11 @@ mod tests {
         // process did not see the change, so it was the others' luck, not the code.
         let samples = [1.08, 1.08, 1.09, 1.0, 1.0, 1.01, 1.07, 1.08, 1.08];
         let rounds = [1.08, 1.0, 1.08];
-        let v = time_verdict(1.08, &samples, &rounds, &nights, 0.001, 1.0).unwrap();
+        let v = time_verdict_over(1.08, None, &samples, &rounds, &nights, 0.001, 1.0).unwrap();
         assert_eq!(v.direction, 0, "{v:?}");
         assert!(v.weakest_round_pct.abs() < 1.0, "{v:?}");
         let rounds = [1.08, 1.07, 1.08];
-        let v = time_verdict(1.08, &samples, &rounds, &nights, 0.001, 1.0).unwrap();
+        let v = time_verdict_over(1.08, None, &samples, &rounds, &nights, 0.001, 1.0).unwrap();
         assert_eq!(v.direction, 1, "{v:?}");
     }
 }

@@ -81,7 +81,8 @@ mod tests {
         assert_eq!(r.load::<Vec<u32>>("b").unwrap(), None);
         std::fs::write(out.join(".partial/t/bad.json"), "{").unwrap();
         assert!(r.load::<Vec<u32>>("bad").is_err());
-        let fresh = Checkpoint::open(&out, "t", false).unwrap();
+        // Opened without --resume, the steps of an earlier run are cleared.
+        Checkpoint::open(&out, "t", false).unwrap();
         assert!(!out.join(".partial/t/a.json").exists());
         let _ = std::fs::remove_dir_all(&out);
     }
