@@ -42,9 +42,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         return Err(input(f));
     }
     let pixels = r.pixels();
-    let sha = hex(&Sha256::digest(&pixels));
+    let sha = hex(&Sha256::digest(pixels));
     if let Some(png) = &a.png {
-        write_png(png, &pixels, a.size)?;
+        write_png(png, pixels, a.size)?;
     }
     let scene = &prepared.input.scene;
     let g = &prepared.input.geometry;
@@ -211,9 +211,9 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
     }
     let r = &ooc.render;
     let pixels = r.pixels();
-    let sha = hex(&Sha256::digest(&pixels));
+    let sha = hex(&Sha256::digest(pixels));
     if let Some(png) = &a.png {
-        write_png(png, &pixels, a.size)?;
+        write_png(png, pixels, a.size)?;
     }
     let h = engine.header();
     let v = json!({

@@ -222,7 +222,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         build_stats: engine.build_stats(),
         check,
         paired_ratio,
-        image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(&pixels))),
+        image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(pixels))),
         wall_s: start.elapsed().as_secs_f64(),
         finished_at: super::env::now_utc(),
         machine: None,

@@ -219,7 +219,7 @@ pub fn cross_check(
         agree,
         t_rel_err: ErrorQuantiles::of(t_err),
         t_rel_err_raw: ErrorQuantiles::of(t_err_raw),
-        image_psnr_db: psnr(&pw, &pg),
+        image_psnr_db: psnr(pw, pg),
         mismatches,
     }
 }
