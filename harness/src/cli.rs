@@ -330,8 +330,9 @@ pub enum SceneCommand {
         /// (box, object) records, Ch.3); the breadth-first engine's `layout` must match.
         #[arg(long, default_value = "split")]
         layout: String,
-        /// `none`, or `gzip` / `gzip:LEVEL` (1-9, default 6 as gzip's): objects.bin.gz, read
-        /// through the codec (seed 000 Table 3.3; `--layout basic` only).
+        /// `none`, `gzip` / `gzip:LEVEL` (1-9, default 6 as gzip's): objects.bin.gz, or `zstd` /
+        /// `zstd:LEVEL` (1-19, default 3): objects.bin.zst, read through the codec (seed 000
+        /// Table 3.3 used gzip; `--layout basic` only).
         #[arg(long, default_value = "none")]
         compress: String,
         /// Also build the bounding-box hierarchy (bbox-K.bin, hierarchy.json; seed 000 §4.2.2

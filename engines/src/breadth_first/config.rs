@@ -267,7 +267,8 @@ impl BreadthFirstConfig {
             "none" => Codec::None,
             // Fast: spill files are written and read once.
             "gzip" => Codec::Gzip(1),
-            v => return Err(bad("spill_codec", v, "none or gzip")),
+            "zstd" => Codec::Zstd(1),
+            v => return Err(bad("spill_codec", v, "none, gzip or zstd")),
         };
         let secondary = on_off(&mut s, "secondary")?;
         let hierarchy: String = s.get("hierarchy", "off".to_string())?;

@@ -32,8 +32,11 @@
 //! A basic store may be gzip-compressed (seed 000 §3.4, Table 3.3): `objects.bin.gz` holds the
 //! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
 //! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
-//! offsets). The compressed file's header carries no checksum of `header.json` (it is written
-//! before the header is known); gzip's own CRC-32 and the records' checksums guard its bytes.
+//! offsets). Or zstd-compressed: `objects.bin.zst`, `"compression": "zstd"` (zstd is offered
+//! beside the thesis's gzip: it compresses several times faster, docs/benchmarks.md issue 15).
+//! The compressed file's header carries no checksum of `header.json` (it is written before the
+//! header is known); the codec's own checksum (gzip's CRC-32; zstd's frame checksum) and the
+//! records' checksums guard its bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
 //! A split store may carry a bounding-box hierarchy (`bbox-K.bin`, `hierarchy.json`; seed 000
@@ -120,6 +123,8 @@ pub const HEADER_FILE: &str = "header.json";
 pub const OBJECTS_FILE: &str = "objects.bin";
 /// `objects.bin` gzip-compressed (basic layout only: it is read strictly forward, §3.4).
 pub const OBJECTS_FILE_GZ: &str = "objects.bin.gz";
+/// `objects.bin` zstd-compressed (the same, beside the thesis's gzip).
+pub const OBJECTS_FILE_ZST: &str = "objects.bin.zst";
 pub const BBOX_FILE: &str = "bbox.bin";
 pub const GEOMETRY_FILE: &str = "geometry.bin";
 pub const MATERIALS_FILE: &str = "materials.bin";

@@ -6,7 +6,7 @@ use super::write::bbox_checksum;
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, BBOX_RECORD, FILE_HEADER, GEOMETRY_FILE,
     GEOMETRY_MAGIC, HEADER_FILE, MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS,
-    MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_MAGIC, VERSION,
+    MIN_GEOMETRY_RECORD, OBJECTS_FILE, OBJECTS_FILE_GZ, OBJECTS_FILE_ZST, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::Prim;
 use glam::{DVec3, Vec3};
@@ -151,17 +151,22 @@ impl StoreHeader {
         };
         let codec = match (v["compression"].as_str(), layout) {
             (None, _) if v["compression"].is_null() => Codec::None,
-            (Some("gzip"), Layout::Basic) => Codec::Gzip(6),
+            (Some(name), Layout::Basic) if Codec::from_header(name).is_some() => {
+                Codec::from_header(name).unwrap_or_default()
+            }
             _ => {
                 return Err(bad(
                     dir,
-                    format!("compression {} (gzip, basic layout only)", v["compression"]),
+                    format!(
+                        "compression {} (gzip or zstd, basic layout only)",
+                        v["compression"]
+                    ),
                 ))
             }
         };
         let stored_bytes = match codec {
             Codec::None => geometry_bytes,
-            Codec::Gzip(_) => count("stored_bytes")?,
+            Codec::Gzip(_) | Codec::Zstd(_) => count("stored_bytes")?,
         };
         let h = StoreHeader {
             dir: dir.to_path_buf(),
@@ -221,7 +226,7 @@ impl StoreHeader {
                 (GEOMETRY_FILE, self.geometry_bytes),
             ],
             Layout::Basic if self.codec == Codec::None => &[(OBJECTS_FILE, self.geometry_bytes)],
-            Layout::Basic => &[(OBJECTS_FILE_GZ, self.stored_bytes)],
+            Layout::Basic => &[(self.codec.objects_file(), self.stored_bytes)],
         };
         let compressed = self.codec != Codec::None;
         for &(name, want) in files {
@@ -345,6 +350,7 @@ fn data_file_version(dir: &Path) -> Option<u32> {
         (BBOX_FILE, Codec::None),
         (OBJECTS_FILE, Codec::None),
         (OBJECTS_FILE_GZ, Codec::Gzip(6)),
+        (OBJECTS_FILE_ZST, Codec::Zstd(3)),
     ];
     for (name, codec) in files {
         let path = dir.join(name);
@@ -441,8 +447,11 @@ fn read_bounded(path: &Path, max: u64) -> io::Result<String> {
 
 fn check_file_header(f: &mut IoFile, magic: &[u8; 8], path: &Path) -> io::Result<()> {
     let mut h = [0u8; FILE_HEADER as usize];
-    f.read_exact(&mut h)
-        .map_err(|_| bad(path, "file shorter than its header"))?;
+    f.read_exact(&mut h).map_err(|e| match e.kind() {
+        io::ErrorKind::UnexpectedEof => bad(path, "file shorter than its header"),
+        // A compressed file whose stream is damaged before the first record.
+        _ => bad(path, format!("unreadable header: {e}")),
+    })?;
     if &h[..8] != magic {
         return Err(bad(path, "wrong magic"));
     }
@@ -646,10 +655,7 @@ impl BasicReader {
         codec: Codec,
         size: u64,
     ) -> io::Result<BasicReader> {
-        let path = dir.join(match codec {
-            Codec::None => OBJECTS_FILE,
-            Codec::Gzip(_) => OBJECTS_FILE_GZ,
-        });
+        let path = dir.join(codec.objects_file());
         let mut file = IoFile::open_codec(&path, buffer, codec)?;
         check_file_header(&mut file, OBJECTS_MAGIC, &path)?;
         Ok(BasicReader {

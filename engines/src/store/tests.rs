@@ -184,24 +184,33 @@ fn a_header_that_disagrees_with_the_files_is_refused() {
     assert!(e.contains("bbox_bytes"), "{e}");
 }
 
-/// A gzip file reads back what was written, through forward seeks (decompress and discard) and
-/// rewinds (the stream again), counting compressed bytes on disk and uncompressed ones through
-/// the codec.
+/// A gzip or zstd file reads back what was written, through forward seeks (decompress and
+/// discard) and rewinds (the stream again), counting compressed bytes on disk and uncompressed
+/// ones through the codec.
 #[test]
 fn gzip_files_seek_forward_and_rewind() {
-    let dir = TempDir::new("gzip-io");
+    compressed_files_seek_forward_and_rewind(Codec::Gzip(6));
+}
+
+#[test]
+fn zstd_files_seek_forward_and_rewind() {
+    compressed_files_seek_forward_and_rewind(Codec::Zstd(3));
+}
+
+fn compressed_files_seek_forward_and_rewind(codec: Codec) {
+    let dir = TempDir::new(&format!("{}-io", codec.name()));
     std::fs::create_dir_all(&dir.0).unwrap();
-    let path = dir.0.join("x.gz");
+    let path = dir.0.join("x.z");
     let data: Vec<u8> = (0..200_000u32)
         .flat_map(|i| (i % 251).to_le_bytes())
         .collect();
-    let mut w = IoFile::create_codec(&path, 4096, Codec::Gzip(6)).unwrap();
+    let mut w = IoFile::create_codec(&path, 4096, codec).unwrap();
     w.write_all(&data).unwrap();
     let wio = w.finish().unwrap();
     assert_eq!(wio.codec_bytes, data.len() as u64);
     assert_eq!(wio.bytes_written, std::fs::metadata(&path).unwrap().len());
     assert!(wio.bytes_written * 4 < data.len() as u64);
-    let mut r = IoFile::open_codec(&path, 4096, Codec::Gzip(6)).unwrap();
+    let mut r = IoFile::open_codec(&path, 4096, codec).unwrap();
     let mut b = [0u8; 8];
     for at in [0u64, 100, 50_000, 700_000, 12, 799_992] {
         r.seek_to(at).unwrap();
@@ -220,6 +229,15 @@ fn gzip_files_seek_forward_and_rewind() {
 /// corrupted one fails with an error (never a panic).
 #[test]
 fn compressed_basic_store_round_trips_and_refuses_damage() {
+    compressed_store_round_trips_and_refuses_damage(Codec::Gzip(6));
+}
+
+#[test]
+fn zstd_basic_store_round_trips_and_refuses_damage() {
+    compressed_store_round_trips_and_refuses_damage(Codec::Zstd(3));
+}
+
+fn compressed_store_round_trips_and_refuses_damage(codec: Codec) {
     let program = Program::Mount;
     let opts = Options {
         size_factor: 3,
@@ -227,12 +245,12 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
     };
     let scene = generate_scene(program, &opts).unwrap();
     let plain = TempDir::new("basic-plain");
-    let gz = TempDir::new("basic-gz");
+    let gz = TempDir::new(&format!("basic-{}", codec.name()));
     StoreWriter::create_layout(&plain.0, "x", Layout::Basic)
         .unwrap()
         .write_scene(&scene)
         .unwrap();
-    StoreWriter::create_with(&gz.0, "x", Layout::Basic, Codec::Gzip(6))
+    StoreWriter::create_with(&gz.0, "x", Layout::Basic, codec)
         .unwrap()
         .write_scene(&scene)
         .unwrap();
@@ -240,7 +258,7 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
         StoreHeader::read(&plain.0).unwrap(),
         StoreHeader::read(&gz.0).unwrap(),
     );
-    assert_eq!(hg.codec, Codec::Gzip(6));
+    assert_eq!(hg.codec.name(), codec.name());
     assert_eq!(hp.geometry_bytes, hg.geometry_bytes);
     assert!(hg.stored_bytes < hp.stored_bytes);
     assert!(hg.verify().unwrap() < hp.verify().unwrap());
@@ -254,9 +272,9 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
         out
     };
     assert_eq!(read_all(&hp), read_all(&hg));
-    assert!(StoreWriter::create_with(&gz.0.join("s"), "x", Layout::Split, Codec::Gzip(6)).is_err());
+    assert!(StoreWriter::create_with(&gz.0.join("s"), "x", Layout::Split, codec).is_err());
     // Truncated: the size no longer matches the header.
-    let f = gz.0.join(OBJECTS_FILE_GZ);
+    let f = gz.0.join(codec.objects_file());
     let bytes = std::fs::read(&f).unwrap();
     std::fs::write(&f, &bytes[..bytes.len() / 2]).unwrap();
     assert!(StoreHeader::read(&gz.0).is_err());
@@ -264,6 +282,14 @@ fn compressed_basic_store_round_trips_and_refuses_damage() {
     let mut bad = bytes.clone();
     let mid = bad.len() / 2;
     bad[mid] ^= 0xff;
+    std::fs::write(&f, &bad).unwrap();
+    let h = StoreHeader::read(&gz.0).unwrap();
+    assert!(h.verify().is_err());
+    // Damaged in the codec's own trailer (gzip's CRC-32 and length; zstd's frame checksum):
+    // the records all read, and the codec still refuses the stream.
+    let mut bad = bytes.clone();
+    let end = bad.len() - 2;
+    bad[end] ^= 0xff;
     std::fs::write(&f, &bad).unwrap();
     let h = StoreHeader::read(&gz.0).unwrap();
     assert!(h.verify().is_err());

@@ -5,8 +5,8 @@
 use super::io::{Codec, IoCounters, IoFile};
 use super::{
     Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
-    MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS, OBJECTS_FILE, OBJECTS_FILE_GZ,
-    OBJECTS_MAGIC, VERSION,
+    MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS, OBJECTS_FILE, OBJECTS_MAGIC,
+    VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
@@ -114,12 +114,8 @@ impl StoreWriter {
                 (Some(bbox), geometry)
             }
             Layout::Basic => {
-                let mut objects = match codec {
-                    Codec::None => IoFile::create(&dir.join(OBJECTS_FILE), WRITE_BUFFER)?,
-                    Codec::Gzip(_) => {
-                        IoFile::create_codec(&dir.join(OBJECTS_FILE_GZ), WRITE_BUFFER, codec)?
-                    }
-                };
+                let mut objects =
+                    IoFile::create_codec(&dir.join(codec.objects_file()), WRITE_BUFFER, codec)?;
                 objects.write_all(&file_header(OBJECTS_MAGIC, 0))?;
                 (None, objects)
             }

@@ -5,14 +5,17 @@ use crate::output::{print_json, write_atomic};
 use crate::source::Source;
 use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
 
-/// `none`, `gzip` or `gzip:LEVEL` (1–9).
+/// `none`, `gzip`, `gzip:LEVEL` (1–9), `zstd` or `zstd:LEVEL` (1–19).
 pub fn parse_codec(s: &str) -> std::result::Result<Codec, String> {
+    let level = |p: &str| s.strip_prefix(p).map(str::parse::<u32>);
     match s {
         "none" => Ok(Codec::None),
         "gzip" => Ok(Codec::Gzip(6)),
-        _ => match s.strip_prefix("gzip:").map(str::parse::<u32>) {
-            Some(Ok(l)) if (1..=9).contains(&l) => Ok(Codec::Gzip(l)),
-            _ => Err("expected none, gzip or gzip:LEVEL (1-9)".into()),
+        "zstd" => Ok(Codec::Zstd(3)),
+        _ => match (level("gzip:"), level("zstd:")) {
+            (Some(Ok(l)), _) if (1..=9).contains(&l) => Ok(Codec::Gzip(l)),
+            (_, Some(Ok(l))) if (1..=19).contains(&l) => Ok(Codec::Zstd(l as i32)),
+            _ => Err("expected none, gzip, gzip:LEVEL (1-9), zstd or zstd:LEVEL (1-19)".into()),
         },
     }
 }
