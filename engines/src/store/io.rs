@@ -92,6 +92,9 @@ fn counted(f: File) -> Counted<File> {
     }
 }
 
+/// log2 of the zstd window: 128 KiB.
+const ZSTD_WINDOW_LOG: u32 = 17;
+
 type ZstdRead = zstd::stream::read::Decoder<'static, io::BufReader<Counted<File>>>;
 type ZstdWrite = zstd::stream::write::Encoder<'static, Counted<File>>;
 
@@ -200,6 +203,10 @@ impl IoFile {
                 let mut e = ZstdWrite::new(counted(f), level.clamp(1, 19))?;
                 // A frame checksum, as gzip has its CRC-32: a damaged byte is caught at the end.
                 e.include_checksum(true)?;
+                // A 128 KiB window (level 3 would take 2 MiB or more): the reader's decoder holds
+                // one window per open stream, and the engine's memory budget (Table 3.3: 64 MiB
+                // in all) has to hold them; measured in docs/benchmarks.md (issue 15).
+                e.window_log(ZSTD_WINDOW_LOG)?;
                 Backing::ZsWrite(Box::new(e))
             }
         };
