@@ -267,8 +267,9 @@ pub struct ReproduceArgs {
     /// Output folder (DIR/<id>.md, DIR/<id>.json).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Keep the steps earlier runs of this id finished in DIR/.partial/<id>/ (nakamaru-3.3,
-    /// nakamaru-3.2 save them) and measure only the rest; without it they are removed first.
+    /// Keep the steps earlier runs of this id finished in DIR/.partial/<id>/ (nakamaru-3.2, -3.3,
+    /// -4.1, -4.2, -fig4.4 and the yamauchi-* ids save them) and measure only the rest; without
+    /// it they are removed first.
     #[arg(long)]
     pub resume: bool,
     /// Engines, comma-separated (default: every available engine but `reference`).
