@@ -127,6 +127,11 @@ mod x86 {
         tmin_s: [f32; 16],
         tri: [TriRay; 16],
         origin: [glam::Vec3; 16],
+        /// Near and far plane rows per axis when every ray of the packet has the same direction
+        /// signs (eye rays, shadow rays to one light: nearly always); `mixed` otherwise.
+        near_row: [usize; 3],
+        far_row: [usize; 3],
+        mixed: bool,
     }
 
     #[derive(Clone, Copy, Default)]
@@ -163,6 +168,8 @@ mod x86 {
         );
         let mut tri = [blank; 16];
         let mut origin = [glam::Vec3::ZERO; 16];
+        let mut signs: Option<[bool; 3]> = None;
+        let mut mixed = false;
         for (l, ray) in rays.iter().enumerate() {
             if !ray.is_traceable() {
                 continue;
@@ -195,7 +202,14 @@ mod x86 {
             };
             tri[l] = <Sse4 as PacketKernel<PACKET>>::prepare(ray.origin, ray.dir, &wt);
             origin[l] = ray.origin;
+            match signs {
+                None => signs = Some(s.negative),
+                Some(g) => mixed |= g != s.negative,
+            }
         }
+        let g = signs.unwrap_or([false; 3]);
+        let near_row = [0, 1, 2].map(|a| 2 * a + g[a] as usize);
+        let far_row = [0, 1, 2].map(|a| 2 * a + 1 - g[a] as usize);
         let lanes = Lanes {
             rdir: std::array::from_fn(|h| std::array::from_fn(|a| load8(&rdir[a], h))),
             org_near: std::array::from_fn(|h| std::array::from_fn(|a| load8(&org_near[a], h))),
@@ -207,44 +221,67 @@ mod x86 {
             tmin_s,
             tri,
             origin,
+            near_row,
+            far_row,
+            mixed,
         };
         (lanes, active)
     }
 
     /// Child `i`'s box against every lane: the lanes that hit it (within each lane's
-    /// `[tmin, tmax]`) and the nearest entry distance among them. Per lane this is the
-    /// single-ray AVX2 test's arithmetic (`box_test.rs`): the near plane of each axis by the
-    /// lane's direction sign, `plane · rdir − org · rdir` in one `fmsub`.
+    /// `[tmin, tmax]`) and, with `ORDER`, the nearest entry distance among them. Per lane this
+    /// is the single-ray AVX2 test's arithmetic (`box_test.rs`): the near plane of each axis by
+    /// the lane's direction sign, `plane · rdir − org · rdir` in one `fmsub`. `MIXED`: the
+    /// packet's rays differ in sign, and each lane picks its planes with a blend; otherwise the
+    /// rows are picked once for the packet, as the single-ray test does.
     #[inline(always)]
-    unsafe fn child_test<const N: usize, const H: usize>(
+    unsafe fn child_test<const N: usize, const H: usize, const MIXED: bool, const ORDER: bool>(
         node: &super::super::node::WideNode<N>,
         i: usize,
         r: &Lanes<H>,
         active: u32,
     ) -> (u32, f32) {
         let p = &node.planes;
-        let lo = [
-            _mm256_set1_ps(p[0][i]),
-            _mm256_set1_ps(p[2][i]),
-            _mm256_set1_ps(p[4][i]),
-        ];
-        let hi = [
-            _mm256_set1_ps(p[1][i]),
-            _mm256_set1_ps(p[3][i]),
-            _mm256_set1_ps(p[5][i]),
-        ];
+        let (near_b, far_b) = if MIXED {
+            (
+                [
+                    _mm256_set1_ps(p[0][i]),
+                    _mm256_set1_ps(p[2][i]),
+                    _mm256_set1_ps(p[4][i]),
+                ],
+                [
+                    _mm256_set1_ps(p[1][i]),
+                    _mm256_set1_ps(p[3][i]),
+                    _mm256_set1_ps(p[5][i]),
+                ],
+            )
+        } else {
+            (
+                [0, 1, 2].map(|a| _mm256_set1_ps(p[r.near_row[a]][i])),
+                [0, 1, 2].map(|a| _mm256_set1_ps(p[r.far_row[a]][i])),
+            )
+        };
         let mut mask = 0u32;
         let mut nearest = _mm256_set1_ps(f32::INFINITY);
         for h in 0..H {
             if (active >> (8 * h)) & 0xff == 0 {
                 continue;
             }
+            // MIXED: near_b holds the lower planes and far_b the upper ones.
             let near = |a: usize| {
-                let plane = _mm256_blendv_ps(lo[a], hi[a], r.negative[h][a]);
+                let plane = if MIXED {
+                    _mm256_blendv_ps(near_b[a], far_b[a], r.negative[h][a])
+                } else {
+                    near_b[a]
+                };
                 _mm256_fmsub_ps(plane, r.rdir[h][a], r.org_near[h][a])
             };
             let far = |a: usize| {
-                let plane = _mm256_blendv_ps(hi[a], lo[a], r.negative[h][a]);
+                let plane = if MIXED {
+                    _mm256_blendv_ps(far_b[a], near_b[a], r.negative[h][a])
+                } else {
+                    far_b[a]
+                };
                 _mm256_fmsub_ps(plane, r.rdir[h][a], r.org_far[h][a])
             };
             let t_near = _mm256_max_ps(
@@ -258,14 +295,16 @@ mod x86 {
             let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far);
             let m = (_mm256_movemask_ps(hit) as u32) << (8 * h);
             mask |= m;
-            nearest = _mm256_min_ps(
-                nearest,
-                _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t_near, hit),
-            );
+            if ORDER {
+                nearest = _mm256_min_ps(
+                    nearest,
+                    _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t_near, hit),
+                );
+            }
         }
         mask &= active;
-        if mask == 0 {
-            return (0, 0.0);
+        if mask == 0 || !ORDER {
+            return (mask, 0.0);
         }
         // Horizontal minimum (lanes outside `active` only widen it: still a valid order key).
         let m4 = _mm_min_ps(
@@ -296,10 +335,27 @@ mod x86 {
         for h in hits.iter_mut() {
             *h = Hit::MISS;
         }
-        let (mut r, active) = prepare::<N, H, W>(bvh, rays);
+        let (r, active) = prepare::<N, H, W>(bvh, rays);
         if active == 0 {
             return;
         }
+        if r.mixed {
+            closest_lanes::<N, H, W, true>(bvh, rays, hits, stack, c, r, active)
+        } else {
+            closest_lanes::<N, H, W, false>(bvh, rays, hits, stack, c, r, active)
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn closest_lanes<const N: usize, const H: usize, const W: bool, const MIXED: bool>(
+        bvh: &Bvh<N>,
+        rays: &[Ray],
+        hits: &mut [Hit],
+        stack: &mut [Entry; STACK_SIZE],
+        c: &mut Counters,
+        mut r: Lanes<H>,
+        active: u32,
+    ) {
         let mut lanes = LaneHits::default();
         let mut sp = 0usize;
         let mut cur = Entry {
@@ -315,7 +371,7 @@ mod x86 {
                 c.box_tests += n_active * node.len as u64;
                 let base = sp;
                 for i in 0..(node.len as usize).min(N) {
-                    let (mask, dist) = child_test(node, i, &r, cur.mask);
+                    let (mask, dist) = child_test::<N, H, MIXED, true>(node, i, &r, cur.mask);
                     if mask != 0 {
                         stack[sp] = Entry {
                             node: node.child[i],
@@ -453,7 +509,24 @@ mod x86 {
         for o in out.iter_mut() {
             *o = false;
         }
-        let (r, mut active) = prepare::<N, H, W>(bvh, rays);
+        let (r, active) = prepare::<N, H, W>(bvh, rays);
+        if r.mixed {
+            any_lanes::<N, H, W, true>(bvh, rays, out, stack, c, &r, active)
+        } else {
+            any_lanes::<N, H, W, false>(bvh, rays, out, stack, c, &r, active)
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn any_lanes<const N: usize, const H: usize, const W: bool, const MIXED: bool>(
+        bvh: &Bvh<N>,
+        rays: &[Ray],
+        out: &mut [bool],
+        stack: &mut [Entry; STACK_SIZE],
+        c: &mut Counters,
+        r: &Lanes<H>,
+        mut active: u32,
+    ) {
         let mut lanes = LaneHits::default();
         let mut sp = 0usize;
         let mut cur = bvh.root;
@@ -467,7 +540,7 @@ mod x86 {
                     c.nodes_visited += n_active;
                     c.box_tests += n_active * node.len as u64;
                     for i in 0..(node.len as usize).min(N) {
-                        let (m, _) = child_test(node, i, &r, mask);
+                        let (m, _) = child_test::<N, H, MIXED, false>(node, i, r, mask);
                         if m != 0 {
                             stack[sp] = Entry {
                                 node: node.child[i],
