@@ -16,7 +16,15 @@ use rtbench_scenes::spd::{Options, Program};
 use std::sync::Arc;
 use std::time::Instant;
 
-const ENGINES: &[(&str, &str, &[(&str, &str)])] = &[
+/// (label, engine, settings).
+type Setup = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+/// The builds compared.
+const ENGINES: &[Setup] = &[
     ("embree 1 thread", "embree", &[("threads", "1")]),
     ("bvh8 1 thread", "bvh8", &[]),
     ("embree 2 threads", "embree", &[("threads", "2")]),

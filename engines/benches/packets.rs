@@ -25,8 +25,15 @@ use std::time::Instant;
 
 const BATCH: usize = 4096;
 
-/// The engines compared: (label, engine, settings).
-const ENGINES: &[(&str, &str, &[(&str, &str)])] = &[
+/// (label, engine, settings).
+type Setup = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+/// The engines compared.
+const ENGINES: &[Setup] = &[
     ("bvh8 single", "bvh8", &[]),
     ("bvh8 packet8", "bvh8", &[("packet", "8")]),
     ("bvh8 packet16", "bvh8", &[("packet", "16")]),
