@@ -332,6 +332,23 @@ mod tests {
     }
 
     #[test]
+    fn packets_and_build_threads() {
+        let c = parse(8, &[]).unwrap();
+        assert_eq!((c.packet, c.build_threads), (PacketSize::Off, 1));
+        assert_eq!(parse(8, &[("packet", "16")]).unwrap().packet.rays(), 16);
+        assert_eq!(parse(4, &[("packet", "8")]).unwrap().packet.rays(), 8);
+        // Packets test boxes in AVX2 lanes: not for the scalar kernels, nor for bvh2.
+        assert!(parse(4, &[("packet", "8"), ("simd", "off")]).is_err());
+        assert!(parse(2, &[("packet", "8")]).is_err());
+        assert!(parse(8, &[("packet", "4")]).is_err());
+        assert_eq!(
+            parse(8, &[("build_threads", "2")]).unwrap().build_threads,
+            2
+        );
+        assert!(parse(8, &[("build_threads", "0")]).is_err());
+    }
+
+    #[test]
     fn widths_are_001s() {
         for w in [2, 4, 6, 8, 10, 12, 14, 16] {
             assert!(parse(w, &[("builder", "median"), ("wide", "direct")]).is_ok());

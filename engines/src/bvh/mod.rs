@@ -5,7 +5,8 @@
 //! SAH, binned SAH; [`config::Builder`]) → a binary tree collapsed to N-wide
 //! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
 //! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
-//! ([`box_test`], picked at run time by [`dispatch`]). Leaves hold up to `leaf` primitives of
+//! ([`box_test`], picked at run time by [`dispatch`]), or with `packet=8|16` packets of rays in
+//! AVX2 lanes ([`packet`]). Leaves hold up to `leaf` primitives of
 //! the shared [`Geometry`], copied in leaf order: triangles in packets of 4 tested with the
 //! shared SIMD triangle kernel, other primitives tested with the shared scalar kernels
 //! (`Prim::intersect`); see [`leaf`].
