@@ -10,8 +10,10 @@
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
 //! | `precompute` | `on`: the ray's reciprocal direction and origin terms are computed once per ray (001 §1.7, thesis Ch. 4.2.2); `off`: each box test divides by the direction and orders the slabs itself (scalar only, for 001's ablation) | `on` |
-//! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16 (with packets: scenes of triangles only; spheres and cones keep one leaf each and the tree below): a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets when `leaf` is not given, else `leaf` |
-//! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets, else 1 |
+//! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16 (with packets: scenes of triangles only; spheres and cones keep one leaf each and the tree below): a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets and `simd=on` when `leaf` is not given, else `leaf` |
+//! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets and `simd=on`, else 1 |
+//! | `packet` | `off`: one ray at a time; `8`, `16`: packets of 8 or 16 consecutive rays of a batch traverse together, their boxes tested in AVX2 lanes (`packet.rs`; needs `simd=on` and a CPU with AVX2 + FMA, else rays go one at a time and `build_stats.packet_rays` says 1) | `off` |
+//! | `build_threads` | threads of the binned SAH build with Embree's leaf rule (the default tree of triangle scenes; `build_sah::binary_blocks_threads`): the subtrees of the top splits are built on threads of their own; the tree is the same whatever the count | 1 |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound when `max_leaf` is `leaf` (bvh2, `packets=off`, or `leaf` given);
@@ -25,6 +27,7 @@
 //! instructions runs the scalar test (`build_stats.simd_lanes` says which ran).
 
 use super::node::MAX_LEAF_PRIMS;
+use super::packet::PacketSize;
 use super::tree::MAX_WIDTH;
 use crate::engine::{EngineError, Settings};
 use crate::geometry::TriangleTest;
@@ -127,6 +130,10 @@ pub struct Config {
     pub max_leaf: usize,
     /// The SAH counts primitives in blocks of this many (Embree's `sahBlockSize`).
     pub sah_block: usize,
+    /// Rays traced together (`packet.rs`).
+    pub packet: PacketSize,
+    /// Threads of the build (`build_sah::binary_blocks_threads`).
+    pub build_threads: usize,
 }
 
 impl Config {
@@ -156,7 +163,11 @@ impl Config {
         let packets = settings.get("packets", OnOff(width > 2))?.0;
         let split_leaves = settings.get("split_leaves", OnOff(!packets))?.0;
         let precompute = settings.get("precompute", OnOff(true))?.0;
-        let wide_packets = width > 2 && packets;
+        // Embree's leaf rule (`max_leaf`, `sah_block`) assumes a packet of 1-4 triangles costs
+        // one SIMD test; tested lane by lane (`simd=off`) every triangle costs a test, and the
+        // rule's larger leaves cost teapot1 39% more instructions (issue 20, nightly), so the
+        // scalar variant keeps 001's count and leaves of at most `leaf`.
+        let wide_packets = width > 2 && packets && simd;
         // A `leaf` given is the largest leaf, as before `max_leaf` existed (001's leaf=1).
         let max_leaf = settings.get(
             "max_leaf",
@@ -167,7 +178,23 @@ impl Config {
             },
         )?;
         let sah_block = settings.get("sah_block", if wide_packets { 4usize } else { 1 })?;
+        let packet = settings.get("packet", PacketSize::Off)?;
+        let build_threads = settings.get("build_threads", 1usize)?;
         settings.finish()?;
+        if !(1..=64).contains(&build_threads) {
+            return Err(bad(
+                "build_threads",
+                build_threads.to_string(),
+                "must be from 1 to 64",
+            ));
+        }
+        if packet != PacketSize::Off && (!simd || width == 2) {
+            return Err(bad(
+                "packet",
+                format!("{}", packet.rays()),
+                "packets need simd=on and bvh4 or bvh8",
+            ));
+        }
         if (1..=MAX_LEAF_PRIMS).contains(&leaf) && !(leaf..=MAX_LEAF_PRIMS).contains(&max_leaf) {
             return Err(bad(
                 "max_leaf",
@@ -220,6 +247,8 @@ impl Config {
             precompute,
             max_leaf,
             sah_block,
+            packet,
+            build_threads,
         })
     }
 }
@@ -292,11 +321,31 @@ mod tests {
         assert_eq!((c.leaf, c.max_leaf), (1, 1));
         let c = parse(4, &[("packets", "off")]).unwrap();
         assert_eq!((c.max_leaf, c.sah_block), (4, 1));
+        // Lane by lane every triangle is a test: 001's count, leaves of at most `leaf`.
+        let c = parse(4, &[("simd", "off")]).unwrap();
+        assert_eq!((c.leaf, c.max_leaf, c.sah_block), (4, 4, 1));
         assert_eq!(parse(2, &[]).unwrap().max_leaf, 1);
         assert!(parse(8, &[("leaf", "8"), ("max_leaf", "4")]).is_err());
         assert!(parse(8, &[("max_leaf", "17")]).is_err());
         assert!(parse(8, &[("sah_block", "0")]).is_err());
         assert!(parse(8, &[("sah_block", "3")]).is_err());
+    }
+
+    #[test]
+    fn packets_and_build_threads() {
+        let c = parse(8, &[]).unwrap();
+        assert_eq!((c.packet, c.build_threads), (PacketSize::Off, 1));
+        assert_eq!(parse(8, &[("packet", "16")]).unwrap().packet.rays(), 16);
+        assert_eq!(parse(4, &[("packet", "8")]).unwrap().packet.rays(), 8);
+        // Packets test boxes in AVX2 lanes: not for the scalar kernels, nor for bvh2.
+        assert!(parse(4, &[("packet", "8"), ("simd", "off")]).is_err());
+        assert!(parse(2, &[("packet", "8")]).is_err());
+        assert!(parse(8, &[("packet", "4")]).is_err());
+        assert_eq!(
+            parse(8, &[("build_threads", "2")]).unwrap().build_threads,
+            2
+        );
+        assert!(parse(8, &[("build_threads", "0")]).is_err());
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! SAH, binned SAH; [`config::Builder`]) → a binary tree collapsed to N-wide
 //! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
 //! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
-//! ([`box_test`], picked at run time by [`dispatch`]). Leaves hold up to `leaf` primitives of
+//! ([`box_test`], picked at run time by [`dispatch`]), or with `packet=8|16` packets of rays in
+//! AVX2 lanes ([`packet`]). Leaves hold up to `leaf` primitives of
 //! the shared [`Geometry`], copied in leaf order: triangles in packets of 4 tested with the
 //! shared SIMD triangle kernel, other primitives tested with the shared scalar kernels
 //! (`Prim::intersect`); see [`leaf`].
@@ -20,6 +21,7 @@ pub mod config;
 pub mod dispatch;
 pub mod leaf;
 pub mod node;
+pub mod packet;
 pub mod stats;
 pub mod traverse;
 pub mod tree;
@@ -123,9 +125,10 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
         Builder::SahSweep if block_leaves => {
             build_sah::binary_blocks(build_sah::Sweep::new(&prims).with_block(block), &rule)
         }
-        Builder::SahBinned if block_leaves => build_sah::binary_blocks(
+        Builder::SahBinned if block_leaves => build_sah::binary_blocks_threads(
             build_sah::Binned::new(&prims, config.bins).with_block(block),
             &rule,
+            config.build_threads,
         ),
         Builder::Median => build_median::binary(&prims, binary_leaf),
         Builder::SahSweep => build_sah::binary(build_sah::Sweep::new(&prims), binary_leaf),
@@ -265,7 +268,8 @@ fn build_engine<const N: usize>(
     let build_s = start.elapsed().as_secs_f64();
     // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
     let kernels = if config.simd {
-        simd_kernels().unwrap_or_else(dispatch::scalar::<N>)
+        let single = simd_kernels().unwrap_or_else(dispatch::scalar::<N>);
+        packet::kernels::<N>(config.packet).unwrap_or(single)
     } else if !config.precompute {
         dispatch::scalar_per_box::<N>()
     } else {
@@ -276,6 +280,14 @@ fn build_engine<const N: usize>(
     stats.insert("build_s".into(), build_s);
     stats.insert("leaf_size".into(), config.leaf as f64);
     stats.insert("simd_lanes".into(), kernels.lanes as f64);
+    stats.insert(
+        "packet_rays".into(),
+        if kernels.name.contains("packets") {
+            config.packet.rays() as f64
+        } else {
+            1.0
+        },
+    );
     stats.insert("triangle_packets".into(), bvh.packets.len() as f64);
     let mut engine = BvhEngine {
         bvh,

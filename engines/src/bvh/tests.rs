@@ -387,7 +387,9 @@ fn simd_and_scalar_kernels_give_the_same_hits_and_counts() {
     let rays = rays(&inp.geometry, 600, 99);
     for w in [4, 8] {
         let (a, ca) = closest(engine(&inp, w, &[("simd", "on")]).as_ref(), &rays);
-        let (b, cb) = closest(engine(&inp, w, &[("simd", "off")]).as_ref(), &rays);
+        // The same tree: `simd=off` alone keeps leaves of at most 4 (config.rs).
+        let scalar = [("simd", "off"), ("max_leaf", "16"), ("sah_block", "4")];
+        let (b, cb) = closest(engine(&inp, w, &scalar).as_ref(), &rays);
         let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
         assert!(
             same + 2 >= rays.len(),
@@ -470,4 +472,95 @@ fn config_is_reported() {
         (Builder::SahBinned, WideMethod::Collapse)
     );
     assert!(e.structure_bytes() > 0);
+}
+
+/// Packets of 8 and 16 rays (`packet.rs`) give every ray the single-ray traversal's answer: the
+/// same occlusion, and the same hit (object and t bit for bit, apart from exact ties of t),
+/// on triangles (gears, tessellated tree) and on spheres and cones (balls, rings), including a
+/// short last packet and untraceable rays; eye-like coherent rays too.
+#[test]
+fn packets_answer_as_single_rays() {
+    if !crate::geometry::lanes::Avx8::available() {
+        return;
+    }
+    for (program, sf, tess) in [
+        (Program::Gears, 2, None),
+        (Program::Balls, 2, None),
+        (Program::Rings, 1, None),
+        (Program::Tree, 3, Some(2)),
+    ] {
+        let inp = input(program, sf, tess);
+        let mut rs = rays(&inp.geometry, 1003, 11);
+        rs[5] = Ray::new(Vec3::splat(f32::NAN), Vec3::X, 0.0, f32::INFINITY);
+        // Coherent rays: a fan from one point towards the scene's centre.
+        let (lo, hi) = (inp.geometry.bounds_min, inp.geometry.bounds_max);
+        let o = hi + (hi - lo) * 0.7;
+        for i in 0..24 {
+            for j in 0..24 {
+                let t = lo + (hi - lo) * Vec3::new(i as f32 / 23.0, j as f32 / 23.0, 0.5);
+                rs.push(Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY));
+            }
+        }
+        for width in [4, 8] {
+            let single = engine(&inp, width, &[]);
+            let (want, wc) = closest(single.as_ref(), &rs);
+            let want_any = occluded(single.as_ref(), &rs);
+            assert!(
+                want.iter().filter(|h| h.is_hit()).count() > 200,
+                "{program:?}"
+            );
+            for size in ["8", "16"] {
+                let e = engine(&inp, width, &[("packet", size)]);
+                assert_eq!(
+                    stats_of(e.as_ref())["packet_rays"],
+                    size.parse::<f64>().unwrap()
+                );
+                let (got, gc) = closest(e.as_ref(), &rs);
+                let same = got
+                    .iter()
+                    .zip(&want)
+                    .filter(|(a, b)| a.object == b.object && a.t.to_bits() == b.t.to_bits())
+                    .count();
+                let ties = got
+                    .iter()
+                    .zip(&want)
+                    .filter(|(a, b)| a.object != b.object && a.t == b.t)
+                    .count();
+                assert_eq!(
+                    same + ties,
+                    rs.len(),
+                    "{program:?} bvh{width} packet={size}"
+                );
+                assert_eq!(
+                    occluded(e.as_ref(), &rs),
+                    want_any,
+                    "{program:?} bvh{width}"
+                );
+                assert_eq!(gc.rays, wc.rays);
+                // A ray tests a leaf only where its own box test admits it: no more triangle
+                // tests than alone, give or take the order in which leaves shrink tmax.
+                assert!(gc.nodes_visited > 0 && gc.primitive_tests > 0);
+            }
+        }
+    }
+}
+
+/// The two-thread build makes the one-thread build's tree, node for node.
+#[test]
+fn threads_build_the_same_tree() {
+    // gears4: 36,610 triangles, so the top splits (ranges of ≥ 8,192) go to threads.
+    let inp = input(Program::Gears, 4, None);
+    let one = Config::parse(8, Settings::new("bvh8", vec![])).unwrap();
+    let base = build_tree(&inp.geometry, &one);
+    assert!(base.nodes.len() > 1000);
+    for threads in ["2", "3"] {
+        let two = Config::parse(
+            8,
+            Settings::new("bvh8", vec![("build_threads".into(), threads.into())]),
+        )
+        .unwrap();
+        let t = build_tree(&inp.geometry, &two);
+        assert_eq!(t.order, base.order, "{threads} threads");
+        assert_eq!(t.nodes, base.nodes, "{threads} threads");
+    }
 }

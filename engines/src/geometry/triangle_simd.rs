@@ -144,6 +144,11 @@ impl<const K: usize> PacketKernel<K> for Scalar {
     ) -> u32 {
         let mut mask = 0;
         for lane in 0..K {
+            // Padding lanes (NaN vertices) never hit, nor would a triangle with a NaN vertex:
+            // skipped, since testing them lane by lane costs as much as a triangle (issue 20).
+            if p.v[0][0][lane].is_nan() {
+                continue;
+            }
             let [a, b, c] = p.triangle(lane);
             let hit = if W {
                 k::triangle_watertight(r.origin, &r.wt, tmin, tmax, a, b, c)

@@ -54,10 +54,14 @@ impl Box3A {
 /// range is then partitioned in place, which also gives both sides' bounds. Primitive boxes
 /// are kept contiguous (Embree's `PrimRef`), with their indices alongside.
 pub struct Binned {
+    /// The boxes and indices of positions `off..off + boxes.len()` of the primitive order (all
+    /// of it, or the part a [`Binned::fork`] took).
     boxes: Vec<Box3A>,
     ids: Vec<u32>,
+    off: usize,
     nb: usize,
-    bins: Vec<[Bin; 3]>,
+    /// Indexed by a `u8` bin number, so no bounds check is needed in the binning loop.
+    bins: Box<[[Bin; 3]; 256]>,
     right_area: Vec<f32>,
     right_count: Vec<usize>,
     /// The SAH counts primitives in blocks of this many ([`super::blocks`]; 1: one by one).
@@ -90,8 +94,9 @@ impl Binned {
                 })
                 .collect(),
             ids: (0..prims.len() as u32).collect(),
+            off: 0,
             nb,
-            bins: vec![[Bin::EMPTY; 3]; nb],
+            bins: Box::new([[Bin::EMPTY; 3]; 256]),
             right_area: vec![0.0; nb],
             right_count: vec![0; nb],
             block: 1,
@@ -106,10 +111,38 @@ impl Binned {
         self
     }
 
+    /// Takes positions `mid..` of the order out into a splitter of their own, so that a range
+    /// on each side can be split on its own thread ([`super::binary::binary_blocks_threads`]);
+    /// [`Binned::join`] puts them back.
+    pub fn fork(&mut self, mid: usize) -> Binned {
+        let at = mid - self.off;
+        Binned {
+            boxes: self.boxes.split_off(at),
+            ids: self.ids.split_off(at),
+            off: mid,
+            nb: self.nb,
+            bins: Box::new([[Bin::EMPTY; 3]; 256]),
+            right_area: vec![0.0; self.nb],
+            right_count: vec![0; self.nb],
+            block: self.block,
+        }
+    }
+
+    /// Puts back the positions a [`Binned::fork`] of this splitter took.
+    pub fn join(&mut self, mut tail: Binned) {
+        assert_eq!(
+            tail.off,
+            self.off + self.boxes.len(),
+            "join: not this splitter's tail"
+        );
+        self.boxes.append(&mut tail.boxes);
+        self.ids.append(&mut tail.ids);
+    }
+
     fn range(&self, start: usize, end: usize) -> Range {
         let mut bounds = Box3A::EMPTY;
         let mut centroids = Box3A::EMPTY;
-        for p in &self.boxes[start..end] {
+        for p in &self.boxes[start - self.off..end - self.off] {
             bounds.grow(p);
             centroids.grow_point(p.centre());
         }
@@ -124,13 +157,14 @@ impl Binned {
     fn median(&mut self, r: &Range, axis: usize) -> Split {
         let k = r.len() / 2;
         // Select on (centre, index) pairs, then reorder boxes and indices to match.
-        let mut keyed: Vec<(f32, u32, Box3A)> = (r.start..r.end)
+        let start = r.start - self.off;
+        let mut keyed: Vec<(f32, u32, Box3A)> = (start..r.end - self.off)
             .map(|i| (self.boxes[i].centre()[axis], self.ids[i], self.boxes[i]))
             .collect();
         keyed.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         for (i, (_, id, b)) in keyed.into_iter().enumerate() {
-            self.ids[r.start + i] = id;
-            self.boxes[r.start + i] = b;
+            self.ids[start + i] = id;
+            self.boxes[start + i] = b;
         }
         let mid = r.start + k;
         Split {
@@ -144,7 +178,7 @@ impl Binned {
 
 impl Splitter for Binned {
     fn root(&self) -> Range {
-        self.range(0, self.boxes.len())
+        self.range(self.off, self.off + self.boxes.len())
     }
 
     fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
@@ -168,11 +202,13 @@ impl Splitter for Binned {
         );
         let last = UVec3::splat(nb as u32 - 1);
         let bin_of = |c: Vec3A| ((c - cb_lo) * scale).max(Vec3A::ZERO).as_uvec3().min(last);
+        let (start, end) = (r.start - self.off, r.end - self.off);
         self.bins[..nb].fill([Bin::EMPTY; 3]);
-        for p in &self.boxes[r.start..r.end] {
+        for p in &self.boxes[start..end] {
             let k = bin_of(p.centre());
             for a in 0..3 {
-                let bin = &mut self.bins[k[a] as usize][a];
+                // k < nb ≤ 256: the u8 is the bin itself, and indexes the 256 bins unchecked.
+                let bin = &mut self.bins[k[a] as u8 as usize][a];
                 bin.bounds.grow(p);
                 bin.count += 1;
             }
@@ -207,8 +243,8 @@ impl Splitter for Binned {
             return self.median(r, axis.unwrap_or_else(|| cb.largest_axis()));
         };
         // Partition in place, bounding both sides on the way.
-        let boxes = &mut self.boxes[r.start..r.end];
-        let ids = &mut self.ids[r.start..r.end];
+        let boxes = &mut self.boxes[start..end];
+        let ids = &mut self.ids[start..end];
         let (mut i, mut j) = (0, boxes.len());
         let (mut lb, mut lcb, mut rb, mut rcb) =
             (Box3A::EMPTY, Box3A::EMPTY, Box3A::EMPTY, Box3A::EMPTY);
@@ -247,10 +283,11 @@ impl Splitter for Binned {
     }
 
     fn ids(&self, r: &Range) -> &[u32] {
-        &self.ids[r.start..r.end]
+        &self.ids[r.start - self.off..r.end - self.off]
     }
 
     fn into_order(self) -> Vec<u32> {
+        debug_assert_eq!(self.off, 0, "the order of a fork");
         self.ids
     }
 }

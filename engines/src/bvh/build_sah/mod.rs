@@ -16,7 +16,7 @@ pub mod sweep;
 #[cfg(test)]
 mod tests;
 
-pub use binary::{binary, binary_blocks, BlockLeaves};
+pub use binary::{binary, binary_blocks, binary_blocks_threads, BlockLeaves};
 pub use binned::Binned;
 pub use nary::wide_same_axis;
 pub use sweep::Sweep;
