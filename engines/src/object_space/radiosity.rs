@@ -581,88 +581,6 @@ enum Ev {
 
 const NONE: u32 = u32::MAX;
 
-/// An [`Ev`] as the event queue holds it: 16 bytes where the enum takes 24 (its queue entry 24
-/// bytes instead of 32). The radix heap moves every entry a few times on its way to the front,
-/// so the entry's size is the simulation's memory traffic. `x` holds the PE (bits 0-23), the
-/// next PE (24-47, all ones for [`NONE`]), the ray (48-60) and the kind (61-62); PEs are below
-/// 2^24 - 1 (a machine has at most one PE per subspace, and at most 2^24 subspaces:
-/// `config::parse_subspaces`) and a shot has at most [`SHOT_RAYS`] rays.
-#[derive(Clone, Copy)]
-struct Packed {
-    x: u64,
-    shot: u32,
-    seg: u32,
-}
-
-/// Rays of a shot at most: every hemicube pixel's root and its reflections.
-const SHOT_RAYS: usize = HEMICUBE_PIXELS * (MAX_REFLECTIONS as usize + 1);
-const _: () = assert!(SHOT_RAYS < 1 << 13, "a shot's ray index must fit 13 bits");
-const PE_MASK: u64 = (1 << 24) - 1;
-
-impl Packed {
-    fn new(kind: u64, pe: u32, next: u32, ray: u32, shot: u32, seg: u32) -> Packed {
-        let next = if next == NONE { PE_MASK } else { next as u64 };
-        Packed {
-            x: pe as u64 | next << 24 | (ray as u64) << 48 | kind << 61,
-            shot,
-            seg,
-        }
-    }
-}
-
-impl From<Ev> for Packed {
-    fn from(e: Ev) -> Packed {
-        match e {
-            Ev::Pick(pe) => Packed::new(0, pe, 0, 0, 0, 0),
-            Ev::Emit { pe, shot, ray } => Packed::new(1, pe, 0, ray, shot, 0),
-            Ev::Arrive { shot, ray, seg, pe } => Packed::new(2, pe, 0, ray, shot, seg),
-            Ev::Done {
-                shot,
-                ray,
-                seg,
-                pe,
-                next,
-            } => Packed::new(3, pe, next, ray, shot, seg),
-        }
-    }
-}
-
-impl From<Packed> for Ev {
-    fn from(p: Packed) -> Ev {
-        let pe = (p.x & PE_MASK) as u32;
-        let ray = ((p.x >> 48) & ((1 << 13) - 1)) as u32;
-        let (shot, seg) = (p.shot, p.seg);
-        match p.x >> 61 {
-            0 => Ev::Pick(pe),
-            1 => Ev::Emit { pe, shot, ray },
-            2 => Ev::Arrive { shot, ray, seg, pe },
-            _ => {
-                let next = ((p.x >> 24) & PE_MASK) as u32;
-                Ev::Done {
-                    shot,
-                    ray,
-                    seg,
-                    pe,
-                    next: if next as u64 == PE_MASK { NONE } else { next },
-                }
-            }
-        }
-    }
-}
-
-/// The simulation's event queue: [`Ev`]s in time order, kept [`Packed`].
-#[derive(Default)]
-struct Events(RadixHeap<Packed>);
-
-impl Events {
-    fn push(&mut self, t: u64, e: Ev) {
-        self.0.push(t, e.into());
-    }
-    fn pop(&mut self) -> Option<(u64, Ev)> {
-        self.0.pop().map(|(t, p)| (t, p.into()))
-    }
-}
-
 /// The torus's PE coordinates, for routing without divisions per packet.
 struct Router {
     pes: [u32; 3],
@@ -743,11 +661,7 @@ pub fn simulate(
         rp_blocks: rpb as u64,
         ..Default::default()
     };
-    assert!(
-        (pes as u64) < PE_MASK,
-        "a machine of {pes} PEs: at most 2^24 - 2 (one PE per subspace)"
-    );
-    let mut heap = Events::default();
+    let mut heap = RadixHeap::default();
     let mut frgu_idle = vec![false; pes];
     for pe in 0..pes {
         heap.push(0, Ev::Pick(pe as u32));
@@ -781,7 +695,7 @@ pub fn simulate(
             },
         };
         last = t;
-        let mut arrive = |at: u64, e: Ev, heap: &mut Events| {
+        let mut arrive = |at: u64, e: Ev, heap: &mut RadixHeap<Ev>| {
             if at == t {
                 debug_assert!(now.is_none());
                 now = Some(e);
@@ -1012,9 +926,6 @@ fn next_root(shot: &Shot, mut k: u32) -> u32 {
 struct RadixHeap<T> {
     last: u64,
     buckets: Vec<Vec<(u64, T)>>,
-    /// Bit i set when bucket i holds entries: the first non-empty bucket is found with one
-    /// instruction rather than by looking at each.
-    full: u128,
 }
 
 impl<T> Default for RadixHeap<T> {
@@ -1022,7 +933,6 @@ impl<T> Default for RadixHeap<T> {
         RadixHeap {
             last: 0,
             buckets: (0..65).map(|_| Vec::new()).collect(),
-            full: 0,
         }
     }
 }
@@ -1034,35 +944,23 @@ impl<T> RadixHeap<T> {
 
     fn push(&mut self, key: u64, v: T) {
         debug_assert!(key >= self.last);
-        let b = Self::bucket(self.last, key);
-        self.buckets[b].push((key, v));
-        self.full |= 1 << b;
+        self.buckets[Self::bucket(self.last, key)].push((key, v));
     }
 
     fn pop(&mut self) -> Option<(u64, T)> {
-        if self.full & 1 == 0 {
-            if self.full == 0 {
-                return None;
-            }
-            let i = self.full.trailing_zeros() as usize;
+        if self.buckets[0].is_empty() {
+            let i = self.buckets.iter().position(|b| !b.is_empty())?;
             // Every entry of bucket i goes to a lower bucket: its allocation is kept for reuse
             // (taking it would reallocate the buckets on every redistribution).
             let mut b = std::mem::take(&mut self.buckets[i]);
             self.last = b.iter().map(|e| e.0).min()?;
             for (k, v) in b.drain(..) {
-                let j = Self::bucket(self.last, k);
-                self.buckets[j].push((k, v));
-                self.full |= 1 << j;
+                self.buckets[Self::bucket(self.last, k)].push((k, v));
             }
             debug_assert!(self.buckets[i].is_empty());
             self.buckets[i] = b;
-            self.full &= !(1 << i);
         }
-        let e = self.buckets[0].pop();
-        if self.buckets[0].is_empty() {
-            self.full &= !1;
-        }
-        e
+        self.buckets[0].pop()
     }
 }
 
@@ -1070,62 +968,18 @@ impl<T> RadixHeap<T> {
 mod tests {
     use super::*;
 
+    /// The order every simulated clock depends on: time order, and on equal times the last
+    /// pushed first (also across a redistribution of buckets).
     #[test]
-    fn events_survive_packing() {
-        let top = (1u32 << 24) - 2;
-        let ray = SHOT_RAYS as u32 - 1;
-        for e in [
-            Ev::Pick(0),
-            Ev::Pick(top),
-            Ev::Emit {
-                pe: top,
-                shot: u32::MAX,
-                ray,
-            },
-            Ev::Arrive {
-                shot: 7,
-                ray,
-                seg: u32::MAX,
-                pe: 3,
-            },
-            Ev::Done {
-                shot: u32::MAX,
-                ray,
-                seg: 9,
-                pe: top,
-                next: NONE,
-            },
-            Ev::Done {
-                shot: 1,
-                ray: 0,
-                seg: 0,
-                pe: 0,
-                next: top,
-            },
-        ] {
-            assert_eq!(Ev::from(Packed::from(e)), e);
+    fn the_radix_heap_pops_in_time_order_last_pushed_first_on_ties() {
+        let mut q = RadixHeap::default();
+        for (t, v) in [(5u64, 1u32), (3, 2), (5, 3), (9, 4), (3, 5)] {
+            q.push(t, v);
         }
-        assert_eq!(std::mem::size_of::<Packed>(), 16);
-    }
-
-    #[test]
-    fn the_queue_pops_in_time_order_last_pushed_first_on_ties() {
-        let mut q = Events::default();
-        for (t, pe) in [(5u64, 1u32), (3, 2), (5, 3), (9, 4), (3, 5)] {
-            q.push(t, Ev::Pick(pe));
-        }
-        let (t, e) = q.pop().unwrap();
-        assert_eq!((t, e), (3, Ev::Pick(5)));
-        q.push(3, Ev::Pick(6));
-        q.push(4, Ev::Pick(7));
-        let order: Vec<(u64, Ev)> = std::iter::from_fn(|| q.pop()).collect();
-        let pes: Vec<(u64, u32)> = order
-            .into_iter()
-            .map(|(t, e)| match e {
-                Ev::Pick(p) => (t, p),
-                _ => unreachable!(),
-            })
-            .collect();
-        assert_eq!(pes, [(3, 6), (3, 2), (4, 7), (5, 3), (5, 1), (9, 4)]);
+        assert_eq!(q.pop(), Some((3, 5)));
+        q.push(3, 6);
+        q.push(4, 7);
+        let order: Vec<(u64, u32)> = std::iter::from_fn(|| q.pop()).collect();
+        assert_eq!(order, [(3, 6), (3, 2), (4, 7), (5, 3), (5, 1), (9, 4)]);
     }
 }
