@@ -963,3 +963,23 @@ impl<T> RadixHeap<T> {
         self.buckets[0].pop()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The order every simulated clock depends on: time order, and on equal times the last
+    /// pushed first (also across a redistribution of buckets).
+    #[test]
+    fn the_radix_heap_pops_in_time_order_last_pushed_first_on_ties() {
+        let mut q = RadixHeap::default();
+        for (t, v) in [(5u64, 1u32), (3, 2), (5, 3), (9, 4), (3, 5)] {
+            q.push(t, v);
+        }
+        assert_eq!(q.pop(), Some((3, 5)));
+        q.push(3, 6);
+        q.push(4, 7);
+        let order: Vec<(u64, u32)> = std::iter::from_fn(|| q.pop()).collect();
+        assert_eq!(order, [(3, 6), (3, 2), (4, 7), (5, 3), (5, 1), (9, 4)]);
+    }
+}

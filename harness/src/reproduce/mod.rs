@@ -19,6 +19,7 @@ mod writer;
 
 mod engine_timing;
 mod grid_runs;
+mod load_balancing;
 mod object_space_pass;
 
 pub use checkpoint::Checkpoint;

@@ -312,11 +312,10 @@ pub fn run_all(
 }
 
 /// A saved machine's key: everything its run depends on (scene, pass, threshold, image size,
-/// unit costs, the machine and its frame buffer).
+/// unit costs, the machine and its frame buffer). The costs enter as a stable hash of their
+/// `Debug` text ([`stable_hash`]), so that a binary built by any Rust version finds the steps.
 fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    format!("{:?}", t.os.config().costs).hash(&mut h);
+    let costs = stable_hash(format!("{:?}", t.os.config().costs).as_bytes());
     let fb = match fb {
         FrameBuffer::Direct => "direct".to_string(),
         FrameBuffer::Cached { m } => format!("cfbs{m}"),
@@ -328,15 +327,23 @@ fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
         .map(|r| format!("-t{}", r.threshold))
         .unwrap_or_default();
     format!(
-        "{}{threshold}-s{}-c{:016x}-{}d-{}-{}-r{}-{fb}",
+        "{}{threshold}-s{}-f{costs:016x}-{}d-{}-{}-r{}-{fb}",
         t.label,
         t.pass.size,
-        h.finish(),
         m.dims,
         m.allocation.name(),
         m.pes_label(),
         m.rp_blocks
     )
+}
+
+/// 64-bit FNV-1a of `bytes`: fixed by its definition, unlike std's `DefaultHasher` (whose
+/// algorithm may change between Rust versions, which would orphan every saved step). Keys made
+/// with it are marked `-f` where the `DefaultHasher` ones (session 6) were marked `-c`.
+pub fn stable_hash(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
 }
 
 /// [`run_all`] without saving: every machine simulated.
@@ -495,6 +502,14 @@ pub mod tests {
             ..SimResult::default()
         };
         SimRecord::new(&r, t1, blocks, 0.0)
+    }
+
+    #[test]
+    fn the_step_keys_hash_is_fnv1a() {
+        // FNV-1a's published test vectors: the hash cannot drift with the compiler.
+        assert_eq!(stable_hash(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(stable_hash(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(stable_hash(b"foobar"), 0x8594_4171_f739_67e8);
     }
 
     #[test]

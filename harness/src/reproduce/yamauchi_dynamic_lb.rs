@@ -3,12 +3,11 @@
 //! allocation, least-loaded dispatch, on 003's ray-tracing pass over SPD scenes. Speed-up and
 //! efficiency are relative to 1 PE with 1 RP block (003 eqs. 24, 25).
 
-use super::object_space_pass::{self as osp, PassRecord, Published, SimRecord, Traced};
+use super::load_balancing::{self as lb, Measured};
+use super::object_space_pass::{self as osp, Published, SimRecord, Traced};
 use super::published;
-use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Table, Verdict};
 use crate::error::Result;
-use crate::workload;
-use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Allocation;
 use rtbench_reports::plot::{Chart, LegendAt};
 use rtbench_reports::{Document, Table as DocTable};
@@ -18,17 +17,11 @@ use std::collections::BTreeMap;
 const RADIOSITY: &str = "a radiosity figure (Fig. 30-b): judged on the room's radiosity pass; the ray-tracing passes' values are shown, not judged";
 const RAY_TRACING: &str = "a ray-tracing figure (Fig. 35): judged on the ray-tracing passes (room and SPD scenes); the radiosity pass's value is shown, not judged";
 
-pub const TABLE: Table = Table {
-    id: "yamauchi-dynamic-lb",
-    seed: "003",
-    source: "§4.2.2, Figs. 30, 35",
-    about: "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
-    runtime: Runtime {
-        quick: "seconds",
-        full: "minutes",
-    },
-    params: osp::PARAMS,
-    claims: &[
+pub const TABLE: Table = lb::table(
+    "yamauchi-dynamic-lb",
+    "§4.2.2, Figs. 30, 35",
+    "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
+    &[
         Claim {
             key: "gains-stop-near-8",
             fidelity: Fidelity::Substituted,
@@ -56,7 +49,7 @@ pub const TABLE: Table = Table {
         },
     ],
     run,
-};
+);
 
 const PUBLISHED: &str = include_str!("../../../data/published/yamauchi-dynamic-lb.json");
 
@@ -72,14 +65,7 @@ struct Run {
     rp_blocks: u32,
 }
 
-#[derive(Serialize)]
-struct Measured {
-    pass: PassRecord,
-    t1_clocks: u64,
-    runs: Vec<Run>,
-}
-
-impl Measured {
+impl Measured<Run> {
     /// Speed-up T(1, 1) / T(PEs, R), if run.
     fn speed(&self, p: u32, r: u32) -> Option<f64> {
         self.runs
@@ -128,7 +114,7 @@ struct Result_ {
     size: u32,
     pe_counts: Vec<u32>,
     rp_blocks: Vec<u32>,
-    measured: Vec<Measured>,
+    measured: Vec<Measured<Run>>,
     findings: Vec<Findings>,
     environment: serde_json::Value,
 }
@@ -139,7 +125,7 @@ fn measure(
     pe_counts: &[u32],
     blocks: &[u32],
     checkpoint: &Checkpoint,
-) -> Result<Measured> {
+) -> Result<Measured<Run>> {
     let mut keys = vec![(1u32, 1u32)];
     keys.extend(
         pe_counts
@@ -150,30 +136,17 @@ fn measure(
         .iter()
         .enumerate()
         .map(|(i, &(p, r))| {
-            let m = if i == 0 {
+            if i == 0 {
                 osp::machine(1, 1, Allocation::Block, 1)
             } else {
                 osp::machine(p, 2, Allocation::Skewed, r)
-            };
-            (m, FrameBuffer::Direct)
+            }
         })
         .collect();
-    eprintln!("{}: simulating {} machines …", t.label, machines.len());
-    let results = osp::run_all(t, &machines, checkpoint)?;
-    let t1 = results[0].0.clocks;
-    let runs = keys
-        .iter()
-        .zip(&results)
-        .map(|(&(pes, rp_blocks), (r, wall))| Run {
-            sim: SimRecord::new(r, t1, (pes * rp_blocks) as u64, *wall),
-            pes,
-            rp_blocks,
-        })
-        .collect();
-    Ok(Measured {
-        pass: t.record(),
-        t1_clocks: t1,
-        runs,
+    lb::measure(t, &machines, checkpoint, |i, sim| Run {
+        sim,
+        pes: keys[i].0,
+        rp_blocks: keys[i].1,
     })
 }
 
@@ -189,11 +162,9 @@ fn run(ctx: &Ctx) -> Result<Output> {
     } else {
         vec![1, 2, 4, 8, 16, 32]
     };
-    let pool = workload::pool(ctx.params.threads()?)?;
-    let measured: Vec<Measured> = traced
-        .iter()
-        .map(|t| pool.install(|| measure(t, &pe_counts, &blocks, ctx.checkpoint)))
-        .collect::<Result<_>>()?;
+    let (measured, threads) = lb::measure_passes(ctx, &traced, |t| {
+        measure(t, &pe_counts, &blocks, ctx.checkpoint)
+    })?;
     let findings: Vec<Findings> = measured
         .iter()
         .map(|m| findings(m, &pe_counts, &blocks))
@@ -213,7 +184,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         rp_blocks: blocks,
         measured,
         findings,
-        environment: environment(pool.current_num_threads()),
+        environment: environment(threads),
     };
     let mut out = Output::new(result, rows, doc);
     out.charts = charts;
@@ -222,7 +193,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
 }
 
 /// Where gains stop, and the configurations the prose names, on one scene (pure).
-fn findings(m: &Measured, pe_counts: &[u32], blocks: &[u32]) -> Findings {
+fn findings(m: &Measured<Run>, pe_counts: &[u32], blocks: &[u32]) -> Findings {
     let gains_stop_after = pe_counts
         .iter()
         .map(|&p| {
@@ -371,7 +342,7 @@ fn rows(p: &Published, f: &Findings) -> Vec<Row> {
 fn document(
     ctx: &Ctx,
     p: &Published,
-    measured: &[Measured],
+    measured: &[Measured<Run>],
     findings: &[Findings],
     size: u32,
     pe_counts: &[u32],
@@ -439,7 +410,7 @@ fn document(
 }
 
 /// Efficiency and speed-up vs RP blocks per PE, a line per PE count (003 Fig. 35).
-fn chart(id: &str, m: &Measured, pe_counts: &[u32], blocks: &[u32]) -> Chart {
+fn chart(id: &str, m: &Measured<Run>, pe_counts: &[u32], blocks: &[u32]) -> Chart {
     let panels = [
         ("efficiency", LegendAt::UpperRight),
         ("speedup", LegendAt::UpperLeft),

@@ -3,12 +3,11 @@
 //! 2D and 3D tori, 1 RP block per PE, on 003's ray-tracing pass over SPD scenes (003's own test
 //! scene is not available). The figures survive as captions only: the prose claims are compared.
 
-use super::object_space_pass::{self as osp, PassRecord, Published, SimRecord, Traced};
+use super::load_balancing::{self as lb, Measured};
+use super::object_space_pass::{self as osp, Published, SimRecord, Traced};
 use super::published;
-use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
+use super::{environment, Checkpoint, Claim, Ctx, Fidelity, Kind, Output, Row, Table, Verdict};
 use crate::error::Result;
-use crate::workload;
-use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Allocation;
 use rtbench_reports::plot::{Chart, LegendAt};
 use rtbench_reports::{Document, Table as DocTable};
@@ -17,17 +16,11 @@ use std::collections::BTreeMap;
 
 const SCENE: &str = "the room (rtbench_scenes::room, both passes) stands in for 003's single test scene (18859 patches, Table 6), which is not available; the SPD scenes are a second set (ray-tracing pass only)";
 
-pub const TABLE: Table = Table {
-    id: "yamauchi-static-lb",
-    seed: "003",
-    source: "§4.2.2, Figs. 31–34",
-    about: "003 (Yamauchi 1997) §4.2.2: (Mπ)² speed-up/efficiency vs PEs, 3 allocations, 1D/2D/3D",
-    runtime: Runtime {
-        quick: "seconds",
-        full: "minutes",
-    },
-    params: osp::PARAMS,
-    claims: &[
+pub const TABLE: Table = lb::table(
+    "yamauchi-static-lb",
+    "§4.2.2, Figs. 31–34",
+    "003 (Yamauchi 1997) §4.2.2: (Mπ)² speed-up/efficiency vs PEs, 3 allocations, 1D/2D/3D",
+    &[
         Claim {
             key: "ordering",
             fidelity: Fidelity::Substituted,
@@ -55,7 +48,7 @@ pub const TABLE: Table = Table {
         },
     ],
     run,
-};
+);
 
 const PUBLISHED: &str = include_str!("../../../data/published/yamauchi-static-lb.json");
 
@@ -81,14 +74,7 @@ struct Run {
     shape: String,
 }
 
-#[derive(Serialize)]
-struct Measured {
-    pass: PassRecord,
-    t1_clocks: u64,
-    runs: Vec<Run>,
-}
-
-impl Measured {
+impl Measured<Run> {
     /// Efficiency T(1) / (T × PEs) of (dims, allocation, PEs), if it was run (1 at 1 PE).
     fn eff(&self, dims: u8, alloc: Allocation, p: u32) -> Option<f64> {
         if p == 1 {
@@ -146,7 +132,7 @@ struct Result_ {
     quick: bool,
     size: u32,
     max_pes: u32,
-    measured: Vec<Measured>,
+    measured: Vec<Measured<Run>>,
     findings: Vec<Findings>,
     environment: serde_json::Value,
 }
@@ -162,7 +148,7 @@ fn cap(dims: u8, max_pes: u32) -> u32 {
 }
 
 /// Simulates every machine on one traced scene.
-fn measure(t: &Traced, max_pes: u32, checkpoint: &Checkpoint) -> Result<Measured> {
+fn measure(t: &Traced, max_pes: u32, checkpoint: &Checkpoint) -> Result<Measured<Run>> {
     let mut keys = vec![(1u8, Allocation::Block, 1u32)];
     for dims in 1..=3u8 {
         for (d, alloc) in COLUMNS {
@@ -179,37 +165,25 @@ fn measure(t: &Traced, max_pes: u32, checkpoint: &Checkpoint) -> Result<Measured
     }
     let machines: Vec<_> = keys
         .iter()
-        .map(|&(d, a, p)| (osp::machine(p, d, a, 1), FrameBuffer::Direct))
+        .map(|&(d, a, p)| osp::machine(p, d, a, 1))
         .collect();
-    eprintln!("{}: simulating {} machines …", t.label, machines.len());
-    let results = osp::run_all(t, &machines, checkpoint)?;
-    let t1 = results[0].0.clocks;
-    let runs = keys
-        .iter()
-        .zip(&results)
-        .map(|(&(dims, alloc, pes), (r, wall))| Run {
-            sim: SimRecord::new(r, t1, pes as u64, *wall),
+    lb::measure(t, &machines, checkpoint, |i, sim| {
+        let (dims, alloc, pes) = keys[i];
+        Run {
+            sim,
             dims,
             allocation: alloc.name(),
             pes,
-            shape: osp::machine(pes, dims, alloc, 1).pes_label(),
-        })
-        .collect();
-    Ok(Measured {
-        pass: t.record(),
-        t1_clocks: t1,
-        runs,
+            shape: machines[i].pes_label(),
+        }
     })
 }
 
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
     let (size, max_pes, traced) = osp::load_balancing_setting(ctx, 1)?;
-    let pool = workload::pool(ctx.params.threads()?)?;
-    let measured: Vec<Measured> = traced
-        .iter()
-        .map(|t| pool.install(|| measure(t, max_pes, ctx.checkpoint)))
-        .collect::<Result<_>>()?;
+    let (measured, threads) =
+        lb::measure_passes(ctx, &traced, |t| measure(t, max_pes, ctx.checkpoint))?;
     let above = p.value("2d-256-above-60");
     let findings: Vec<Findings> = measured
         .iter()
@@ -230,7 +204,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         max_pes,
         measured,
         findings,
-        environment: environment(pool.current_num_threads()),
+        environment: environment(threads),
     };
     let mut out = Output::new(result, rows, doc);
     out.charts = charts;
@@ -240,7 +214,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
 
 /// The orderings and the figures the prose names, on one scene (pure); `above`: the 2D, 256-PE
 /// efficiency 003 reports exceeding.
-fn findings(m: &Measured, max_pes: u32, above: f64) -> Findings {
+fn findings(m: &Measured<Run>, max_pes: u32, above: f64) -> Findings {
     let mut ordering = BTreeMap::new();
     let mut holds = true;
     // Radiosity (003 §4.2.2): block < distributed < skewed "always"; ray tracing: skewed above
@@ -428,7 +402,7 @@ fn same_trends(findings: &[Findings], max_pes: u32) -> Vec<Row> {
 fn document(
     ctx: &Ctx,
     p: &Published,
-    measured: &[Measured],
+    measured: &[Measured<Run>],
     findings: &[Findings],
     size: u32,
     max_pes: u32,
@@ -483,7 +457,7 @@ fn document(
 }
 
 /// Efficiency and speed-up vs PEs, a panel per dimension, and 2D skewed vs 3D distributed.
-fn charts(id: &str, m: &Measured, size: u32, max_pes: u32) -> Vec<Chart> {
+fn charts(id: &str, m: &Measured<Run>, size: u32, max_pes: u32) -> Vec<Chart> {
     let pts = |dims: u8, a: Allocation, speed: bool| -> Vec<(f64, f64)> {
         osp::powers(cap(dims, max_pes))
             .into_iter()
@@ -540,7 +514,7 @@ mod tests {
     use crate::reproduce::object_space_pass::tests::{pass, sim};
 
     /// Runs up to 4 PEs whose efficiency is `e(dims, allocation)` at every PE count above 1.
-    fn measured(e: impl Fn(u8, Allocation) -> f64) -> Measured {
+    fn measured(e: impl Fn(u8, Allocation) -> f64) -> Measured<Run> {
         let t1 = 1_000_000u64;
         let mut runs = Vec::new();
         for (dims, a) in COLUMNS {
