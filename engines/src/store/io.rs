@@ -5,9 +5,11 @@
 //! Table 3.3): offsets and positions are then those of the uncompressed stream, `bytes_read` /
 //! `bytes_written` count the compressed bytes on disk and `codec_bytes` the uncompressed bytes
 //! through the codec. A forward seek decompresses and discards; a backward one (a rewind) opens
-//! the stream again from its start.
+//! the stream again from its start. A compressed file may hold several gzip members one after
+//! the other (RFC 1952 §2.2), read as one stream: a store written in segments across sessions
+//! ends a member at every segment ([`IoFile::checkpoint`]).
 
-use flate2::read::GzDecoder;
+use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use flate2::Compression;
 use serde::Serialize;
@@ -71,7 +73,7 @@ fn counted(f: File) -> Counted<File> {
 
 enum Backing {
     Plain(File),
-    GzRead(Box<GzDecoder<Counted<File>>>),
+    GzRead(Box<MultiGzDecoder<Counted<File>>>),
     GzWrite(Box<GzEncoder<Counted<File>>>),
 }
 
@@ -102,6 +104,7 @@ impl IoCounters {
 /// writing sequentially, counting every system call it makes.
 pub struct IoFile {
     file: Backing,
+    codec: Codec,
     path: PathBuf,
     /// Disk bytes and calls of compressed streams already closed (a rewind reopens).
     done_bytes: u64,
@@ -128,9 +131,9 @@ impl IoFile {
         let f = File::open(path)?;
         let file = match codec {
             Codec::None => Backing::Plain(f),
-            Codec::Gzip(_) => Backing::GzRead(Box::new(GzDecoder::new(counted(f)))),
+            Codec::Gzip(_) => Backing::GzRead(Box::new(MultiGzDecoder::new(counted(f)))),
         };
-        Ok(Self::new(file, path, buffer))
+        Ok(Self::new(file, codec, path, buffer))
     }
 
     pub fn create_codec(path: &Path, buffer: usize, codec: Codec) -> io::Result<IoFile> {
@@ -142,12 +145,87 @@ impl IoFile {
                 Compression::new(level.min(9)),
             ))),
         };
-        Ok(Self::new(file, path, buffer))
+        Ok(Self::new(file, codec, path, buffer))
     }
 
-    fn new(file: Backing, path: &Path, buffer: usize) -> IoFile {
+    /// Takes up writing a file that a [`IoFile::checkpoint`] left `stored` bytes long on disk,
+    /// `written` bytes of the stream (uncompressed) long: anything after the checkpoint (half a
+    /// segment of a process that stopped) is cut off, and writing goes on from there (in a
+    /// compressed file, as a new gzip member). The counters start at the file's size, so that
+    /// `bytes_written` stays the file's size on disk.
+    pub fn append_codec(
+        path: &Path,
+        buffer: usize,
+        codec: Codec,
+        stored: u64,
+        written: u64,
+    ) -> io::Result<IoFile> {
+        let mut f = std::fs::OpenOptions::new().write(true).open(path)?;
+        let len = f.metadata()?.len();
+        if len < stored {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "{}: {len} bytes, its checkpoint says at least {stored}: truncated",
+                    path.display()
+                ),
+            ));
+        }
+        f.set_len(stored)?;
+        f.seek(SeekFrom::Start(stored))?;
+        let file = match codec {
+            Codec::None => Backing::Plain(f),
+            Codec::Gzip(level) => Backing::GzWrite(Box::new(GzEncoder::new(
+                Counted {
+                    inner: f,
+                    bytes: stored,
+                    calls: 0,
+                },
+                Compression::new(level.min(9)),
+            ))),
+        };
+        let mut io = Self::new(file, codec, path, buffer);
+        io.base = written;
+        io.io.bytes_written = stored;
+        Ok(io)
+    }
+
+    /// Makes everything written so far durable and complete on its own: flushes the buffer,
+    /// ends the gzip member (a compressed file) and starts the next one, and syncs. Returns the
+    /// file's size on disk, from which [`IoFile::append_codec`] can take writing up again.
+    pub fn checkpoint(&mut self) -> io::Result<u64> {
+        self.flush()?;
+        let dup = match &self.file {
+            Backing::Plain(f) => {
+                f.sync_data()?;
+                return Ok(self.io.bytes_written);
+            }
+            Backing::GzWrite(e) => e.get_ref().inner.try_clone()?,
+            Backing::GzRead(_) => return Err(io::Error::other("checkpoint of a file being read")),
+        };
+        let Backing::GzWrite(e) = std::mem::replace(&mut self.file, Backing::Plain(dup)) else {
+            unreachable!("matched above")
+        };
+        let c = e.finish()?;
+        c.inner.sync_data()?;
+        let stored = c.bytes;
+        self.io.write_calls = c.calls;
+        self.io.bytes_written = stored;
+        let level = match self.codec {
+            Codec::Gzip(level) => level,
+            Codec::None => 6,
+        };
+        self.file = Backing::GzWrite(Box::new(GzEncoder::new(
+            c,
+            Compression::new(level.min(9)),
+        )));
+        Ok(stored)
+    }
+
+    fn new(file: Backing, codec: Codec, path: &Path, buffer: usize) -> IoFile {
         IoFile {
             file,
+            codec,
             path: path.to_path_buf(),
             done_bytes: 0,
             done_calls: 0,
@@ -208,7 +286,7 @@ impl IoFile {
                     let c = d.get_ref();
                     self.done_bytes += c.bytes;
                     self.done_calls += c.calls;
-                    **d = GzDecoder::new(counted(File::open(&self.path)?));
+                    **d = MultiGzDecoder::new(counted(File::open(&self.path)?));
                     self.io.seeks += 1;
                     self.base = 0;
                     self.pos = 0;

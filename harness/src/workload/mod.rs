@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod frustum;
 pub mod out_of_core;
 pub mod paging;
 pub mod pass_003;
@@ -9,6 +10,7 @@ pub mod rayshade_memory;
 pub mod replacement;
 pub mod surface;
 pub mod tiles;
+pub mod view_file;
 pub mod trace;
 
 use crate::error::{input, Result};
