@@ -402,7 +402,7 @@ fn a_damaged_material_table_is_refused() {
 }
 
 /// Every object of a store as read back: (id, box, record).
-fn read_all(dir: &std::path::Path) -> Vec<(u64, glam::Vec3, glam::Vec3, ObjectRecord)> {
+fn read_all(dir: &std::path::Path) -> Vec<(u32, glam::Vec3, glam::Vec3, ObjectRecord)> {
     let h = StoreHeader::read(dir).unwrap();
     let mut r = SceneReader::open(&h, 4096, false).unwrap();
     let mut rec = ObjectRecord::default();
