@@ -261,6 +261,11 @@ impl Sink for SegmentedWriter {
         if self.seen <= self.skip || self.stopped || self.error.is_some() {
             return;
         }
+        if self.seen == self.skip + 1 && self.skip > 0 {
+            // The first segment of a resumed run is timed from here, not from the pass over
+            // the objects already on disk.
+            self.segment_start = Instant::now();
+        }
         self.writer.shape(shape);
         if self.writer.objects() % self.log.segment == 0 {
             if let Err(e) = self.end_segment() {
