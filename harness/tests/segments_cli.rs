@@ -17,13 +17,37 @@ fn a_store_written_in_segments_across_runs_renders_as_one_written_at_once() {
     let once = d.join("once");
     let seg = d.join("seg");
     json(&[
-        "scene", "store", "rings", "--sf", "2", "-o", &once, "--layout", "basic", "--compress",
-        "gzip:1", "--json",
+        "scene",
+        "store",
+        "rings",
+        "--sf",
+        "2",
+        "-o",
+        &once,
+        "--layout",
+        "basic",
+        "--compress",
+        "gzip:1",
+        "--json",
     ]);
     let args = |resume: bool| {
         let mut a = vec![
-            "scene", "store", "rings", "--sf", "2", "-o", &seg, "--layout", "basic", "--compress",
-            "gzip:1", "--segment", "100", "--max-seconds", "0.000001", "--json",
+            "scene",
+            "store",
+            "rings",
+            "--sf",
+            "2",
+            "-o",
+            &seg,
+            "--layout",
+            "basic",
+            "--compress",
+            "gzip:1",
+            "--segment",
+            "100",
+            "--max-seconds",
+            "0.000001",
+            "--json",
         ];
         if resume {
             a.push("--resume");
@@ -57,7 +81,15 @@ fn a_store_written_in_segments_across_runs_renders_as_one_written_at_once() {
     assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
     expect_input_error(
         &[
-            "scene", "store", "rings", "--sf", "2", "-o", &d.join("x"), "--segment", "10",
+            "scene",
+            "store",
+            "rings",
+            "--sf",
+            "2",
+            "-o",
+            &d.join("x"),
+            "--segment",
+            "10",
             "--hierarchy",
         ],
         "--hierarchy",
@@ -67,13 +99,19 @@ fn a_store_written_in_segments_across_runs_renders_as_one_written_at_once() {
 #[test]
 fn the_rings368m_view_sees_a_small_share_of_rings() {
     let whole = json(&["scene", "stats", "rings", "--sf", "6", "--json"]);
-    let v = json(&["scene", "stats", "rings", "--sf", "6", "--view", VIEW, "--json"]);
+    let v = json(&[
+        "scene", "stats", "rings", "--sf", "6", "--view", VIEW, "--json",
+    ]);
     assert_eq!(v["objects"], whole["objects"]);
     let n = v["objects_in_view"].as_u64().unwrap();
     assert!(n > 0 && n < v["objects"].as_u64().unwrap() / 10, "{v}");
     let d = Dir::new("seg-cli", "view");
     let bad = d.join("bad.json");
-    std::fs::write(&bad, r#"{"view": {"from": [0,0,0], "at": [0,0,0], "up": [0,0,1], "angle": 10}}"#).unwrap();
+    std::fs::write(
+        &bad,
+        r#"{"view": {"from": [0,0,0], "at": [0,0,0], "up": [0,0,1], "angle": 10}}"#,
+    )
+    .unwrap();
     expect_input_error(
         &["scene", "stats", "rings", "--sf", "2", "--view", &bad],
         "from ≠ at",
@@ -110,7 +148,10 @@ fn nakamaru_4_3_stops_at_a_checkpoint_and_finishes_resumed() {
     assert_eq!(done["finished"], true);
     let rows = done["rows"].as_array().unwrap();
     assert!(rows.iter().all(|r| r["fidelity"].is_string()));
-    let image: Vec<&Value> = rows.iter().filter(|r| r["claim"] == "image-equal").collect();
+    let image: Vec<&Value> = rows
+        .iter()
+        .filter(|r| r["claim"] == "image-equal")
+        .collect();
     assert_eq!(image.len(), 2);
     assert!(image.iter().all(|r| r["verdict"] == "holds"), "{image:?}");
     let m = &done["measured"];
@@ -121,5 +162,7 @@ fn nakamaru_4_3_stops_at_a_checkpoint_and_finishes_resumed() {
     assert!(rows
         .iter()
         .any(|r| r["claim"] == "basic-model" && r["fidelity"] == "model"));
-    assert!(!Path::new(&out).join(".partial/nakamaru-4.3/stores").exists());
+    assert!(!Path::new(&out)
+        .join(".partial/nakamaru-4.3/stores")
+        .exists());
 }

@@ -215,10 +215,7 @@ impl IoFile {
             Codec::Gzip(level) => level,
             Codec::None => 6,
         };
-        self.file = Backing::GzWrite(Box::new(GzEncoder::new(
-            c,
-            Compression::new(level.min(9)),
-        )));
+        self.file = Backing::GzWrite(Box::new(GzEncoder::new(c, Compression::new(level.min(9)))));
         Ok(stored)
     }
 

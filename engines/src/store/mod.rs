@@ -67,8 +67,8 @@ pub use io::{Codec, IoCounters, IoFile};
 pub use read::{
     BasicReader, BboxReader, BboxRecord, GeometryReader, ObjectRecord, SceneReader, StoreHeader,
 };
-pub use surface::Surface;
 pub use segments::{Outcome, SegmentLog, SegmentedWriter, SEGMENTS_FILE};
+pub use surface::Surface;
 pub use write::{FileState, StoreWriter, WriteState};
 
 /// Format version written in every file; readers refuse any other (2: checksums; 3: the material

@@ -157,10 +157,7 @@ impl SegmentedWriter {
         let log = SegmentLog::read(dir)?
             .ok_or_else(|| bad(dir, "missing: no store is being written here"))?;
         if log.scene != scene {
-            return Err(bad(
-                dir,
-                format!("written from {}, not {scene}", log.scene),
-            ));
+            return Err(bad(dir, format!("written from {}, not {scene}", log.scene)));
         }
         let layout: Layout = log
             .layout

@@ -439,7 +439,10 @@ fn a_store_written_in_segments_across_stops_equals_one_written_at_once() {
             .with_budget(Duration::ZERO);
         spd::generate(program, &opts, &mut w).unwrap();
         assert!(matches!(w.finish().unwrap(), Outcome::Stopped));
-        assert!(StoreHeader::read(&seg.0).is_err(), "no header while being written");
+        assert!(
+            StoreHeader::read(&seg.0).is_err(),
+            "no header while being written"
+        );
         let mut runs = 1;
         loop {
             // A process that died mid-segment leaves bytes after the checkpoint: cut off.
@@ -455,7 +458,10 @@ fn a_store_written_in_segments_across_stops_equals_one_written_at_once() {
                 .open(seg.0.join(file))
                 .unwrap();
             std::io::Write::write_all(&mut f, b"half a segment").unwrap();
-            assert!(SegmentedWriter::resume(&seg.0, "rings3").is_err(), "another scene");
+            assert!(
+                SegmentedWriter::resume(&seg.0, "rings3").is_err(),
+                "another scene"
+            );
             let mut w = SegmentedWriter::resume(&seg.0, "rings2")
                 .unwrap()
                 .with_budget(Duration::ZERO);
@@ -471,10 +477,25 @@ fn a_store_written_in_segments_across_stops_equals_one_written_at_once() {
         assert_eq!(runs, 9, "{tag}");
         assert!(!seg.0.join(SEGMENTS_FILE).exists());
         assert_eq!(read_all(&seg.0), read_all(&once.0), "{tag}");
-        let (a, b) = (StoreHeader::read(&seg.0).unwrap(), StoreHeader::read(&once.0).unwrap());
+        let (a, b) = (
+            StoreHeader::read(&seg.0).unwrap(),
+            StoreHeader::read(&once.0).unwrap(),
+        );
         assert_eq!(
-            (a.objects, a.primitives, a.bounds, a.view.clone(), a.materials.clone()),
-            (b.objects, b.primitives, b.bounds, b.view.clone(), b.materials.clone())
+            (
+                a.objects,
+                a.primitives,
+                a.bounds,
+                a.view.clone(),
+                a.materials.clone()
+            ),
+            (
+                b.objects,
+                b.primitives,
+                b.bounds,
+                b.view.clone(),
+                b.materials.clone()
+            )
         );
         assert_eq!(a.verify().unwrap(), b.verify().unwrap());
         if codec == Codec::None {

@@ -56,7 +56,9 @@ pub fn charts(id: &str, points: &[SizePoint], size: u32) -> Vec<Chart> {
                 title: format!("{scene}: time per eye ray and memory against size (000 Ch.4)"),
                 panels: vec![
                     Panel::Xy(XyPanel {
-                        title: format!("{scene}: seconds per eye ray (with its ray tree), {size}×{size}"),
+                        title: format!(
+                            "{scene}: seconds per eye ray (with its ray tree), {size}×{size}"
+                        ),
                         x_label: "objects".into(),
                         y_label: "seconds per eye ray".into(),
                         x_log: true,
@@ -110,7 +112,11 @@ mod tests {
             seconds: [s, s / 2.0, s / 4.0],
             peak_rss: [1 << 20, 2 << 20, 3 << 20],
         };
-        let pts = [p("mount", 100, 8.0), p("tetra", 10, 1.0), p("mount", 10, 2.0)];
+        let pts = [
+            p("mount", 100, 8.0),
+            p("tetra", 10, 1.0),
+            p("mount", 10, 2.0),
+        ];
         let c = charts("x", &pts, 1);
         assert_eq!(c.len(), 2);
         assert_eq!(c[0].stem, "x-per-ray-mount");

@@ -28,7 +28,12 @@ impl Frustum {
         let cam = Camera::new(view);
         let corner = |i, j| cam.corner_ray(i, j, size).dir;
         // Top-left, top-right, bottom-right, bottom-left.
-        let c = [corner(0, 0), corner(size, 0), corner(size, size), corner(0, size)];
+        let c = [
+            corner(0, 0),
+            corner(size, 0),
+            corner(size, size),
+            corner(0, size),
+        ];
         let forward = (c[0] + c[1] + c[2] + c[3]).normalize();
         let mut normals = [forward; 5];
         for k in 0..4 {

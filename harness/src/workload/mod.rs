@@ -10,8 +10,8 @@ pub mod rayshade_memory;
 pub mod replacement;
 pub mod surface;
 pub mod tiles;
-pub mod view_file;
 pub mod trace;
+pub mod view_file;
 
 use crate::error::{input, Result};
 use crate::source::Source;

@@ -57,8 +57,8 @@ impl ViewFile {
     }
 
     pub fn read(path: &Path) -> Result<ViewFile> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| input(format!("{}: {e}", path.display())))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
         Self::parse(&text, &path.display().to_string())
     }
 }
