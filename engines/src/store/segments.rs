@@ -264,7 +264,7 @@ impl Sink for SegmentedWriter {
             self.segment_start = Instant::now();
         }
         self.writer.shape(shape);
-        if self.writer.objects() % self.log.segment == 0 {
+        if self.writer.objects().is_multiple_of(self.log.segment) {
             if let Err(e) = self.end_segment() {
                 self.error = Some(e);
             }

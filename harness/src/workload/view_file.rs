@@ -34,8 +34,7 @@ impl ViewFile {
         let r = f.view;
         let (from, at, up) = (DVec3::from(r.from), DVec3::from(r.at), DVec3::from(r.up));
         let dir = at - from;
-        if !(r.angle > 0.0 && r.angle < 180.0)
-            || !dir.is_finite()
+        if !(r.angle > 0.0 && r.angle < 180.0 && dir.is_finite())
             || dir.length() == 0.0
             || dir.cross(up).length() == 0.0
             || !r.hither.is_finite()
