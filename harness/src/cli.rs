@@ -340,6 +340,17 @@ pub enum SceneCommand {
         /// "B") with the thesis's constants for the scene (`--layout split` only).
         #[arg(long)]
         hierarchy: bool,
+        /// Write in segments of N objects, each made durable with a checkpoint
+        /// (`segments.json`; compressed: one gzip member per segment), in place: a store too
+        /// large for one session (seed 000 Table 4.3). Not with --hierarchy.
+        #[arg(long, value_name = "N")]
+        segment: Option<u64>,
+        /// Go on with the store being written in the directory (with --segment).
+        #[arg(long, requires = "segment")]
+        resume: bool,
+        /// Stop at the first checkpoint after this many seconds (with --segment).
+        #[arg(long, requires = "segment", value_name = "S")]
+        max_seconds: Option<f64>,
         #[arg(long)]
         json: bool,
     },
@@ -347,6 +358,10 @@ pub enum SceneCommand {
     Stats {
         #[command(flatten)]
         scene: SceneArg,
+        /// Also count the objects whose box reaches into this view's frustum (a view file such
+        /// as data/views/rings368m.json; 512×512 eye rays), in place of the scene's own camera.
+        #[arg(long, value_name = "FILE")]
+        view: Option<PathBuf>,
         #[arg(long)]
         json: bool,
     },

@@ -49,18 +49,49 @@ fn run(cli: Cli) -> Result<()> {
             layout,
             compress,
             hierarchy,
+            segment,
+            resume,
+            max_seconds,
             json,
-        }) => commands::scene::store(
+        }) => match segment {
+            Some(segment) if hierarchy => Err(error::input(format!(
+                "--segment {segment} --hierarchy: build the hierarchy once the store is finished (render with --set hierarchy=on)"
+            ))),
+            Some(segment) => commands::store_segments::store(
+                &Source::from_args(&scene.scene, &scene.opts)?,
+                &output,
+                &commands::store_segments::SegmentArgs {
+                    layout: &layout,
+                    compress: &compress,
+                    segment,
+                    resume,
+                    max_seconds,
+                    as_json: json,
+                },
+            ),
+            None => commands::scene::store(
+                &Source::from_args(&scene.scene, &scene.opts)?,
+                &output,
+                &layout,
+                &compress,
+                hierarchy,
+                json,
+            ),
+        },
+        Command::Scene(SceneCommand::Stats {
+            scene,
+            view: Some(view),
+            json,
+        }) => commands::scene::view_stats(
             &Source::from_args(&scene.scene, &scene.opts)?,
-            &output,
-            &layout,
-            &compress,
-            hierarchy,
+            &view,
             json,
         ),
-        Command::Scene(SceneCommand::Stats { scene, json }) => {
-            commands::scene::stats(&Source::from_args(&scene.scene, &scene.opts)?, json)
-        }
+        Command::Scene(SceneCommand::Stats {
+            scene,
+            view: None,
+            json,
+        }) => commands::scene::stats(&Source::from_args(&scene.scene, &scene.opts)?, json),
         Command::Engines { json } => commands::engines::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),

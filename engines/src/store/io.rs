@@ -6,9 +6,12 @@
 //! `bytes_written` count the compressed bytes on disk and `codec_bytes` the uncompressed bytes
 //! through the codec. A forward seek decompresses and discards; a backward one (a rewind) opens
 //! the stream again from its start. zstd ([`Codec::Zstd`]) is offered beside gzip, which is the
-//! thesis's: the issue asks for both measured (docs/benchmarks.md, issue 15).
+//! thesis's: the issue asks for both measured (docs/benchmarks.md, issue 15). A compressed file
+//! may hold several gzip members (RFC 1952 §2.2) or zstd frames (RFC 8878 §3.1) one after the
+//! other, read as one stream: a store written in segments across sessions ends a member or frame
+//! at every segment ([`IoFile::checkpoint`]).
 
-use flate2::read::GzDecoder;
+use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use flate2::Compression;
 use serde::Serialize;
@@ -100,14 +103,39 @@ type ZstdWrite = zstd::stream::write::Encoder<'static, Counted<File>>;
 
 enum Backing {
     Plain(File),
-    GzRead(Box<GzDecoder<Counted<File>>>),
+    GzRead(Box<MultiGzDecoder<Counted<File>>>),
     GzWrite(Box<GzEncoder<Counted<File>>>),
     ZsRead(Box<ZstdRead>),
     ZsWrite(Box<ZstdWrite>),
 }
 
-fn zstd_reader(f: File) -> io::Result<Backing> {
-    Ok(Backing::ZsRead(Box::new(ZstdRead::new(counted(f))?)))
+/// A reader of a compressed file: every gzip member or zstd frame in turn, as one stream.
+fn decoder(codec: Codec, f: File) -> io::Result<Backing> {
+    Ok(match codec {
+        Codec::None => Backing::Plain(f),
+        Codec::Gzip(_) => Backing::GzRead(Box::new(MultiGzDecoder::new(counted(f)))),
+        Codec::Zstd(_) => Backing::ZsRead(Box::new(ZstdRead::new(counted(f))?)),
+    })
+}
+
+/// A writer through the codec, onto `c` (a new file, or one taken up after a checkpoint).
+fn encoder(codec: Codec, c: Counted<File>) -> io::Result<Backing> {
+    Ok(match codec {
+        Codec::None => Backing::Plain(c.inner),
+        Codec::Gzip(level) => {
+            Backing::GzWrite(Box::new(GzEncoder::new(c, Compression::new(level.min(9)))))
+        }
+        Codec::Zstd(level) => {
+            let mut e = ZstdWrite::new(c, level.clamp(1, 19))?;
+            // A frame checksum, as gzip has its CRC-32: a damaged byte is caught at the end.
+            e.include_checksum(true)?;
+            // A 128 KiB window (level 3 would take 2 MiB or more): the reader's decoder holds
+            // one window per open stream, and the engine's memory budget (Table 3.3: 64 MiB in
+            // all) has to hold them; measured in docs/benchmarks.md (issue 15).
+            e.window_log(ZSTD_WINDOW_LOG)?;
+            Backing::ZsWrite(Box::new(e))
+        }
+    })
 }
 
 impl Backing {
@@ -159,6 +187,7 @@ impl IoCounters {
 /// writing sequentially, counting every system call it makes.
 pub struct IoFile {
     file: Backing,
+    codec: Codec,
     path: PathBuf,
     /// Disk bytes and calls of compressed streams already closed (a rewind reopens).
     done_bytes: u64,
@@ -183,39 +212,88 @@ impl IoFile {
 
     pub fn open_codec(path: &Path, buffer: usize, codec: Codec) -> io::Result<IoFile> {
         let f = File::open(path)?;
-        let file = match codec {
-            Codec::None => Backing::Plain(f),
-            Codec::Gzip(_) => Backing::GzRead(Box::new(GzDecoder::new(counted(f)))),
-            Codec::Zstd(_) => zstd_reader(f)?,
-        };
-        Ok(Self::new(file, path, buffer))
+        let file = decoder(codec, f)?;
+        Ok(Self::new(file, codec, path, buffer))
     }
 
     pub fn create_codec(path: &Path, buffer: usize, codec: Codec) -> io::Result<IoFile> {
-        let f = File::create(path)?;
-        let file = match codec {
-            Codec::None => Backing::Plain(f),
-            Codec::Gzip(level) => Backing::GzWrite(Box::new(GzEncoder::new(
-                counted(f),
-                Compression::new(level.min(9)),
-            ))),
-            Codec::Zstd(level) => {
-                let mut e = ZstdWrite::new(counted(f), level.clamp(1, 19))?;
-                // A frame checksum, as gzip has its CRC-32: a damaged byte is caught at the end.
-                e.include_checksum(true)?;
-                // A 128 KiB window (level 3 would take 2 MiB or more): the reader's decoder holds
-                // one window per open stream, and the engine's memory budget (Table 3.3: 64 MiB
-                // in all) has to hold them; measured in docs/benchmarks.md (issue 15).
-                e.window_log(ZSTD_WINDOW_LOG)?;
-                Backing::ZsWrite(Box::new(e))
-            }
-        };
-        Ok(Self::new(file, path, buffer))
+        let file = encoder(codec, counted(File::create(path)?))?;
+        Ok(Self::new(file, codec, path, buffer))
     }
 
-    fn new(file: Backing, path: &Path, buffer: usize) -> IoFile {
+    /// Takes up writing a file that a [`IoFile::checkpoint`] left `stored` bytes long on disk,
+    /// `written` bytes of the stream (uncompressed) long: anything after the checkpoint (half a
+    /// segment of a process that stopped) is cut off, and writing goes on from there (in a
+    /// compressed file, as a new gzip member). The counters start at the file's size, so that
+    /// `bytes_written` stays the file's size on disk.
+    pub fn append_codec(
+        path: &Path,
+        buffer: usize,
+        codec: Codec,
+        stored: u64,
+        written: u64,
+    ) -> io::Result<IoFile> {
+        let mut f = std::fs::OpenOptions::new().write(true).open(path)?;
+        let len = f.metadata()?.len();
+        if len < stored {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "{}: {len} bytes, its checkpoint says at least {stored}: truncated",
+                    path.display()
+                ),
+            ));
+        }
+        f.set_len(stored)?;
+        f.seek(SeekFrom::Start(stored))?;
+        let file = encoder(
+            codec,
+            Counted {
+                inner: f,
+                bytes: stored,
+                calls: 0,
+            },
+        )?;
+        let mut io = Self::new(file, codec, path, buffer);
+        io.base = written;
+        io.io.bytes_written = stored;
+        Ok(io)
+    }
+
+    /// Makes everything written so far durable and complete on its own: flushes the buffer,
+    /// ends the gzip member (a compressed file) and starts the next one, and syncs. Returns the
+    /// file's size on disk, from which [`IoFile::append_codec`] can take writing up again.
+    pub fn checkpoint(&mut self) -> io::Result<u64> {
+        self.flush()?;
+        let dup = match &self.file {
+            Backing::Plain(f) => {
+                f.sync_data()?;
+                return Ok(self.io.bytes_written);
+            }
+            Backing::GzWrite(e) => e.get_ref().inner.try_clone()?,
+            Backing::ZsWrite(e) => e.get_ref().inner.try_clone()?,
+            Backing::GzRead(_) | Backing::ZsRead(_) => {
+                return Err(io::Error::other("checkpoint of a file being read"))
+            }
+        };
+        // End the member or frame, then start the next one on the same file.
+        let c = match std::mem::replace(&mut self.file, Backing::Plain(dup)) {
+            Backing::GzWrite(e) => e.finish()?,
+            Backing::ZsWrite(e) => e.finish()?,
+            _ => unreachable!("matched above"),
+        };
+        c.inner.sync_data()?;
+        let stored = c.bytes;
+        self.io.write_calls = c.calls;
+        self.io.bytes_written = stored;
+        self.file = encoder(self.codec, c)?;
+        Ok(stored)
+    }
+
+    fn new(file: Backing, codec: Codec, path: &Path, buffer: usize) -> IoFile {
         IoFile {
             file,
+            codec,
             path: path.to_path_buf(),
             done_bytes: 0,
             done_calls: 0,
@@ -271,11 +349,7 @@ impl IoFile {
                     let (bytes, calls) = self.file.decoder_counts();
                     self.done_bytes += bytes;
                     self.done_calls += calls;
-                    let f = File::open(&self.path)?;
-                    self.file = match self.file {
-                        Backing::GzRead(_) => Backing::GzRead(Box::new(GzDecoder::new(counted(f)))),
-                        _ => zstd_reader(f)?,
-                    };
+                    self.file = decoder(self.codec, File::open(&self.path)?)?;
                     self.io.seeks += 1;
                     self.base = 0;
                     self.pos = 0;

@@ -39,6 +39,9 @@
 //! records' checksums guard its bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
+//! A store too large to write in one session is written in segments ([`segments`]): while it
+//! is being written its directory holds `segments.json` and no `header.json`.
+//!
 //! A split store may carry a bounding-box hierarchy (`bbox-K.bin`, `hierarchy.json`; seed 000
 //! §4.2.2 "B"): see [`hierarchy`].
 //!
@@ -58,6 +61,7 @@
 pub mod hierarchy;
 mod io;
 mod read;
+pub mod segments;
 mod surface;
 mod write;
 
@@ -66,8 +70,9 @@ pub use io::{Codec, IoCounters, IoFile};
 pub use read::{
     BasicReader, BboxReader, BboxRecord, GeometryReader, ObjectRecord, SceneReader, StoreHeader,
 };
+pub use segments::{Outcome, SegmentLog, SegmentedWriter, SEGMENTS_FILE};
 pub use surface::Surface;
-pub use write::StoreWriter;
+pub use write::{FileState, StoreWriter, WriteState};
 
 /// Format version written in every file; readers refuse any other (2: checksums; 3: the material
 /// table moved out of header.json into `materials.bin`, so that the header stays small at 10^9

@@ -11,10 +11,33 @@ use super::{
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
 use rtbench_scenes::{Light, Material, Scene, ShapeRef, Sink, View};
+use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::collections::HashMap;
 use std::io;
 use std::path::{Path, PathBuf};
+
+/// One binary file at a checkpoint: its size on disk and the length of its (uncompressed) stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileState {
+    pub stored: u64,
+    pub written: u64,
+}
+
+/// Where a store being written stood at its last checkpoint ([`StoreWriter::checkpoint`]):
+/// counts, the bounds so far (as f32 bits: an empty box is ±infinity, which JSON cannot hold)
+/// and each binary file's state.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct WriteState {
+    pub objects: u64,
+    pub primitives: u64,
+    pub lo_bits: [u32; 3],
+    pub hi_bits: [u32; 3],
+    /// `bbox.bin` (split layout only).
+    pub bbox: Option<FileState>,
+    /// `geometry.bin` (split) or `objects.bin[.gz]` (basic).
+    pub geometry: FileState,
+}
 
 /// Buffer of each file being written.
 const WRITE_BUFFER: usize = 1 << 16;
@@ -120,7 +143,20 @@ impl StoreWriter {
                 (None, objects)
             }
         };
-        Ok(StoreWriter {
+        Ok(Self::create_with_files(
+            dir, name, layout, codec, bbox, geometry,
+        ))
+    }
+
+    fn create_with_files(
+        dir: &Path,
+        name: &str,
+        layout: Layout,
+        codec: Codec,
+        bbox: Option<IoFile>,
+        geometry: IoFile,
+    ) -> StoreWriter {
+        StoreWriter {
             dir: dir.to_path_buf(),
             name: name.to_string(),
             layout,
@@ -141,7 +177,98 @@ impl StoreWriter {
             prims: Vec::new(),
             tris: Vec::new(),
             record: Vec::new(),
+        }
+    }
+
+    /// Objects written so far.
+    pub fn objects(&self) -> u64 {
+        self.objects
+    }
+
+    /// Makes the store written so far durable and complete up to the last object
+    /// ([`IoFile::checkpoint`] on every binary file: a gzip member ends) and returns where it
+    /// stands, for [`StoreWriter::resume`] in another process. The first error of the stream is
+    /// returned here.
+    pub fn checkpoint(&mut self) -> io::Result<WriteState> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let bbox = match self.bbox.as_mut() {
+            Some(b) => Some(FileState {
+                stored: b.checkpoint()?,
+                written: b.written(),
+            }),
+            None => None,
+        };
+        let geometry = FileState {
+            stored: self.geometry.checkpoint()?,
+            written: self.geometry.written(),
+        };
+        Ok(WriteState {
+            objects: self.objects,
+            primitives: self.prims_total,
+            lo_bits: self.lo.to_array().map(f32::to_bits),
+            hi_bits: self.hi.to_array().map(f32::to_bits),
+            bbox,
+            geometry,
         })
+    }
+
+    /// Takes up a store that [`StoreWriter::checkpoint`] left at `state` in `dir` (same name,
+    /// layout and codec): the files are cut back to the checkpoint and appended to. The caller
+    /// streams the scene again from its start and passes the first `state.objects` shapes by
+    /// (they are on disk); lights, view and materials are taken again from that stream, and the
+    /// material table comes out the same because it is built in order of first use.
+    pub fn resume(
+        dir: &Path,
+        name: &str,
+        layout: Layout,
+        codec: Codec,
+        state: &WriteState,
+    ) -> io::Result<StoreWriter> {
+        let (bbox, geometry) = match (layout, &state.bbox) {
+            (Layout::Split, Some(b)) => (
+                Some(IoFile::append_codec(
+                    &dir.join(BBOX_FILE),
+                    WRITE_BUFFER,
+                    Codec::None,
+                    b.stored,
+                    b.written,
+                )?),
+                IoFile::append_codec(
+                    &dir.join(GEOMETRY_FILE),
+                    WRITE_BUFFER,
+                    Codec::None,
+                    state.geometry.stored,
+                    state.geometry.written,
+                )?,
+            ),
+            (Layout::Basic, None) => {
+                let file = codec.objects_file();
+                (
+                    None,
+                    IoFile::append_codec(
+                        &dir.join(file),
+                        WRITE_BUFFER,
+                        codec,
+                        state.geometry.stored,
+                        state.geometry.written,
+                    )?,
+                )
+            }
+            _ => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("{}: the checkpoint is of another layout", dir.display()),
+                ))
+            }
+        };
+        let mut w = StoreWriter::create_with_files(dir, name, layout, codec, bbox, geometry);
+        w.objects = state.objects;
+        w.prims_total = state.primitives;
+        w.lo = Vec3::from_array(state.lo_bits.map(f32::from_bits));
+        w.hi = Vec3::from_array(state.hi_bits.map(f32::from_bits));
+        Ok(w)
     }
 
     /// Writes a scene already in memory (the breadth-first engine built from a `BuildInput`):

@@ -7,4 +7,5 @@ pub mod plan;
 pub mod render;
 pub mod runs;
 pub mod scene;
+pub mod store_segments;
 pub mod tree_stats;

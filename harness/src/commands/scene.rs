@@ -257,3 +257,36 @@ pub fn stats(src: &Source, as_json: bool) -> Result<()> {
     }
     Ok(())
 }
+
+/// `rtbench scene stats … --view FILE`: the objects and those whose box reaches into the view's
+/// frustum ([`crate::workload::frustum`]), streamed from the generator.
+pub fn view_stats(src: &Source, file: &Path, as_json: bool) -> Result<()> {
+    let vf = crate::workload::view_file::ViewFile::read(file)?;
+    let start = std::time::Instant::now();
+    let mut c = crate::workload::frustum::ViewCount::new(&vf.view, 512);
+    src.stream(&mut c)?;
+    if c.objects == 0 {
+        return Err(input(format!("{}: the scene has no objects", src.label())));
+    }
+    let v = json!({
+        "scene": src.label(),
+        "view": file.display().to_string(),
+        "objects": c.objects,
+        "objects_in_view": c.in_view,
+        "fraction_in_view": c.in_view as f64 / c.objects as f64,
+        "time_s": start.elapsed().as_secs_f64(),
+    });
+    if as_json {
+        print_json(&v);
+    } else {
+        println!(
+            "{}: {} of {} objects in view ({:.4}%) under {}",
+            src.label(),
+            c.in_view,
+            c.objects,
+            100.0 * c.in_view as f64 / c.objects as f64,
+            file.display()
+        );
+    }
+    Ok(())
+}

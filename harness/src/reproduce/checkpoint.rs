@@ -26,6 +26,12 @@ impl Checkpoint {
         Ok(Checkpoint { dir, resume })
     }
 
+    /// `out/.partial/<id>`: where a table may also keep what its steps need between runs
+    /// (scene stores), removed with the steps when a run starts without `--resume`.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
     fn file(&self, key: &str) -> PathBuf {
         self.dir.join(format!("{key}.json"))
     }

@@ -21,6 +21,7 @@ mod engine_timing;
 mod grid_runs;
 mod load_balancing;
 mod object_space_pass;
+mod per_ray;
 
 pub use checkpoint::Checkpoint;
 pub use claims::{Claim, Fidelity, Kind, Row, Verdict};
@@ -54,6 +55,7 @@ registry! {
     nakamaru_3_3,
     nakamaru_4_1,
     nakamaru_4_2,
+    nakamaru_4_3,
     nakamaru_fig4_4,
     nakamaru_fig3_2,
     nakamaru_fig3_3,

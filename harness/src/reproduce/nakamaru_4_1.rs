@@ -13,6 +13,7 @@
 //!
 //! `--quick` traces one small row per scene at 64×64; `--set rows=balls6,mount9` picks rows.
 
+use super::per_ray::{self, SizePoint};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
 use crate::commands::render::hex;
@@ -141,6 +142,9 @@ struct Run {
     /// `bh_level_K_skipped` per level K ≥ 1.
     bh_skipped: Vec<u64>,
     load_average: String,
+    /// Rays traced, every kind (0 in rows saved before session 7, which did not keep it).
+    #[serde(default)]
+    rays: u64,
 }
 
 impl Run {
@@ -280,30 +284,83 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
             .map(|k| x(&format!("bh_level_{k}_skipped")))
             .collect(),
         load_average,
+        rays: r.stats.total,
     })
 }
 
-fn measure_row(scene: &str, sf: u32, thesis_row: bool, s: &Setup) -> Result<Measured> {
+/// One method's run, saved on its own (`{key}.{method}`) as soon as it finishes, so that a row of
+/// hours resumed in another session does not trace its finished methods again.
+fn method(
+    cp: &super::Checkpoint,
+    key: &str,
+    name: &str,
+    run: impl FnOnce() -> Result<Run>,
+) -> Result<Run> {
+    let k = format!("{key}.{name}");
+    if let Some(r) = cp.load::<Run>(&k)? {
+        eprintln!("nakamaru-4.1: {key}: {name} saved by an earlier run");
+        return Ok(r);
+    }
+    let r = run()?;
+    cp.save(&k, &r)?;
+    Ok(r)
+}
+
+fn measure_row(
+    scene: &str,
+    sf: u32,
+    thesis_row: bool,
+    s: &Setup,
+    cp: &super::Checkpoint,
+    key: &str,
+) -> Result<Measured> {
     let src = resolve(scene, sf)?;
     let spill = SpillDir::create(s.spill.map(Path::new)).map_err(input)?;
     let basic_dir = spill.path().join("basic");
-    eprintln!("nakamaru-4.1: {scene}{sf}: basic store …");
-    let (hb, _) = write_store(&src, &basic_dir, Layout::Basic)?;
-    eprintln!("nakamaru-4.1: {scene}{sf}: basic ({} objects) …", hb.objects);
-    let basic = trace(&basic_dir, s, &[("layout", "basic")])?;
-    std::fs::remove_dir_all(&basic_dir).map_err(|e| input(e.to_string()))?;
+    // The basic store's size is saved with its run (`basic_bytes`), so a resumed row need not
+    // write the basic store again.
+    #[derive(Serialize, Deserialize)]
+    struct BasicStep {
+        bytes: u64,
+        run: Run,
+    }
+    let basic_key = format!("{key}.basic");
+    let basic_step = match cp.load::<BasicStep>(&basic_key)? {
+        Some(b) => {
+            eprintln!("nakamaru-4.1: {key}: basic saved by an earlier run");
+            b
+        }
+        None => {
+            eprintln!("nakamaru-4.1: {scene}{sf}: basic store …");
+            let (hb, _) = write_store(&src, &basic_dir, Layout::Basic)?;
+            eprintln!("nakamaru-4.1: {scene}{sf}: basic ({} objects) …", hb.objects);
+            let run = trace(&basic_dir, s, &[("layout", "basic")])?;
+            std::fs::remove_dir_all(&basic_dir).map_err(|e| input(e.to_string()))?;
+            let b = BasicStep {
+                bytes: hb.geometry_bytes,
+                run,
+            };
+            cp.save(&basic_key, &b)?;
+            b
+        }
+    };
     let split_dir = spill.path().join("split");
     let (hs, generation_s) = write_store(&src, &split_dir, Layout::Split)?;
-    eprintln!("nakamaru-4.1: {scene}{sf}: S+G …");
-    let sg = trace(&split_dir, s, &[("layout", "split")])?;
-    eprintln!("nakamaru-4.1: {scene}{sf}: S+G+B …");
-    let sgb = trace(&split_dir, s, &[("layout", "split"), ("hierarchy", "on")])?;
+    let sg = method(cp, key, "sg", || {
+        eprintln!("nakamaru-4.1: {scene}{sf}: S+G …");
+        trace(&split_dir, s, &[("layout", "split")])
+    })?;
+    let sgb = method(cp, key, "sgb", || {
+        eprintln!("nakamaru-4.1: {scene}{sf}: S+G+B …");
+        trace(&split_dir, s, &[("layout", "split"), ("hierarchy", "on")])
+    })?;
+    let basic = basic_step.run;
     Ok(Measured {
         scene: scene.to_string(),
         sf,
         thesis_row,
         objects: hs.objects,
-        basic_bytes: hb.geometry_bytes,
+        basic_bytes: basic_step.bytes,
         split_bytes: hs.bbox_bytes + hs.geometry_bytes,
         generation_s,
         basic,
@@ -364,7 +421,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
                 m
             }
             None => {
-                let m = measure_row(&scene, sf, thesis, &setup)?;
+                let m = measure_row(&scene, sf, thesis, &setup, ctx.checkpoint, &key)?;
                 ctx.checkpoint.save(&key, &m)?;
                 m
             }
@@ -372,8 +429,19 @@ fn run(ctx: &Ctx) -> Result<Output> {
         measured.push(m);
     }
     let rows = rows(&p, &measured);
-    let doc = document(&p, &measured, &setup, ctx.quick);
-    Ok(Output::new(
+    let mut doc = document(&p, &measured, &setup, ctx.quick);
+    let points: Vec<SizePoint> = measured
+        .iter()
+        .map(|m| SizePoint {
+            scene: m.scene.clone(),
+            objects: m.objects,
+            seconds: [m.basic.total_s(), m.sg.total_s(), m.sgb.total_s()],
+            peak_rss: [m.basic.peak_rss_bytes, m.sg.peak_rss_bytes, m.sgb.peak_rss_bytes],
+        })
+        .collect();
+    per_ray_table(&mut doc, &points, size);
+    let charts = per_ray::charts(ctx.id, &points, size);
+    let mut out = Output::new(
         Result_ {
             id: ctx.id,
             published: raw,
@@ -385,7 +453,37 @@ fn run(ctx: &Ctx) -> Result<Output> {
         },
         rows,
         doc,
-    ))
+    );
+    out.charts = charts;
+    Ok(out)
+}
+
+/// Issue 19's benchmark in numbers: per scene, the time per eye ray at its smallest and largest
+/// row and the growth between them, per method (the plots are `plots/<id>-per-ray-<scene>.svg`).
+fn per_ray_table(doc: &mut Document, points: &[SizePoint], size: u32) {
+    let mut t = DocTable::new(
+        "Time per eye ray (preprocessing + tracing over the (size+1)² eye rays, each with its ray tree): smallest and largest row per scene, growth = largest / smallest",
+        &["scene", "objects", "basic µs", "S+G µs", "S+G+B µs", "growth basic / S+G / S+G+B"],
+    );
+    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
+    scenes.sort();
+    scenes.dedup();
+    for scene in scenes {
+        let mut ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
+        ps.sort_by_key(|p| p.objects);
+        let us = |p: &SizePoint, k: usize| format!("{:.0}", 1e6 * per_ray::per_eye_ray(p.seconds[k], size));
+        let (a, b) = (ps[0], ps[ps.len() - 1]);
+        let g = per_ray::growth(points, scene);
+        t.push(vec![
+            scene.to_string(),
+            if ps.len() > 1 { format!("{} → {}", a.objects, b.objects) } else { a.objects.to_string() },
+            format!("{} → {}", us(a, 0), us(b, 0)),
+            format!("{} → {}", us(a, 1), us(b, 1)),
+            format!("{} → {}", us(a, 2), us(b, 2)),
+            g.map_or("-".into(), |(_, _, g)| format!("{:.2} / {:.2} / {:.2}", g[0], g[1], g[2])),
+        ]);
+    }
+    doc.table(t);
 }
 
 fn ratio(a: f64, b: f64) -> f64 {

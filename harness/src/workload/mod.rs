@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod frustum;
 pub mod out_of_core;
 pub mod paging;
 pub mod pass_003;
@@ -10,6 +11,7 @@ pub mod replacement;
 pub mod surface;
 pub mod tiles;
 pub mod trace;
+pub mod view_file;
 
 use crate::error::{input, Result};
 use crate::source::Source;

@@ -208,13 +208,24 @@ pub fn render_tile(
     size: u32,
     tile: Option<crate::runs::shard::ShardSpec>,
 ) -> io::Result<OutOfCoreRender> {
+    render_view(engine, size, tile, None)
+}
+
+/// The same through another camera than the store's (`None`: the store's): a view the seed
+/// names but the scene's generator does not make, such as seed 000's rings368m (§4.4).
+pub fn render_view(
+    engine: &BreadthFirst,
+    size: u32,
+    tile: Option<crate::runs::shard::ShardSpec>,
+    view: Option<&rtbench_scenes::View>,
+) -> io::Result<OutOfCoreRender> {
     let start = Instant::now();
     let cpu_start = super::thread_cpu_seconds();
     let h = engine.header();
     let config = engine.config();
     let buffer = config.buffer as usize;
     let spill = SpillDir::create(config.spill.as_deref()).map_err(io::Error::other)?;
-    let camera = Camera::new(&h.view);
+    let camera = Camera::new(view.unwrap_or(&h.view));
     let w = size + 1;
     let n_corners = (w as usize) * (w as usize);
     let mut corners = vec![Vec3::ZERO; n_corners];

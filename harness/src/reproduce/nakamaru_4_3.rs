@@ -1,0 +1,744 @@
+//! `nakamaru-4.3`: seed 000's Tables 4.3 and 4.4, the massive scenes (§4.4): mount14
+//! (536,870,916 objects), rings368 and rings368m (1,000,787,041 objects; rings368m is rings368
+//! under a view that sees about 0.1% of them, ours in `data/views/rings368m.json`). Totals, and
+//! the split into preprocessing and tracing, of the basic method, S+G and S+G+B. As the thesis
+//! did here, every method uses the high-resolution grid (`grid=two-level`), so that only S, G
+//! and B differ.
+//!
+//! A row is a chain of steps, each saved as it finishes (`--resume`), so a row of days is done
+//! in sessions: the basic store (gzip-compressed: the basic method reads it strictly forward,
+//! §3.4) and the split store are written in segments (`rtbench_engines::store::segments`), each
+//! segment a checkpoint; `max-seconds=S` stops the run at the first checkpoint past S seconds
+//! (the report then says which steps are still to do). Where the basic method cannot be traced
+//! whole, `basic-fraction=N` traces every N-th band of image rows (a tile set, as
+//! `render --tile 1/N` makes it) and extrapolates its tracing time by the rows not traced: that
+//! row is labelled `model`, with the extrapolation written out. `--quick` runs small stand-ins
+//! (mount6, rings6, rings6m at 64×64) with the basic method both whole and on a quarter of the
+//! rows, which tests the model against a measurement.
+
+use super::published::{self, Source};
+use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
+use crate::commands::render::hex;
+use crate::error::{input, Result};
+use crate::runs::shard::ShardSpec;
+use crate::workload::frustum::Frustum;
+use crate::workload::view_file::ViewFile;
+use crate::workload::{self, out_of_core, tiles};
+use rtbench_engines::breadth_first::config::BreadthFirstConfig;
+use rtbench_engines::breadth_first::BreadthFirst;
+use rtbench_engines::store::{
+    BboxReader, Codec, Layout, Outcome, SegmentLog, SegmentedWriter, StoreHeader,
+};
+use rtbench_engines::Settings;
+use rtbench_reports::{Document, Table as DocTable};
+use rtbench_scenes::View;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+const ROWS: Param = Param {
+    key: "rows",
+    help: "rows, e.g. mount14,rings368m (default: the table's 3; --quick: mount6,rings6,rings6m); a trailing m is the rings368m view",
+};
+const SIZE: Param = Param {
+    key: "size",
+    help: "image size (default 512, 64 with --quick)",
+};
+const MEMORY: Param = Param {
+    key: "memory",
+    help: "engine memory budget (default 256MiB, the thesis's machine)",
+};
+const CACHE: Param = Param {
+    key: "cache",
+    help: "cold (default) or warm",
+};
+const STORES: Param = Param {
+    key: "stores",
+    help: "directory for the scene stores, kept between runs (default OUT/.partial/nakamaru-4.3/stores; removed when every row is done)",
+};
+const SPILL: Param = Param {
+    key: "spill",
+    help: "directory for spill files (default the system temp dir)",
+};
+const SEGMENT: Param = Param {
+    key: "segment",
+    help: "objects per store segment, each a checkpoint (default 16777216; --quick 1000)",
+};
+const MAX_SECONDS: Param = Param {
+    key: "max-seconds",
+    help: "stop at the first checkpoint after this many seconds (default: no limit)",
+};
+const FRACTION: Param = Param {
+    key: "basic-fraction",
+    help: "trace the basic method on every N-th band of rows only and extrapolate (a model; default 1: whole)",
+};
+
+pub const TABLE: Table = Table {
+    id: "nakamaru-4.3",
+    seed: "000",
+    source: "Tables 4.3, 4.4",
+    about: "000 (Nakamaru 2002) Tables 4.3/4.4: mount14, rings368, rings368m (5e8–1e9 objects), basic vs S+G vs S+G+B; resumable by store segment and step",
+    runtime: Runtime {
+        quick: "a minute",
+        full: "days to weeks (10^9 objects out of core, three methods); resumable by segment and step",
+    },
+    params: &[ROWS, SIZE, MEMORY, CACHE, STORES, SPILL, SEGMENT, MAX_SECONDS, FRACTION],
+    claims: &[
+        Claim {
+            key: "sgb-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; a basic method traced on a fraction of the rows makes the row a model",
+        },
+        Claim {
+            key: "sg-ratio",
+            fidelity: Fidelity::Substituted,
+            why: "as sgb-ratio",
+        },
+        Claim {
+            key: "basic-model",
+            fidelity: Fidelity::Model,
+            why: "basic tracing time extrapolated from a tile set of the image rows (--quick: against the whole image, measured)",
+        },
+        Claim {
+            key: "view",
+            fidelity: Fidelity::Substituted,
+            why: "the thesis does not give rings368m's camera; ours keeps rings' eye and narrows the angle (data/views/rings368m.json)",
+        },
+        Claim {
+            key: "memory",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+        Claim {
+            key: "image-equal",
+            fidelity: Fidelity::Faithful,
+            why: "",
+        },
+    ],
+    run,
+};
+
+const PUBLISHED: &str = include_str!("../../../data/published/nakamaru-4.3.json");
+const VIEW: &str = include_str!("../../../data/views/rings368m.json");
+
+#[derive(Deserialize)]
+struct Published {
+    source: Source,
+    improvement_range: [f64; 2],
+    rows: Vec<PublishedRow>,
+}
+
+#[derive(Deserialize, Serialize, Clone)]
+struct PublishedRow {
+    scene: String,
+    sf: u32,
+    view: String,
+    objects: u64,
+    basic_s: u64,
+    sg: f64,
+    sgb: f64,
+    pre_basic_s: u64,
+    trace_basic_s: u64,
+}
+
+/// One method's run.
+#[derive(Serialize, Deserialize, Clone, Default)]
+struct Run {
+    preprocess_s: f64,
+    trace_s: f64,
+    passes: u64,
+    rays: u64,
+    sha256: String,
+    peak_rss_bytes: u64,
+    /// The image rows traced (of size + 1) and the factor the tracing time was extrapolated by
+    /// (1: the whole image, measured).
+    rows_traced: u32,
+    scale: f64,
+    load_average: String,
+}
+
+impl Run {
+    /// Preprocessing + tracing, the tracing extrapolated when only a tile set was traced.
+    fn total_s(&self) -> f64 {
+        self.preprocess_s + self.trace_s * self.scale
+    }
+}
+
+/// A store written in segments: its seconds summed over sessions, its size.
+#[derive(Serialize, Deserialize, Clone, Default)]
+struct StoreStep {
+    objects: u64,
+    stored_bytes: u64,
+    seconds: f64,
+    segments: usize,
+}
+
+#[derive(Serialize, Deserialize, Clone, Default)]
+struct Measured {
+    row: String,
+    scene: String,
+    sf: u32,
+    view: String,
+    objects: u64,
+    objects_in_view: Option<u64>,
+    basic_store: Option<StoreStep>,
+    split_store: Option<StoreStep>,
+    basic: Option<Run>,
+    /// `--quick`: the basic method on a quarter of the rows, beside the whole (the model's test).
+    basic_tile: Option<Run>,
+    sg: Option<Run>,
+    sgb: Option<Run>,
+}
+
+#[derive(Serialize)]
+struct Result_ {
+    id: &'static str,
+    published: serde_json::Value,
+    measured: Vec<Measured>,
+    size: u32,
+    memory: String,
+    cache: String,
+    finished: bool,
+    environment: serde_json::Value,
+}
+
+struct Setup {
+    size: u32,
+    memory: String,
+    cache: String,
+    spill: Option<String>,
+    stores: PathBuf,
+    segment: u64,
+    deadline: Option<Instant>,
+    fraction: u32,
+    view: View,
+}
+
+fn reset_peak_rss() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Writes (or goes on writing) the store at `dir`; `None` when stopped by the deadline.
+fn write_store(
+    src: &crate::source::Source,
+    dir: &Path,
+    layout: Layout,
+    codec: Codec,
+    s: &Setup,
+) -> Result<Option<StoreStep>> {
+    let cannot = |e: std::io::Error| input(format!("{}: {e}", dir.display()));
+    let mut w = if SegmentLog::read(dir).map_err(cannot)?.is_some() {
+        SegmentedWriter::resume(dir, &src.label()).map_err(cannot)?
+    } else {
+        if dir.exists() {
+            std::fs::remove_dir_all(dir).map_err(cannot)?;
+        }
+        SegmentedWriter::start(dir, &src.label(), layout, codec, s.segment).map_err(cannot)?
+    };
+    if let Some(d) = s.deadline {
+        w = w.with_budget(d.saturating_duration_since(Instant::now()));
+    }
+    src.stream(&mut w)?;
+    let log = w.log().clone();
+    match w.finish().map_err(cannot)? {
+        Outcome::Stopped => Ok(None),
+        Outcome::Finished(_) => {
+            let h = StoreHeader::read(dir).map_err(|e| input(e.to_string()))?;
+            Ok(Some(StoreStep {
+                objects: h.objects,
+                stored_bytes: h.stored_bytes + h.bbox_bytes,
+                seconds: log.done.iter().map(|d| d.seconds).sum(),
+                segments: log.done.len(),
+            }))
+        }
+    }
+}
+
+fn trace(
+    dir: &Path,
+    s: &Setup,
+    view: Option<&View>,
+    tile: Option<ShardSpec>,
+    extra: &[(&str, &str)],
+) -> Result<Run> {
+    reset_peak_rss();
+    let load_average = super::grid_runs::load_average();
+    let mut pairs: Vec<(String, String)> = vec![
+        ("memory".into(), s.memory.clone()),
+        ("verify".into(), "records".into()),
+        ("cache".into(), s.cache.clone()),
+        ("grid".into(), "two-level".into()),
+    ];
+    if let Some(sp) = &s.spill {
+        pairs.push(("spill".into(), sp.clone()));
+    }
+    pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
+    let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    let t = Instant::now();
+    let engine = BreadthFirst::open(dir, config)?;
+    let preprocess_s = t.elapsed().as_secs_f64();
+    let ooc = out_of_core::render_view(&engine, s.size, tile, view)
+        .map_err(|e| input(format!("{}: out-of-core render: {e}", dir.display())))?;
+    let r = &ooc.render;
+    let rows_traced = match tile {
+        Some(t) => tiles::rows(t, s.size).len() as u32,
+        None => s.size + 1,
+    };
+    Ok(Run {
+        preprocess_s,
+        trace_s: r.trace_s,
+        passes: r.counters.extra.get("bf_passes").copied().unwrap_or(0),
+        rays: r.stats.total,
+        sha256: hex(&Sha256::digest(r.pixels())),
+        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        rows_traced,
+        scale: (s.size + 1) as f64 / rows_traced.max(1) as f64,
+        load_average,
+    })
+}
+
+/// Objects whose box reaches into `view`, read from the split store's `bbox.bin`.
+fn count_in_view(dir: &Path, view: &View, size: u32) -> Result<u64> {
+    let h = StoreHeader::read(dir).map_err(|e| input(e.to_string()))?;
+    let f = Frustum::new(view, size);
+    let mut r = BboxReader::open(dir, h.objects, 1 << 20).map_err(|e| input(e.to_string()))?;
+    let mut n = 0;
+    while let Some((_, b)) = r.next_record().map_err(|e| input(e.to_string()))? {
+        n += u64::from(f.sees(b.lo, b.hi));
+    }
+    Ok(n)
+}
+
+/// Whether the time budget (`max-seconds`) is spent: no further step starts.
+fn past(s: &Setup) -> bool {
+    s.deadline.is_some_and(|d| Instant::now() >= d)
+}
+
+/// Measures what is left of one row; returns whether it is complete.
+fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Result<bool> {
+    let cp = ctx.checkpoint;
+    let key = format!("{}-{}-{}-{}", m.row, s.size, s.memory, s.cache);
+    let save = |m: &Measured| cp.save(&key, m);
+    if let Some(saved) = cp.load::<Measured>(&key)? {
+        *m = saved;
+    }
+    let src = super::grid_runs::resolve(&m.scene, m.sf)?;
+    let store = |kind: &str| s.stores.join(format!("{}{}-{kind}", m.scene, m.sf));
+    let view = (m.view == "m").then_some(&s.view);
+    // The basic store, its run (whole or a tile set), then the split store and S+G, S+G+B.
+    if m.basic.is_none() {
+        if past(s) {
+            return Ok(false);
+        }
+        let dir = store("basic");
+        if m.basic_store.is_none() {
+            eprintln!("nakamaru-4.3: {}: basic store (gzip, in segments) …", m.row);
+            match write_store(&src, &dir, Layout::Basic, Codec::Gzip(1), s)? {
+                Some(st) => m.basic_store = Some(st),
+                None => return Ok(false),
+            }
+            save(m)?;
+        }
+        eprintln!("nakamaru-4.3: {}: basic …", m.row);
+        let basic_sets = [("layout", "basic")];
+        if ctx.quick {
+            let t = ShardSpec { k: 1, n: 4 };
+            m.basic_tile = Some(trace(&dir, s, view, Some(t), &basic_sets)?);
+        }
+        let tile = (s.fraction > 1).then_some(ShardSpec {
+            k: 1,
+            n: s.fraction,
+        });
+        m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
+        save(m)?;
+        if !keep_basic {
+            // The disk holds the basic and the split store of a 10^9-object scene only one
+            // after the other.
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+    }
+    for (name, sets) in [
+        ("S+G", &[("layout", "split")][..]),
+        ("S+G+B", &[("layout", "split"), ("hierarchy", "on")][..]),
+    ] {
+        let slot = if name == "S+G" { &m.sg } else { &m.sgb };
+        if slot.is_some() {
+            continue;
+        }
+        if past(s) {
+            return Ok(false);
+        }
+        let dir = store("split");
+        if m.split_store.is_none() {
+            eprintln!("nakamaru-4.3: {}: split store (in segments) …", m.row);
+            match write_store(&src, &dir, Layout::Split, Codec::None, s)? {
+                Some(st) => m.split_store = Some(st),
+                None => return Ok(false),
+            }
+            m.objects = m.split_store.as_ref().map_or(0, |st| st.objects);
+            save(m)?;
+        }
+        if view.is_some() && m.objects_in_view.is_none() {
+            m.objects_in_view = Some(count_in_view(&dir, &s.view, s.size)?);
+            save(m)?;
+        }
+        eprintln!("nakamaru-4.3: {}: {name} …", m.row);
+        let r = trace(&dir, s, view, None, sets)?;
+        if name == "S+G" {
+            m.sg = Some(r);
+        } else {
+            m.sgb = Some(r);
+        }
+        save(m)?;
+    }
+    Ok(true)
+}
+
+fn run(ctx: &Ctx) -> Result<Output> {
+    let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
+    let size = ctx
+        .params
+        .number::<u32>(SIZE.key, 1)?
+        .unwrap_or(if ctx.quick { 64 } else { 512 });
+    workload::check_size(size)?;
+    let fraction = ctx.params.number::<u32>(FRACTION.key, 1)?.unwrap_or(1);
+    let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;
+    let segment = ctx
+        .params
+        .number::<u64>(SEGMENT.key, 1)?
+        .unwrap_or(if ctx.quick { 1000 } else { 1 << 24 });
+    let view = ViewFile::parse(VIEW, "data/views/rings368m.json")?.view;
+    let out_stores = ctx
+        .params
+        .raw(STORES.key)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| ctx.checkpoint.dir().join("stores"));
+    let s = Setup {
+        size,
+        memory: ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string(),
+        cache: ctx.params.raw(CACHE.key).unwrap_or("cold").to_string(),
+        spill: ctx.params.raw(SPILL.key).map(str::to_string),
+        stores: out_stores,
+        segment,
+        deadline: max_seconds.map(|x| Instant::now() + Duration::from_secs_f64(x)),
+        fraction,
+        view,
+    };
+    let names: Vec<String> = match ctx.params.list(ROWS.key)? {
+        Some(l) => l,
+        None if ctx.quick => vec!["mount6".into(), "rings6".into(), "rings6m".into()],
+        None => p
+            .rows
+            .iter()
+            .map(|r| format!("{}{}{}", r.scene, r.sf, r.view))
+            .collect(),
+    };
+    let mut measured = Vec::new();
+    let mut finished = true;
+    let bases: Vec<String> = names
+        .iter()
+        .map(|n| n.strip_suffix('m').unwrap_or(n).to_string())
+        .collect();
+    for (i, name) in names.iter().enumerate() {
+        let keep_basic = bases[i + 1..].contains(&bases[i]);
+        let view = if name.ends_with('m') && name.starts_with("rings") {
+            "m"
+        } else {
+            ""
+        };
+        let base = name.strip_suffix(view).unwrap_or(name);
+        let rows = super::grid_runs::parse_rows(ctx.id, &[base.to_string()], &["mount", "rings"])?;
+        let (scene, sf) = rows[0].clone();
+        let mut m = Measured {
+            row: name.clone(),
+            scene,
+            sf,
+            view: view.to_string(),
+            ..Default::default()
+        };
+        if finished {
+            finished = measure_row(ctx, &mut m, &s, keep_basic)?;
+        } else if let Some(saved) = ctx.checkpoint.load::<Measured>(&format!(
+            "{}-{}-{}-{}",
+            m.row, s.size, s.memory, s.cache
+        ))? {
+            m = saved;
+        }
+        measured.push(m);
+    }
+    if finished {
+        // Stores no row still needs.
+        let _ = std::fs::remove_dir_all(&s.stores);
+    }
+    let rows = rows(&p, &measured, &s);
+    let doc = document(&p, &measured, &s, ctx.quick, finished);
+    Ok(Output::new(
+        Result_ {
+            id: ctx.id,
+            published: raw,
+            measured,
+            size,
+            memory: s.memory.clone(),
+            cache: s.cache.clone(),
+            finished,
+            environment: environment(1),
+        },
+        rows,
+        doc,
+    ))
+}
+
+fn ratio(a: f64, b: f64) -> f64 {
+    a / b.max(1e-9)
+}
+
+/// The extrapolation of a basic run, written out.
+fn model_text(r: &Run) -> String {
+    if r.scale == 1.0 {
+        format!("{:.1} s measured", r.total_s())
+    } else {
+        format!(
+            "pre {:.1} s + trace {:.1} s × {:.2} ({} of the rows traced) = {:.1} s",
+            r.preprocess_s,
+            r.trace_s,
+            r.scale,
+            r.rows_traced,
+            r.total_s()
+        )
+    }
+}
+
+fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for m in measured {
+        let pubrow = p
+            .rows
+            .iter()
+            .find(|r| r.scene == m.scene && r.sf == m.sf && r.view == m.view);
+        let note = if pubrow.is_some() {
+            String::new()
+        } else {
+            format!("{}: a smaller stand-in, not a row of the table", m.row)
+        };
+        let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
+        if let (Some(b), Some(sg), Some(sgb)) = (&m.basic, &m.sg, &m.sgb) {
+            let model = b.scale != 1.0;
+            let tag = if model { " (basic: model)" } else { "" };
+            for (claim, x, f) in [
+                ("sg-ratio", sg, (|r: &PublishedRow| r.sg) as fn(&PublishedRow) -> f64),
+                ("sgb-ratio", sgb, |r: &PublishedRow| r.sgb),
+            ] {
+                let v = ratio(b.total_s(), x.total_s());
+                let verdict = if claim == "sgb-ratio" && pubrow.is_some() {
+                    let [lo, hi] = p.improvement_range;
+                    Verdict::of((lo..=hi).contains(&v))
+                } else {
+                    Verdict::Shown
+                };
+                rows.push(
+                    Row::new(
+                        claim,
+                        m.row.clone(),
+                        if claim == "sgb-ratio" {
+                            format!("{} (text: 5–14)", shown(f))
+                        } else {
+                            shown(f)
+                        },
+                        format!("{:.1} s / {:.1} s = {v:.2}{tag}", b.total_s(), x.total_s()),
+                        Kind::Ratio,
+                        verdict,
+                    )
+                    .with_note(note.clone()),
+                );
+            }
+            let same = sg.sha256 == sgb.sha256 && (model || b.sha256 == sg.sha256);
+            rows.push(
+                Row::new(
+                    "image-equal",
+                    m.row.clone(),
+                    "equal",
+                    format!(
+                        "{}{} / {} / {}",
+                        if model { "(basic: a tile set, not compared) " } else { "" },
+                        &b.sha256[..12.min(b.sha256.len())],
+                        &sg.sha256[..12.min(sg.sha256.len())],
+                        &sgb.sha256[..12.min(sgb.sha256.len())]
+                    ),
+                    Kind::Count,
+                    Verdict::of(same),
+                )
+                .with_note(note.clone()),
+            );
+            let peak = b.peak_rss_bytes.max(sg.peak_rss_bytes).max(sgb.peak_rss_bytes);
+            rows.push(
+                Row::new(
+                    "memory",
+                    m.row.clone(),
+                    "256 MB machine; bound 320 MiB",
+                    format!("peak RSS {:.1} MiB", peak as f64 / 1048576.0),
+                    Kind::Ordering,
+                    Verdict::of(peak <= 320 << 20),
+                )
+                .with_note(note.clone()),
+            );
+            rows.push(
+                Row::new(
+                    "basic-model",
+                    m.row.clone(),
+                    pubrow.map_or("-".into(), |r| format!("{} s", r.basic_s)),
+                    model_text(b),
+                    Kind::Ratio,
+                    Verdict::Shown,
+                )
+                .with_note(note.clone()),
+            );
+        }
+        if let (Some(tile), Some(whole)) = (&m.basic_tile, &m.basic) {
+            // The model against the measurement it stands in for (`--quick`).
+            let e = ratio(tile.total_s(), whole.total_s());
+            rows.push(
+                Row::new(
+                    "basic-model",
+                    format!("{}: a quarter of the rows against the whole", m.row),
+                    "within 25% of the measured time",
+                    format!("{} against {:.1} s measured: {e:.2}", model_text(tile), whole.total_s()),
+                    Kind::Ratio,
+                    Verdict::of((0.75..=1.25).contains(&e)),
+                )
+                .with_note(note.clone()),
+            );
+        }
+        if m.view == "m" {
+            let measured = match m.objects_in_view {
+                Some(n) => format!(
+                    "{n} of {} ({:.3}%)",
+                    m.objects,
+                    100.0 * n as f64 / m.objects.max(1) as f64
+                ),
+                None => "not counted yet".into(),
+            };
+            rows.push(
+                Row::new(
+                    "view",
+                    m.row.clone(),
+                    "about 1,000,000 of 10^9 (0.1%)",
+                    measured,
+                    Kind::Ratio,
+                    match m.objects_in_view {
+                        Some(n) => {
+                            let f = n as f64 / m.objects.max(1) as f64;
+                            Verdict::of(pubrow.is_none() || (0.0005..=0.002).contains(&f))
+                        }
+                        None => Verdict::NotMeasured,
+                    },
+                )
+                .with_note(if pubrow.is_none() {
+                    format!("{}: at this size the view's share is not the thesis's; shown only", m.row)
+                } else {
+                    String::new()
+                }),
+            );
+        }
+        if m.sgb.is_none() {
+            rows.push(Row::new(
+                "sgb-ratio",
+                m.row.clone(),
+                shown(|r| r.sgb),
+                format!("steps still to run at {}×{}", s.size, s.size),
+                Kind::Ratio,
+                Verdict::NotMeasured,
+            ));
+        }
+    }
+    rows
+}
+
+fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finished: bool) -> Document {
+    let mut doc = Document::new("nakamaru-4.3: massive data, basic method vs S+G and S+G+B");
+    doc.paragraph(format!(
+        "Published: {}. Measured: `rtbench reproduce nakamaru-4.3{}`, {}×{}, engine memory {}, cache {}, high-resolution grid for every method (as the thesis), basic store gzip level 1 in segments of {} objects.{}",
+        p.source.cite(),
+        if quick { " --quick" } else { "" },
+        s.size,
+        s.size,
+        s.memory,
+        s.cache,
+        s.segment,
+        if finished { "" } else { " **Partial: stopped at a checkpoint; run again with --resume.**" }
+    ));
+    let mut t = DocTable::new(
+        "",
+        &[
+            "row", "objects", "in view", "basic store MB / s", "split store MB / s", "basic s (pre + trace)",
+            "S+G", "S+G+B", "thesis S+G", "thesis S+G+B", "passes", "peak RSS MiB",
+        ],
+    );
+    let secs = |r: &Option<Run>| r.as_ref().map_or("-".into(), |r| format!("{:.1}", r.total_s()));
+    for m in measured {
+        let pubrow = p
+            .rows
+            .iter()
+            .find(|r| r.scene == m.scene && r.sf == m.sf && r.view == m.view);
+        let st = |x: &Option<StoreStep>| {
+            x.as_ref()
+                .map_or("-".into(), |x| format!("{:.1} / {:.1}", x.stored_bytes as f64 / 1e6, x.seconds))
+        };
+        let r = |x: &Option<Run>| match (&m.basic, x) {
+            (Some(b), Some(x)) => format!("{:.2}", ratio(b.total_s(), x.total_s())),
+            _ => "-".into(),
+        };
+        let runs = [&m.basic, &m.sg, &m.sgb];
+        t.push(vec![
+            m.row.clone(),
+            m.objects.to_string(),
+            m.objects_in_view.map_or("-".into(), |n| n.to_string()),
+            st(&m.basic_store),
+            st(&m.split_store),
+            match &m.basic {
+                Some(b) if b.scale != 1.0 => format!("{} (model)", secs(&m.basic)),
+                _ => secs(&m.basic),
+            },
+            r(&m.sg),
+            r(&m.sgb),
+            pubrow.map_or("-".into(), |r| format!("{:.2}", r.sg)),
+            pubrow.map_or("-".into(), |r| format!("{:.2}", r.sgb)),
+            runs.iter()
+                .map(|r| r.as_ref().map_or("-".into(), |r| r.passes.to_string()))
+                .collect::<Vec<_>>()
+                .join("/"),
+            format!(
+                "{:.1}",
+                runs.iter()
+                    .filter_map(|r| r.as_ref().map(|r| r.peak_rss_bytes))
+                    .max()
+                    .unwrap_or(0) as f64
+                    / 1048576.0
+            ),
+        ]);
+    }
+    doc.table(t);
+    let mut split = DocTable::new(
+        "Preprocessing and tracing (Table 4.4's split), seconds; basic tracing extrapolated where marked",
+        &["row", "method", "preprocess s", "trace s", "rows traced", "scale", "rays", "image sha256", "load avg"],
+    );
+    for m in measured {
+        for (name, r) in [("basic", &m.basic), ("basic ¼ (quick)", &m.basic_tile), ("S+G", &m.sg), ("S+G+B", &m.sgb)] {
+            if let Some(r) = r {
+                split.push(vec![
+                    m.row.clone(),
+                    name.into(),
+                    format!("{:.2}", r.preprocess_s),
+                    format!("{:.2}", r.trace_s),
+                    format!("{} of {}", r.rows_traced, s.size + 1),
+                    format!("{:.2}", r.scale),
+                    r.rays.to_string(),
+                    format!("{}…", &r.sha256[..12.min(r.sha256.len())]),
+                    r.load_average.clone(),
+                ]);
+            }
+        }
+    }
+    doc.table(split);
+    doc
+}

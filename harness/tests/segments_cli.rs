@@ -1,0 +1,168 @@
+//! Seed 000 Table 4.3's groundwork from the command line (issue 19): a store written in segments
+//! across runs (`scene store --segment N --max-seconds S`, then `--resume`) renders as the store
+//! written at once; the rings368m view file counts objects in view; and `reproduce nakamaru-4.3`
+//! stops at a checkpoint under a time budget and finishes when resumed.
+
+mod common;
+
+use common::{expect_input_error, json, render_breadth_first, rtbench, Dir};
+use serde_json::Value;
+use std::path::Path;
+
+const VIEW: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/views/rings368m.json");
+
+#[test]
+fn a_store_written_in_segments_across_runs_renders_as_one_written_at_once() {
+    let d = Dir::new("seg-cli", "store");
+    let once = d.join("once");
+    let seg = d.join("seg");
+    json(&[
+        "scene",
+        "store",
+        "rings",
+        "--sf",
+        "2",
+        "-o",
+        &once,
+        "--layout",
+        "basic",
+        "--compress",
+        "gzip:1",
+        "--json",
+    ]);
+    let args = |resume: bool| {
+        let mut a = vec![
+            "scene",
+            "store",
+            "rings",
+            "--sf",
+            "2",
+            "-o",
+            &seg,
+            "--layout",
+            "basic",
+            "--compress",
+            "gzip:1",
+            "--segment",
+            "100",
+            "--max-seconds",
+            "0.000001",
+            "--json",
+        ];
+        if resume {
+            a.push("--resume");
+        }
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let run = |resume| {
+        let a = args(resume);
+        json(&a.iter().map(|s| s.as_str()).collect::<Vec<_>>())
+    };
+    let first = run(false);
+    assert_eq!(first["finished"], false);
+    assert_eq!(first["objects_on_disk"], 100);
+    // Not resumed: refused, the partial store kept.
+    let a = args(false);
+    expect_input_error(
+        &a.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        "--resume",
+    );
+    // 301 objects in segments of 100: runs 2 and 3 stop after 200 and 300, run 4 finishes.
+    let mut runs = vec![first];
+    while runs.last().unwrap()["finished"] == false {
+        runs.push(run(true));
+        assert!(runs.len() <= 4, "{runs:?}");
+    }
+    assert_eq!(runs.len(), 4);
+    assert_eq!(runs[3]["objects_on_disk"], 301);
+    assert_eq!(runs[3]["this_run"]["skipped_objects"], 300);
+    let a = render_breadth_first(&once, &["layout=basic"]);
+    let b = render_breadth_first(&seg, &["layout=basic"]);
+    assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
+    expect_input_error(
+        &[
+            "scene",
+            "store",
+            "rings",
+            "--sf",
+            "2",
+            "-o",
+            &d.join("x"),
+            "--segment",
+            "10",
+            "--hierarchy",
+        ],
+        "--hierarchy",
+    );
+}
+
+#[test]
+fn the_rings368m_view_sees_a_small_share_of_rings() {
+    let whole = json(&["scene", "stats", "rings", "--sf", "6", "--json"]);
+    let v = json(&[
+        "scene", "stats", "rings", "--sf", "6", "--view", VIEW, "--json",
+    ]);
+    assert_eq!(v["objects"], whole["objects"]);
+    let n = v["objects_in_view"].as_u64().unwrap();
+    assert!(n > 0 && n < v["objects"].as_u64().unwrap() / 10, "{v}");
+    let d = Dir::new("seg-cli", "view");
+    let bad = d.join("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"view": {"from": [0,0,0], "at": [0,0,0], "up": [0,0,1], "angle": 10}}"#,
+    )
+    .unwrap();
+    expect_input_error(
+        &["scene", "stats", "rings", "--sf", "2", "--view", &bad],
+        "from ≠ at",
+    );
+}
+
+#[test]
+fn nakamaru_4_3_stops_at_a_checkpoint_and_finishes_resumed() {
+    let d = Dir::new("seg-cli", "repro");
+    let out = d.join("out");
+    let sets = [
+        "rows=mount4,rings2m",
+        "size=16",
+        "segment=100",
+        "cache=warm",
+    ];
+    let run = |extra: &[&str], resume: bool| -> Value {
+        let mut args = vec!["reproduce", "nakamaru-4.3", "--out", &out];
+        if resume {
+            args.push("--resume");
+        }
+        for s in sets.iter().chain(extra) {
+            args.push("--set");
+            args.push(s);
+        }
+        let r = rtbench(&args);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        serde_json::from_slice(&std::fs::read(Path::new(&out).join("nakamaru-4.3.json")).unwrap())
+            .unwrap()
+    };
+    let partial = run(&["max-seconds=0.000001"], false);
+    assert_eq!(partial["finished"], false, "{partial}");
+    let done = run(&["basic-fraction=2"], true);
+    assert_eq!(done["finished"], true);
+    let rows = done["rows"].as_array().unwrap();
+    assert!(rows.iter().all(|r| r["fidelity"].is_string()));
+    let image: Vec<&Value> = rows
+        .iter()
+        .filter(|r| r["claim"] == "image-equal")
+        .collect();
+    assert_eq!(image.len(), 2);
+    assert!(image.iter().all(|r| r["verdict"] == "holds"), "{image:?}");
+    let m = &done["measured"];
+    assert!(m[1]["objects_in_view"].as_u64().unwrap() > 0);
+    // The basic method was traced on half the bands of rows and extrapolated: a model.
+    let basic = &m[0]["basic"];
+    assert!(basic["scale"].as_f64().unwrap() > 1.0, "{basic}");
+    assert!(rows
+        .iter()
+        .any(|r| r["claim"] == "basic-model" && r["fidelity"] == "model"));
+    assert!(!Path::new(&out)
+        .join(".partial/nakamaru-4.3/stores")
+        .exists());
+}
