@@ -78,6 +78,8 @@ mod hierarchy_tests;
 #[cfg(test)]
 mod hires_tests;
 #[cfg(test)]
+mod layout_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
@@ -277,7 +279,8 @@ impl BreadthFirst {
         };
         let mut plan = None;
         let mut hr_stats = BTreeMap::new();
-        // The grid takes about one voxel per primitive (5 bytes each: flags and a list head).
+        // The grid takes about one voxel per primitive (5 bytes each: flags and where its rays
+        // begin in the registrations grouped by voxel).
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
         // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
         let voxel_target = grid_n.min(config.memory / 2 / 5).max(1);
@@ -308,7 +311,7 @@ impl BreadthFirst {
                     hires::reg_bytes(),
                 )
             }
-            _ => (nvox * 5, intersect::reg_bytes()),
+            _ => (nvox * 5, voxels::reg_bytes()),
         };
         if grid_bytes > config.memory {
             return Err(err(format!(
@@ -452,13 +455,12 @@ impl BreadthFirst {
         let is_hr = hires.is_some();
         let work = Work {
             extent: if extent.is_finite() { extent } else { 0.0 },
-            head: vec![u32::MAX; if is_hr { 0 } else { voxels.count() }],
-            voxels,
-            regs: Vec::with_capacity(if is_hr {
-                0
+            registered: if is_hr {
+                voxels::Registrations::new(0, 0)
             } else {
-                capacity * initial as usize
-            }),
+                voxels::Registrations::new(voxels.count(), capacity * initial as usize)
+            },
+            voxels,
             regs_capacity: capacity * initial as usize,
             slots: Vec::with_capacity(capacity),
             capacity,
@@ -473,6 +475,7 @@ impl BreadthFirst {
             scene,
             record: ObjectRecord::default(),
             floor,
+            floor_tests: 0,
             tree,
             cold: config.cold,
             hires,
@@ -508,6 +511,10 @@ impl BreadthFirst {
         let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
         let before = w.io();
         let r = w.trace(rays, any, self.config.triangle, out, c);
+        let floor_tests = std::mem::take(&mut w.floor_tests);
+        if floor_tests > 0 {
+            *c.extra.entry("bf_floor_tests".into()).or_insert(0) += floor_tests;
+        }
         if let Some(t) = w.tree.as_mut() {
             hierarchy::report(t, c);
         }
