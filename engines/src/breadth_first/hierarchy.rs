@@ -209,7 +209,7 @@ impl Work {
                 .unwrap_or(false);
         }
         let cells: u64 = (0..3).map(|i| (z[i] - a[i] + 1) as u64).product();
-        if cells > self.registered.len() as u64 {
+        if cells > self.registered.count() as u64 {
             let [rx, ry, _] = g.lattice.res;
             return self.registered.regs.iter().any(|reg| {
                 let v = reg.voxel;

@@ -115,7 +115,8 @@ pub struct Tally {
 #[repr(C, align(64))]
 pub struct Slot {
     pub(super) boxray: BoxRay,
-    /// Nearest hit so far; `t` also ends the segment still searched.
+    /// The t of the nearest hit so far (at first the segment's end): ends the segment still
+    /// searched.
     pub(super) best_t: f32,
     /// Last object tested (the mailbox, on the ray's side).
     mailbox: u32,
@@ -126,6 +127,7 @@ pub struct Slot {
     /// The walk ended (left the grid or the segment) during registration.
     pub(super) exhausted: bool,
     pub(super) ray: Ray,
+    /// Nearest hit so far.
     pub(super) best: Hit,
     /// The walk is swept up to here once this pass's sweep is done.
     pub(super) covered: f32,
@@ -135,8 +137,8 @@ pub struct Slot {
     pub(super) dda: Dda,
 }
 
-// The visit's fields fill the first cache line and no more; the slot's size is the 256 bytes
-// the memory budget has counted per ray since seed 000's engine was written.
+// The visit's fields fill the first cache line and no more; the slot keeps the 256 bytes the
+// memory budget counted per ray before this layout.
 const _: () = assert!(std::mem::offset_of!(Slot, ray) == 64);
 const _: () = assert!(std::mem::size_of::<Slot>() == 256);
 
@@ -171,8 +173,8 @@ impl BoxRay {
 
     /// [`crate::geometry::aabb::Aabb::slab`]`(self, tmin, tmax).is_some()` for the box of
     /// `planes`: the same answer for every box and every traceable ray ([`Ray::is_traceable`]),
-    /// in fewer instructions (the sweep makes this test once per ray and object it does not skip,
-    /// seed 000 §3.3):
+    /// without a NaN test per plane (the sweep makes this test once per ray and object it does not
+    /// skip, seed 000 §3.3):
     /// - the near plane of an axis is the upper one where `rdir` is negative, as
     ///   `SlabRay::negative` says; `rdir` is never zero or NaN (`SlabRay::new` clamps tiny
     ///   components), so its sign bit says the same and indexes the plane without a branch;
@@ -454,7 +456,7 @@ impl Work {
                 }
             }
         }
-        *c.extra.entry("bf_registrations".into()).or_insert(0) += self.registered.len() as u64;
+        *c.extra.entry("bf_registrations".into()).or_insert(0) += self.registered.count() as u64;
         self.registered.group();
     }
 

@@ -86,7 +86,7 @@ fn registrations_come_grouped_by_voxel_latest_first() {
             r.push(voxel, slot);
         }
         r.group();
-        assert_eq!(r.len(), 6);
+        assert_eq!(r.count(), 6);
         // A voxel's rays latest first, as a list whose new nodes went in at its head.
         assert_eq!(r.run(3, 3), &[2, 1, 0]);
         assert_eq!(r.run(1, 1), &[4, 0]);
@@ -95,7 +95,7 @@ fn registrations_come_grouped_by_voxel_latest_first() {
         // A run of voxels is their lists one after the other.
         assert_eq!(r.run(0, 4), &[2, 4, 0, 2, 1, 0]);
         r.clear();
-        assert_eq!(r.len(), 0);
+        assert_eq!(r.count(), 0);
         assert_eq!(r.run(0, 4), &[] as &[u32]);
     }
 }

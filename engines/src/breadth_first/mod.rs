@@ -4,7 +4,8 @@
 //!
 //! Rays, not objects, are registered in a uniform grid; the scene is streamed from disk once per
 //! pass, sequentially, so its size never makes the engine thrash. Files, one concept each:
-//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4),
+//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4, and the
+//! rays registered per voxel in a pass),
 //! [`intersect`] (passes, registration, the sweep: Algorithm 3.5), [`spill`] (the temporary
 //! store of an in-memory scene). The resumable walk each ray keeps between passes is the shared
 //! 3D-DDA ([`crate::geometry::dda`]), the `grid` engine's, so both engines visit the same cells.

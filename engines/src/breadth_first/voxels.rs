@@ -171,7 +171,8 @@ impl Registrations {
         self.first[voxel as usize] += 1;
     }
 
-    pub fn len(&self) -> usize {
+    /// Registrations made this pass.
+    pub fn count(&self) -> usize {
         self.regs.len()
     }
 
