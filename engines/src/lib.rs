@@ -26,6 +26,8 @@ pub mod plugin;
 pub mod ray;
 pub mod reference;
 pub mod store;
+#[cfg(test)]
+mod test_support;
 pub mod testing;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};

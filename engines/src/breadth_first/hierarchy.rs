@@ -14,9 +14,8 @@
 //! Reading checks that each box read lies in its parent's and that siblings' children follow one
 //! another: a hierarchy that disagrees with its level below is an error, not a silent miss.
 
-use super::intersect::{Tally, Work, NONE};
+use super::intersect::{BoxRay, Tally, Work};
 use crate::engine::Counters;
-use crate::geometry::aabb::Aabb;
 use crate::geometry::TriangleTest;
 use crate::store::hierarchy::NODE_RECORD;
 use crate::store::hierarchy::{disagree, Hierarchy, LevelReader, NodeRecord};
@@ -193,14 +192,14 @@ impl Work {
         }
         let g = &self.voxels;
         let (a, z) = g.range(n.lo, n.hi);
-        let aabb = Aabb::new(n.lo - g.pad, n.hi + g.pad);
+        let planes = BoxRay::planes(n.lo - g.pad, n.hi + g.pad);
         let mut hits = |slot: u32| {
             let s = &self.slots[slot as usize];
             if any && s.best.is_hit() {
                 return false;
             }
             lt.ray_tests += 1;
-            aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_some()
+            s.boxray.hits(&planes, s.best_t)
         };
         if let Some(h) = &self.hires {
             // The two-level registration grid (§4.3.3).
@@ -210,9 +209,9 @@ impl Work {
                 .unwrap_or(false);
         }
         let cells: u64 = (0..3).map(|i| (z[i] - a[i] + 1) as u64).product();
-        if cells > self.regs.len() as u64 {
+        if cells > self.registered.count() as u64 {
             let [rx, ry, _] = g.lattice.res;
-            return self.regs.iter().any(|reg| {
+            return self.registered.regs.iter().any(|reg| {
                 let v = reg.voxel;
                 let p = [v % rx, (v / rx) % ry, v / (rx * ry)];
                 (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) && hits(reg.slot)
@@ -221,15 +220,11 @@ impl Work {
         for cz in a[2]..=z[2] {
             for cy in a[1]..=z[1] {
                 let row = g.lattice.index([0, cy, cz]);
-                for cx in a[0]..=z[0] {
-                    let mut r = self.head[row + cx as usize];
-                    while r != NONE {
-                        let reg = self.regs[r as usize];
-                        r = reg.next;
-                        if hits(reg.slot) {
-                            return true;
-                        }
-                    }
+                let run = self
+                    .registered
+                    .run(row + a[0] as usize, row + z[0] as usize);
+                if run.iter().any(|&slot| hits(slot)) {
+                    return true;
                 }
             }
         }

@@ -9,65 +9,12 @@ use crate::store::hierarchy::{
 };
 use crate::store::tests::TempDir;
 use crate::store::FILE_HEADER;
-use crate::{build_engine, Counters, Engine, Hit, Ray};
-use rtbench_scenes::generate_scene;
-use rtbench_scenes::spd::{Options, Program};
-use std::sync::Arc;
+use crate::test_support::{answers, kv, rays_around, spd};
+use crate::{build_engine, Counters, Ray};
+use rtbench_scenes::spd::Program;
 
-fn spd(program: Program, sf: u32) -> BuildInput {
-    let scene = generate_scene(
-        program,
-        &Options {
-            size_factor: sf,
-            ..Options::standard(program)
-        },
-    )
-    .unwrap();
-    BuildInput {
-        geometry: Arc::new(Geometry::from_scene(&scene)),
-        scene: Arc::new(scene),
-    }
-}
-
-fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
-    pairs
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect()
-}
-
-/// Rays from the camera's eye through a jittered lattice of directions, and from points around
-/// the scene to points in it (closest and any hit).
 fn rays(g: &Geometry, n: usize) -> (Vec<Ray>, Vec<Ray>) {
-    let (lo, hi) = (g.bounds_min, g.bounds_max);
-    let mut s = 12345u64;
-    let mut unit = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let mut pt = |a: Vec3, b: Vec3| a + (b - a) * Vec3::new(unit(), unit(), unit());
-    let c = (lo + hi) * 0.5;
-    let h = (hi - lo) * 0.5;
-    let (mut closest, mut any) = (Vec::new(), Vec::new());
-    for _ in 0..n {
-        let o = pt(c - h * 1.5, c + h * 1.5);
-        let t = pt(lo, hi);
-        closest.push(Ray::new(o, (t - o).normalize(), 0.0, f32::INFINITY));
-        let a = pt(lo, hi);
-        let d = pt(lo, hi) - a;
-        any.push(Ray::new(a, d / d.length(), 0.0, d.length()));
-    }
-    (closest, any)
-}
-
-fn answers(e: &dyn Engine, r: &(Vec<Ray>, Vec<Ray>), c: &mut Counters) -> (Vec<Hit>, Vec<bool>) {
-    let mut hits = vec![Hit::MISS; r.0.len()];
-    let mut occ = vec![false; r.1.len()];
-    e.intersect(&r.0, &mut hits, c);
-    e.occluded(&r.1, &mut occ, c);
-    (hits, occ)
+    rays_around(g, n, 12345)
 }
 
 #[test]

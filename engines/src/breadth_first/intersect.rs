@@ -21,14 +21,15 @@
 //! - Hit records leave in completion order through `out(ray id, hit)`; the caller files them by
 //!   ray id (the thesis's sort by ray id).
 
-use super::voxels::{face_bit, Voxels, MARKED};
+use super::voxels::{face_bit, Registrations, Voxels, MARKED};
 use crate::engine::Counters;
-use crate::geometry::aabb::{Aabb, SlabRay};
+use crate::geometry::aabb::SlabRay;
 use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 use crate::store::{BboxRecord, IoCounters, ObjectRecord, SceneReader};
+use glam::Vec3;
 use std::io;
 
 #[inline]
@@ -40,9 +41,8 @@ pub(super) fn face_bit_of(entered: u8) -> u8 {
 /// registrations, and the two files.
 pub struct Work {
     pub(super) voxels: Voxels,
-    /// Per voxel, the first registration of its list.
-    pub(super) head: Vec<u32>,
-    pub(super) regs: Vec<Reg>,
+    /// The rays registered in each voxel this pass.
+    pub(super) registered: Registrations,
     pub(super) regs_capacity: usize,
     pub(super) slots: Vec<Slot>,
     /// Rays in memory at most.
@@ -57,6 +57,9 @@ pub struct Work {
     pub(super) record: ObjectRecord,
     /// The floor group: (object id, its record), held in memory.
     pub(super) floor: Vec<(u32, ObjectRecord)>,
+    /// Primitive tests of the floor group not yet in the counters (`bf_floor_tests`): counted
+    /// here and added once per call, as a lookup of that key per test cost more than the test.
+    pub(super) floor_tests: u64,
     /// Largest absolute coordinate of the scene: the conservative slab test's rounding bound.
     pub(super) extent: f32,
     /// The bounding-box hierarchy's level files (`hierarchy=on`; §4.2.2 "B").
@@ -64,7 +67,7 @@ pub struct Work {
     /// Drop the store from the page cache after every sweep (`cache=cold`).
     pub(super) cold: bool,
     /// The high-resolution grid (`grid=two-level`, §4.3): its flags on disk, rays registered in
-    /// its two-level grid; `voxels` then holds the grid's frame only, and `head` nothing.
+    /// its two-level grid; `voxels` then holds the grid's frame only, and `registered` nothing.
     pub(super) hires: Option<super::hires::HiRes>,
 }
 
@@ -92,9 +95,6 @@ impl Work {
     }
 }
 
-/// No registration: the end of a voxel's list.
-pub(super) const NONE: u32 = u32::MAX;
-
 /// What one sweep counted.
 #[derive(Default)]
 pub struct Tally {
@@ -105,42 +105,103 @@ pub struct Tally {
 }
 
 /// One ray in memory (seed 000 §1.3's per-ray data).
+///
+/// Laid out for the sweep: the first 64 bytes (one cache line, the struct being aligned to one)
+/// hold all that a visit of [`Work::object`] reads for a ray whose box test fails or is skipped
+/// (the box ray, `best_t`, the mailbox, the previous voxel, the any-hit flag); the rest is read
+/// only on a box hit or between passes. The size stays what it was with Rust's field order
+/// (256 bytes), so the rays a memory budget holds, and with them the passes, do not change.
 #[derive(Clone, Copy)]
+#[repr(C, align(64))]
 pub struct Slot {
-    pub(super) id: u32,
-    pub(super) ray: Ray,
-    pub(super) slab: SlabRay,
-    wt: WatertightRay,
-    pub(super) dda: Dda,
-    /// Nearest hit so far; `t` also ends the segment still searched.
-    pub(super) best: Hit,
+    pub(super) boxray: BoxRay,
+    /// The t of the nearest hit so far (at first the segment's end): ends the segment still
+    /// searched.
     pub(super) best_t: f32,
     /// Last object tested (the mailbox, on the ray's side).
     mailbox: u32,
     /// The last voxel registered in the previous pass, and in this one (`[u32::MAX; 3]`: none).
     pub(super) prev: [u32; 3],
-    pub(super) last: [u32; 3],
-    /// The walk is swept up to here once this pass's sweep is done.
-    pub(super) covered: f32,
+    /// `best.is_hit()`, kept beside the mailbox for the any-hit check of every visit.
+    has_hit: bool,
     /// The walk ended (left the grid or the segment) during registration.
     pub(super) exhausted: bool,
+    pub(super) ray: Ray,
+    /// Nearest hit so far.
+    pub(super) best: Hit,
+    /// The walk is swept up to here once this pass's sweep is done.
+    pub(super) covered: f32,
+    pub(super) id: u32,
+    pub(super) last: [u32; 3],
+    wt: WatertightRay,
+    pub(super) dda: Dda,
 }
 
-/// One registration of a ray in a voxel: a link of that voxel's list.
+// The visit's fields fill the first cache line and no more; the slot keeps the 256 bytes the
+// memory budget counted per ray before this layout.
+const _: () = assert!(std::mem::offset_of!(Slot, ray) == 64);
+const _: () = assert!(std::mem::size_of::<Slot>() == 256);
+
+/// The ray as the sweep's box test reads it: [`SlabRay`]'s inverse direction and conservative
+/// `origin × inverse` terms (the near plane picked by the sign of `rdir`, as `SlabRay::negative`
+/// is), and the segment's start.
 #[derive(Clone, Copy)]
-pub struct Reg {
-    pub(super) voxel: u32,
-    pub(super) slot: u32,
-    pub(super) next: u32,
+pub struct BoxRay {
+    rdir: [f32; 3],
+    org_rdir_near: [f32; 3],
+    org_rdir_far: [f32; 3],
+    tmin: f32,
+}
+
+impl BoxRay {
+    pub fn new(ray: &Ray, extent: f32) -> BoxRay {
+        let s = SlabRay::new(ray, extent);
+        BoxRay {
+            rdir: s.rdir.to_array(),
+            org_rdir_near: s.org_rdir_near.to_array(),
+            org_rdir_far: s.org_rdir_far.to_array(),
+            tmin: ray.tmin,
+        }
+    }
+
+    /// A box's six planes in the order lo x, hi x, lo y, hi y, lo z, hi z: what
+    /// [`BoxRay::hits`] takes, made once per box.
+    #[inline(always)]
+    pub fn planes(lo: Vec3, hi: Vec3) -> [f32; 6] {
+        [lo.x, hi.x, lo.y, hi.y, lo.z, hi.z]
+    }
+
+    /// [`crate::geometry::aabb::Aabb::slab`]`(self, tmin, tmax).is_some()` for the box of
+    /// `planes`: the same answer for every box and every traceable ray ([`Ray::is_traceable`]),
+    /// without a NaN test per plane (the sweep makes this test once per ray and object it does not
+    /// skip, seed 000 §3.3):
+    /// - the near plane of an axis is the upper one where `rdir` is negative, as
+    ///   `SlabRay::negative` says; `rdir` is never zero or NaN (`SlabRay::new` clamps tiny
+    ///   components), so its sign bit says the same and indexes the plane without a branch;
+    /// - each `if x > acc { x } else { acc }` keeps `acc` when `x` is NaN (an overflow's ∞ − ∞),
+    ///   as `f32::max` ignores a NaN, and `acc`, starting at tmin or tmax (never NaN for a
+    ///   traceable ray), never is one; so no NaN test is made per plane.
+    #[inline(always)]
+    pub fn hits(&self, planes: &[f32; 6], tmax: f32) -> bool {
+        let (mut near, mut far) = (self.tmin, tmax);
+        let mut axis = |i: usize| {
+            let r = self.rdir[i];
+            let n = 2 * i + (r.to_bits() >> 31) as usize;
+            let tn = planes[n] * r - self.org_rdir_near[i];
+            let tf = planes[n ^ 1] * r - self.org_rdir_far[i];
+            near = if tn > near { tn } else { near };
+            far = if tf < far { tf } else { far };
+        };
+        axis(0);
+        axis(1);
+        axis(2);
+        near <= far
+    }
 }
 
 /// Bytes one ray in memory takes (slot and its registrations), for the memory budget.
 pub fn slot_bytes() -> u64 {
     std::mem::size_of::<Slot>() as u64
-}
-
-pub fn reg_bytes() -> u64 {
-    std::mem::size_of::<Reg>() as u64
 }
 
 /// With `boundary` off every marked voxel is a candidate.
@@ -160,6 +221,81 @@ fn first_candidate(g: &Voxels, d: &mut Dda, boundary: bool, c: &mut Counters) ->
         }
         if !d.advance(g.lattice.res) {
             return false;
+        }
+    }
+}
+
+/// One object of the sweep, as each ray registered where its box reaches meets it.
+struct Visit {
+    id: u32,
+    /// The box of voxels the object's box reaches: its first voxel and its extent − 1.
+    a: [u32; 3],
+    span: [u32; 3],
+    /// The object's box, padded as the grid pads it ([`BoxRay::planes`]).
+    planes: [f32; 6],
+    any: bool,
+    prev_skip: bool,
+}
+
+impl Visit {
+    /// Whether the ray must meet the object's geometry: not for an any-hit ray already answered,
+    /// the mailbox (§3.3: the object was tested for this ray in another voxel), the previous-voxel
+    /// skip (§3.3: the ray's last voxel of the previous pass is in the object's box of voxels, so
+    /// it was tested then), or a missed box.
+    #[inline(always)]
+    fn needs(&self, s: &mut Slot, c: &mut Counters, t: &mut Tally) -> bool {
+        if self.any && s.has_hit {
+            return false;
+        }
+        if s.mailbox == self.id {
+            c.mailbox_skips += 1;
+            return false;
+        }
+        s.mailbox = self.id;
+        // One unsigned comparison per axis, without branches: a voxel below `a` wraps round past
+        // the span, and "none" (u32::MAX) is past every span.
+        let p = s.prev;
+        let inside = (p[0].wrapping_sub(self.a[0]) <= self.span[0])
+            & (p[1].wrapping_sub(self.a[1]) <= self.span[1])
+            & (p[2].wrapping_sub(self.a[2]) <= self.span[2]);
+        if self.prev_skip & inside {
+            t.prev_skips += 1;
+            return false;
+        }
+        c.box_tests += 1;
+        s.boxray.hits(&self.planes, s.best_t)
+    }
+}
+
+impl Slot {
+    /// The ray against object `id`'s primitives, keeping the nearest hit (any hit: the first).
+    #[inline(never)]
+    fn intersect(
+        &mut self,
+        id: u32,
+        record: &ObjectRecord,
+        any: bool,
+        test: TriangleTest,
+        c: &mut Counters,
+    ) {
+        let mut seg = self.ray;
+        for prim in &record.prims {
+            seg.tmax = self.best_t;
+            c.primitive_tests += 1;
+            if let Some((th, u, v)) = prim.intersect(&seg, test, &self.wt) {
+                c.primitive_hits += 1;
+                self.best_t = th;
+                self.best = Hit {
+                    t: th,
+                    object: id,
+                    u,
+                    v,
+                };
+                self.has_hit = true;
+                if any {
+                    break;
+                }
+            }
         }
     }
 }
@@ -219,7 +355,7 @@ impl Work {
     /// walk), then its walk starts where it enters the grid. `Err(best)`: the ray leaves now
     /// (an any-hit query met the floor, or the segment misses the grid).
     pub(super) fn admit(
-        &self,
+        &mut self,
         id: u32,
         ray: Ray,
         any: bool,
@@ -227,13 +363,18 @@ impl Work {
         c: &mut Counters,
     ) -> Result<Slot, Hit> {
         c.rays += 1;
+        if !ray.is_traceable() {
+            // As every engine answers it (`Ray::is_traceable`); it also keeps NaN out of the
+            // box test's accumulators (`BoxRay::hits`).
+            return Err(Hit::MISS);
+        }
         let wt = WatertightRay::new(ray.dir);
         let mut best = Hit::MISS;
         let mut seg = ray;
         'floor: for (fid, rec) in &self.floor {
             for prim in &rec.prims {
                 c.primitive_tests += 1;
-                *c.extra.entry("bf_floor_tests".into()).or_insert(0) += 1;
+                self.floor_tests += 1;
                 if let Some((t, u, v)) = prim.intersect(&seg, test, &wt) {
                     c.primitive_hits += 1;
                     seg.tmax = t;
@@ -256,18 +397,19 @@ impl Work {
             return Err(best);
         };
         Ok(Slot {
-            id,
-            ray,
-            slab: SlabRay::new(&ray, self.extent),
-            wt,
-            dda,
-            best,
+            boxray: BoxRay::new(&ray, self.extent),
             best_t: seg.tmax,
             mailbox: u32::MAX,
             prev: [u32::MAX; 3],
-            last: [u32::MAX; 3],
-            covered: f32::NEG_INFINITY,
+            has_hit: best.is_hit(),
             exhausted: false,
+            ray,
+            best,
+            covered: f32::NEG_INFINITY,
+            id,
+            last: [u32::MAX; 3],
+            wt,
+            dda,
         })
     }
 
@@ -290,13 +432,7 @@ impl Work {
             let mut k = 0;
             'walk: loop {
                 let v = s.dda.voxel();
-                let vi = g.lattice.index(v) as u32;
-                self.regs.push(Reg {
-                    voxel: vi,
-                    slot: si as u32,
-                    next: self.head[vi as usize],
-                });
-                self.head[vi as usize] = (self.regs.len() - 1) as u32;
+                self.registered.push(g.lattice.index(v) as u32, si as u32);
                 k += 1;
                 s.last = v;
                 s.covered = s.dda.t_exit();
@@ -320,7 +456,8 @@ impl Work {
                 }
             }
         }
-        *c.extra.entry("bf_registrations".into()).or_insert(0) += self.regs.len() as u64;
+        *c.extra.entry("bf_registrations".into()).or_insert(0) += self.registered.count() as u64;
+        self.registered.group();
     }
 
     /// One sequential sweep of the bounding-box file (Algorithm 3.5's "for all objects"), or of
@@ -347,10 +484,7 @@ impl Work {
                 self.object(id, &b, read, any, test, c, &mut t)?;
             }
         }
-        for reg in &self.regs {
-            self.head[reg.voxel as usize] = NONE;
-        }
-        self.regs.clear();
+        self.registered.clear();
         if let Some(h) = self.hires.as_mut() {
             h.reg.clear();
         }
@@ -383,68 +517,47 @@ impl Work {
             return Ok(());
         }
         let g = &self.voxels;
-        let prev_skip = self.prev_skip;
         let (a, z) = g.range(b.lo, b.hi);
-        let aabb = Aabb::new(b.lo - g.pad, b.hi + g.pad);
+        let v = Visit {
+            id,
+            a,
+            span: [0, 1, 2].map(|i| z[i] - a[i]),
+            planes: BoxRay::planes(b.lo - g.pad, b.hi + g.pad),
+            any,
+            prev_skip: self.prev_skip,
+        };
+        let (slots, scene, record) = (&mut self.slots, &mut self.scene, &mut self.record);
+        // Past the box: the geometry, read at the first ray that needs it.
         let mut loaded = read;
-        let (scene, record, slots) = (&mut self.scene, &mut self.record, &mut self.slots);
-        let mut visit = |slot: u32| -> io::Result<bool> {
-            let s = &mut slots[slot as usize];
-            if any && s.best.is_hit() {
-                return Ok(false);
-            }
-            if s.mailbox == id {
-                c.mailbox_skips += 1;
-                return Ok(false);
-            }
-            s.mailbox = id;
-            let p = s.prev;
-            if prev_skip && (0..3).all(|i| p[i] >= a[i] && p[i] <= z[i]) {
-                t.prev_skips += 1;
-                return Ok(false);
-            }
-            c.box_tests += 1;
-            if aabb.slab(&s.slab, s.ray.tmin, s.best_t).is_none() {
-                return Ok(false);
-            }
+        let mut hit = |s: &mut Slot, c: &mut Counters, t: &mut Tally| -> io::Result<()> {
             if !loaded {
                 scene.load(b, record)?;
                 loaded = true;
                 t.loads += 1;
             }
-            let mut seg = s.ray;
-            for prim in &record.prims {
-                seg.tmax = s.best_t;
-                c.primitive_tests += 1;
-                if let Some((th, u, v)) = prim.intersect(&seg, test, &s.wt) {
-                    c.primitive_hits += 1;
-                    s.best_t = th;
-                    s.best = Hit {
-                        t: th,
-                        object: id,
-                        u,
-                        v,
-                    };
-                    if any {
-                        break;
-                    }
-                }
-            }
-            Ok(false)
+            s.intersect(id, record, any, test, c);
+            Ok(())
         };
         if let Some(h) = &self.hires {
-            h.reg.for_each(a, z, visit)?;
+            h.reg.for_each(a, z, |slot| {
+                let s = &mut slots[slot as usize];
+                if v.needs(s, c, t) {
+                    hit(s, c, t)?;
+                }
+                Ok::<bool, io::Error>(false)
+            })?;
             return Ok(());
         }
         for cz in a[2]..=z[2] {
             for cy in a[1]..=z[1] {
                 let row = g.lattice.index([0, cy, cz]);
-                for cx in a[0]..=z[0] {
-                    let mut r = self.head[row + cx as usize];
-                    while r != NONE {
-                        let reg = self.regs[r as usize];
-                        r = reg.next;
-                        visit(reg.slot)?;
+                for &slot in self
+                    .registered
+                    .run(row + a[0] as usize, row + z[0] as usize)
+                {
+                    let s = &mut slots[slot as usize];
+                    if v.needs(s, c, t) {
+                        hit(s, c, t)?;
                     }
                 }
             }

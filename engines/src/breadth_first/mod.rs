@@ -4,7 +4,8 @@
 //!
 //! Rays, not objects, are registered in a uniform grid; the scene is streamed from disk once per
 //! pass, sequentially, so its size never makes the engine thrash. Files, one concept each:
-//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4),
+//! [`config`] (settings), [`voxels`] (the marked grid and face flags, Algorithm 3.4, and the
+//! rays registered per voxel in a pass),
 //! [`intersect`] (passes, registration, the sweep: Algorithm 3.5), [`spill`] (the temporary
 //! store of an in-memory scene). The resumable walk each ray keeps between passes is the shared
 //! 3D-DDA ([`crate::geometry::dda`]), the `grid` engine's, so both engines visit the same cells.
@@ -77,6 +78,8 @@ pub mod voxels;
 mod hierarchy_tests;
 #[cfg(test)]
 mod hires_tests;
+#[cfg(test)]
+mod layout_tests;
 #[cfg(test)]
 mod tests;
 
@@ -277,7 +280,8 @@ impl BreadthFirst {
         };
         let mut plan = None;
         let mut hr_stats = BTreeMap::new();
-        // The grid takes about one voxel per primitive (5 bytes each: flags and a list head).
+        // The grid takes about one voxel per primitive (5 bytes each: flags and where its rays
+        // begin in the registrations grouped by voxel).
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
         // the rest stays for rays (seed 000 §1.2 sizes its grid to the machine's memory too).
         let voxel_target = grid_n.min(config.memory / 2 / 5).max(1);
@@ -308,7 +312,7 @@ impl BreadthFirst {
                     hires::reg_bytes(),
                 )
             }
-            _ => (nvox * 5, intersect::reg_bytes()),
+            _ => (nvox * 5, voxels::reg_bytes()),
         };
         if grid_bytes > config.memory {
             return Err(err(format!(
@@ -452,13 +456,12 @@ impl BreadthFirst {
         let is_hr = hires.is_some();
         let work = Work {
             extent: if extent.is_finite() { extent } else { 0.0 },
-            head: vec![u32::MAX; if is_hr { 0 } else { voxels.count() }],
-            voxels,
-            regs: Vec::with_capacity(if is_hr {
-                0
+            registered: if is_hr {
+                voxels::Registrations::new(0, 0)
             } else {
-                capacity * initial as usize
-            }),
+                voxels::Registrations::new(voxels.count(), capacity * initial as usize)
+            },
+            voxels,
             regs_capacity: capacity * initial as usize,
             slots: Vec::with_capacity(capacity),
             capacity,
@@ -473,6 +476,7 @@ impl BreadthFirst {
             scene,
             record: ObjectRecord::default(),
             floor,
+            floor_tests: 0,
             tree,
             cold: config.cold,
             hires,
@@ -508,6 +512,10 @@ impl BreadthFirst {
         let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
         let before = w.io();
         let r = w.trace(rays, any, self.config.triangle, out, c);
+        let floor_tests = std::mem::take(&mut w.floor_tests);
+        if floor_tests > 0 {
+            *c.extra.entry("bf_floor_tests".into()).or_insert(0) += floor_tests;
+        }
         if let Some(t) = w.tree.as_mut() {
             hierarchy::report(t, c);
         }

@@ -5,10 +5,9 @@
 use super::config::{Bytes, Registration};
 use super::*;
 use crate::geometry::Geometry;
-use crate::{build_engine, Counters, Engine, Hit, Ray};
-use rtbench_scenes::generate_scene;
-use rtbench_scenes::spd::{Options, Program};
-use std::sync::Arc;
+use crate::test_support::{answers, kv, spd};
+use crate::{build_engine, Counters, Hit, Ray};
+use rtbench_scenes::spd::Program;
 
 /// SplitMix64: the same rays every run.
 struct Rng(u64);
@@ -24,28 +23,6 @@ impl Rng {
     fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
         lo + (hi - lo) * Vec3::new(self.unit(), self.unit(), self.unit())
     }
-}
-
-fn spd(program: Program, sf: u32) -> BuildInput {
-    let scene = generate_scene(
-        program,
-        &Options {
-            size_factor: sf,
-            ..Options::standard(program)
-        },
-    )
-    .unwrap();
-    BuildInput {
-        geometry: Arc::new(Geometry::from_scene(&scene)),
-        scene: Arc::new(scene),
-    }
-}
-
-fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
-    pairs
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect()
 }
 
 /// Closest-hit rays from around the scene towards points in it, and segments between points.
@@ -66,15 +43,6 @@ fn rays_for(g: &Geometry, n: usize) -> (Vec<Ray>, Vec<Ray>) {
         any.push(Ray::new(a, d / d.length(), 0.0, d.length()));
     }
     (closest, any)
-}
-
-/// Hits and occlusion answers of `engine` for `rays`.
-fn answers(e: &dyn Engine, rays: &(Vec<Ray>, Vec<Ray>), c: &mut Counters) -> (Vec<Hit>, Vec<bool>) {
-    let mut hits = vec![Hit::MISS; rays.0.len()];
-    let mut occ = vec![false; rays.1.len()];
-    e.intersect(&rays.0, &mut hits, c);
-    e.occluded(&rays.1, &mut occ, c);
-    (hits, occ)
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! The in-memory voxel structure of the basic method (seed 000 §1.3, Algorithm 3.4): per voxel
 //! one byte, a "marked" bit (some object's bounding box reaches it) and six face bits, set
 //! where the voxel lies on the voxel boundary of some box (the boundary of the box of voxels the
-//! bounding box reaches). Rays are registered in voxels, not objects; see [`super::intersect`].
+//! bounding box reaches). Rays are registered in voxels, not objects ([`Registrations`]: the rays
+//! of each voxel in one pass); see [`super::intersect`].
 //!
 //! The grid's box and resolution are the `grid` engine's (⌊n^(1/3) + 0.5⌋ cells per axis with
 //! n the primitives, the box padded against `f32` rounding), so both engines walk the same cells;
@@ -124,5 +125,87 @@ impl Voxels {
 
     pub fn marked_count(&self) -> usize {
         self.flags.iter().filter(|&&f| f & MARKED != 0).count()
+    }
+}
+
+/// One registration of a ray in a voxel, in the order the rays were registered.
+#[derive(Clone, Copy)]
+pub struct Reg {
+    pub(super) voxel: u32,
+    pub(super) slot: u32,
+}
+
+/// A registration and its entry in the per-voxel lists ([`Registrations`]).
+pub fn reg_bytes() -> u64 {
+    (std::mem::size_of::<Reg>() + std::mem::size_of::<u32>()) as u64
+}
+
+/// The rays registered in each voxel in one pass: filled by registration, then grouped by voxel
+/// into one array (a counting sort) before the sweep, so the sweep walks the rays of a run of
+/// voxels as one contiguous slice rather than a linked list of nodes scattered in memory.
+///
+/// Within a voxel the rays come latest-registered first: the order of the linked lists this
+/// replaced, so every count that depends on it (the hierarchy's `bh_level_K_ray_tests`, which
+/// stop at the first ray that needs a node) is unchanged.
+pub struct Registrations {
+    /// In registration order.
+    pub(super) regs: Vec<Reg>,
+    /// Slot indices grouped by voxel: voxel v's are `slots[first[v]..first[v + 1]]`.
+    pub(super) slots: Vec<u32>,
+    /// Per voxel, and one past the last: where its rays begin in `slots` (all 0 between passes).
+    pub(super) first: Vec<u32>,
+}
+
+impl Registrations {
+    pub fn new(voxels: usize, capacity: usize) -> Registrations {
+        Registrations {
+            regs: Vec::with_capacity(capacity),
+            slots: Vec::with_capacity(capacity),
+            first: vec![0; voxels + 1],
+        }
+    }
+
+    #[inline]
+    pub fn push(&mut self, voxel: u32, slot: u32) {
+        self.regs.push(Reg { voxel, slot });
+        self.first[voxel as usize] += 1;
+    }
+
+    /// Registrations made this pass.
+    pub fn count(&self) -> usize {
+        self.regs.len()
+    }
+
+    /// Groups the registrations by voxel (counts were kept by [`Registrations::push`]).
+    pub fn group(&mut self) {
+        // Running sums: first[v] = the end of voxel v's rays; then each ray is put at its
+        // voxel's end, moving it down, so first[v] ends at the voxel's beginning and the earliest
+        // registered lands last.
+        let mut sum = 0;
+        let n = self.first.len() - 1;
+        for f in &mut self.first[..n] {
+            sum += *f;
+            *f = sum;
+        }
+        self.first[n] = sum;
+        self.slots.clear();
+        self.slots.resize(self.regs.len(), 0);
+        for r in &self.regs {
+            let f = &mut self.first[r.voxel as usize];
+            *f -= 1;
+            self.slots[*f as usize] = r.slot;
+        }
+    }
+
+    /// The rays of voxels `a..=z` (consecutive indices: one row of a box of voxels).
+    #[inline]
+    pub fn run(&self, a: usize, z: usize) -> &[u32] {
+        &self.slots[self.first[a] as usize..self.first[z + 1] as usize]
+    }
+
+    pub fn clear(&mut self) {
+        self.first.fill(0);
+        self.regs.clear();
+        self.slots.clear();
     }
 }

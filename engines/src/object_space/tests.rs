@@ -12,26 +12,11 @@ use super::ObjectSpace;
 use crate::engine::{BuildInput, Counters, Settings};
 use crate::geometry::Geometry;
 use crate::ray::{Hit, Ray};
+use crate::test_support::spd;
 use crate::{build_engine, EngineError};
 use glam::Vec3;
-use rtbench_scenes::generate_scene;
-use rtbench_scenes::spd::{Options, Program};
+use rtbench_scenes::spd::Program;
 use std::sync::Arc;
-
-fn spd(program: Program, sf: u32) -> BuildInput {
-    let scene = generate_scene(
-        program,
-        &Options {
-            size_factor: sf,
-            ..Options::standard(program)
-        },
-    )
-    .unwrap();
-    BuildInput {
-        geometry: Arc::new(Geometry::from_scene(&scene)),
-        scene: Arc::new(scene),
-    }
-}
 
 fn config(kv: &[(&str, &str)]) -> Result<ObjectSpaceConfig, EngineError> {
     ObjectSpaceConfig::from_settings(Settings::new(
