@@ -341,7 +341,7 @@ pub enum SceneCommand {
         #[arg(long)]
         hierarchy: bool,
         /// Write in segments of N objects, each made durable with a checkpoint
-        /// (`segments.json`; compressed: one gzip member per segment), in place: a store too
+        /// (`segments.json`; compressed: one gzip member or zstd frame per segment), in place: a store too
         /// large for one session (seed 000 Table 4.3). Not with --hierarchy.
         #[arg(long, value_name = "N")]
         segment: Option<u64>,
