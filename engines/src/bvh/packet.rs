@@ -116,6 +116,31 @@ mod x86 {
 
     type TriRay = <Sse4 as PacketKernel<PACKET>>::Ray;
 
+    /// The watertight test's per-ray set-up (`W`), or the unused placeholder Möller–Trumbore
+    /// takes.
+    fn watertight<const W: bool>(dir: glam::Vec3) -> WatertightRay {
+        if W {
+            WatertightRay::new(dir)
+        } else {
+            WatertightRay {
+                kx: 0,
+                ky: 1,
+                kz: 2,
+                sx: 0.0,
+                sy: 0.0,
+                sz: 0.0,
+            }
+        }
+    }
+
+    fn triangle_test<const W: bool>() -> TriangleTest {
+        if W {
+            TriangleTest::Watertight
+        } else {
+            TriangleTest::Moller
+        }
+    }
+
     /// The rays of a packet in lanes: `H` registers of 8 lanes per quantity (8·H rays).
     struct Lanes<const H: usize> {
         rdir: [[__m256; 3]; H],
@@ -191,18 +216,7 @@ mod x86 {
             }
             tmin_s[l] = ray.tmin;
             tmax_s[l] = ray.tmax;
-            let wt = if W {
-                WatertightRay::new(ray.dir)
-            } else {
-                WatertightRay {
-                    kx: 0,
-                    ky: 1,
-                    kz: 2,
-                    sx: 0.0,
-                    sy: 0.0,
-                    sz: 0.0,
-                }
-            };
+            let wt = watertight::<W>(ray.dir);
             tri[l] = <Sse4 as PacketKernel<PACKET>>::prepare(ray.origin, ray.dir, &wt);
             origin[l] = ray.origin;
             match signs {
@@ -436,23 +450,8 @@ mod x86 {
                     m &= m - 1;
                     let ray = &rays[l];
                     let mut rr = Ray::new(r.origin[l], ray.dir, r.tmin_s[l], r.tmax_s[l]);
-                    let wt = if W {
-                        WatertightRay::new(ray.dir)
-                    } else {
-                        WatertightRay {
-                            kx: 0,
-                            ky: 1,
-                            kz: 2,
-                            sx: 0.0,
-                            sy: 0.0,
-                            sz: 0.0,
-                        }
-                    };
-                    let test = if W {
-                        TriangleTest::Watertight
-                    } else {
-                        TriangleTest::Moller
-                    };
+                    let wt = watertight::<W>(ray.dir);
+                    let test = triangle_test::<W>();
                     for k in first..first + count {
                         c.primitive_tests += 1;
                         if let Some((t, u, v)) = bvh.prims[k].intersect(&rr, test, &wt) {
@@ -582,23 +581,8 @@ mod x86 {
                         let l = m.trailing_zeros() as usize;
                         m &= m - 1;
                         let ray = &rays[l];
-                        let wt = if W {
-                            WatertightRay::new(ray.dir)
-                        } else {
-                            WatertightRay {
-                                kx: 0,
-                                ky: 1,
-                                kz: 2,
-                                sx: 0.0,
-                                sy: 0.0,
-                                sz: 0.0,
-                            }
-                        };
-                        let test = if W {
-                            TriangleTest::Watertight
-                        } else {
-                            TriangleTest::Moller
-                        };
+                        let wt = watertight::<W>(ray.dir);
+                        let test = triangle_test::<W>();
                         for k in first..first + count {
                             c.primitive_tests += 1;
                             if bvh.prims[k].intersect(ray, test, &wt).is_some() {
