@@ -73,3 +73,26 @@ pub fn answers(
     e.occluded(&r.1, &mut occ, c);
     (hits, occ)
 }
+
+/// Builds `engine` with `settings` on `input`, answers `r` and asserts the answers are `want`'s
+/// (the same object at the same t, the same occlusion) and that the engine did not fail; the
+/// engine and its counters are returned for the caller's own checks.
+pub fn same_answers(
+    engine: &str,
+    input: &BuildInput,
+    settings: &[(&str, &str)],
+    r: &(Vec<Ray>, Vec<Ray>),
+    want: &(Vec<Hit>, Vec<bool>),
+) -> (Box<dyn Engine>, Counters) {
+    let e = crate::build_engine(engine, input, kv(settings)).unwrap();
+    let mut c = Counters::default();
+    let got = answers(e.as_ref(), r, &mut c);
+    assert!(e.failure().is_none(), "{settings:?}: {:?}", e.failure());
+    let same = got
+        .0
+        .iter()
+        .zip(&want.0)
+        .all(|(a, b)| a.object == b.object && a.t == b.t);
+    assert!(same && got.1 == want.1, "{settings:?}: answers differ");
+    (e, c)
+}

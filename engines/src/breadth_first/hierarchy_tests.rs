@@ -9,7 +9,7 @@ use crate::store::hierarchy::{
 };
 use crate::store::tests::TempDir;
 use crate::store::FILE_HEADER;
-use crate::test_support::{answers, kv, rays_around, spd};
+use crate::test_support::{answers, kv, rays_around, same_answers, spd};
 use crate::{build_engine, Counters, Ray};
 use rtbench_scenes::spd::Program;
 
@@ -46,16 +46,7 @@ fn the_hierarchy_skips_subtrees_and_changes_no_answer() {
                 ("lazy", "off"),
             ],
         ] {
-            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
-            let mut c = Counters::default();
-            let got = answers(e.as_ref(), &r, &mut c);
-            assert!(e.failure().is_none(), "{:?}", e.failure());
-            let same = got
-                .0
-                .iter()
-                .zip(&want.0)
-                .all(|(a, b)| a.object == b.object && a.t == b.t);
-            assert!(same && got.1 == want.1, "{program:?} {settings:?}");
+            let (e, c) = same_answers("breadth-first", &input, &settings, &r, &want);
             let s = e.build_stats();
             assert!(s["bh_levels"] >= 1.0);
             let objects = input.scene.objects.len() as u64;

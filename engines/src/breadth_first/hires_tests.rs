@@ -9,7 +9,7 @@ use super::hires::disk_grid::FILE_NAME;
 use super::*;
 use crate::geometry::Geometry;
 use crate::store::tests::TempDir;
-use crate::test_support::{answers, kv, rays_around, spd};
+use crate::test_support::{answers, kv, rays_around, same_answers, spd};
 use crate::{build_engine, Counters, Engine, Ray};
 use rtbench_scenes::spd::Program;
 
@@ -52,16 +52,7 @@ fn every_grid_answers_as_the_basic_one() {
                 ("subspace", "5"),
             ],
         ] {
-            let e = build_engine("breadth-first", &input, kv(&settings)).unwrap();
-            let mut c = Counters::default();
-            let got = answers(e.as_ref(), &r, &mut c);
-            assert!(e.failure().is_none(), "{:?}", e.failure());
-            let same = got
-                .0
-                .iter()
-                .zip(&want.0)
-                .all(|(a, b)| a.object == b.object && a.t == b.t);
-            assert!(same && got.1 == want.1, "{program:?} {settings:?}");
+            let (e, c) = same_answers("breadth-first", &input, &settings, &r, &want);
             if settings[0].1 == "two-level" {
                 let s = e.build_stats();
                 let x = s["res_x"] as u64;
