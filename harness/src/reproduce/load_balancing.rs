@@ -87,3 +87,91 @@ pub fn measure_passes<M: Send>(
         .collect::<Result<_>>()?;
     Ok((measured, pool.current_num_threads()))
 }
+
+/// Why a machine's efficiency is what it is, split exactly (003 eqs. 24, 25 with the busy time
+/// taken apart): efficiency = T(1) / (T × units) = (T(1) / busy) × (busy / (T × units)), and
+/// busy / (T × units) = (busiest PE's busy share of T) / imbalance. So efficiency × imbalance =
+/// work ratio × the busiest PE's busy share: below 1 either because the machine does more work
+/// than the 1-PE machine (the radiosity pass: PEs shoot side by side, more shots) or because
+/// its busiest PE waits (for rays to reach it).
+#[derive(Serialize, Clone, Copy, Debug, PartialEq)]
+pub struct Explained {
+    /// Machines above 1 PE the ranges cover.
+    pub machines: usize,
+    /// Range of efficiency × imbalance (1: the load balance explains it all).
+    pub of_balance: (f64, f64),
+    /// Range of T(1) / busy clocks summed over the machine (1: no extra work).
+    pub work: (f64, f64),
+    /// Range of the busiest PE's busy share of the run (1: never waits).
+    pub busiest_busy: (f64, f64),
+}
+
+/// The split over `sims` (pass the machines other than the 1-PE one; pure); `None` if empty.
+pub fn explain<'a>(sims: impl Iterator<Item = &'a SimRecord>) -> Option<Explained> {
+    let range = |r: (f64, f64), v: f64| (r.0.min(v), r.1.max(v));
+    let empty = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut e = Explained {
+        machines: 0,
+        of_balance: empty,
+        work: empty,
+        busiest_busy: empty,
+    };
+    for s in sims.filter(|s| s.utilisation > 0.0) {
+        e.machines += 1;
+        e.of_balance = range(e.of_balance, s.efficiency * s.imbalance);
+        e.work = range(e.work, s.efficiency / s.utilisation);
+        e.busiest_busy = range(e.busiest_busy, s.utilisation * s.imbalance);
+    }
+    (e.machines > 0).then_some(e)
+}
+
+impl Explained {
+    pub fn text(&self) -> String {
+        let r = |(a, b): (f64, f64)| format!("{:.0}–{:.0}%", a * 100.0, b * 100.0);
+        format!(
+            "Efficiency against load balance, {} machines above 1 PE: efficiency × imbalance = {} \
+             (1/imbalance explains it all at 100%); it splits exactly into the work ratio T(1) / busy clocks \
+             = {} (below 100%: more work than the 1-PE machine, e.g. more shots when PEs shoot side by side) \
+             and the busiest PE's busy share of the run = {} (below 100%: the busiest PE waits for work).",
+            self.machines,
+            r(self.of_balance),
+            r(self.work),
+            r(self.busiest_busy)
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reproduce::object_space_pass::tests::sim;
+
+    fn machine(efficiency: f64, utilisation: f64, imbalance: f64) -> SimRecord {
+        let mut s = sim(1, 1, 1);
+        (s.efficiency, s.utilisation, s.imbalance) = (efficiency, utilisation, imbalance);
+        s
+    }
+
+    #[test]
+    fn efficiency_splits_into_balance_work_and_the_busiest_pes_waiting() {
+        assert_eq!(explain([].iter()), None);
+        // Balance explains it all: 50% efficient at imbalance 2, busiest PE always busy.
+        let even = machine(0.5, 0.5, 2.0);
+        // Same balance, 40% more work (the radiosity pass's extra shots): 0.5 / 1.4.
+        let more_work = machine(0.5 / 1.4, 0.5, 2.0);
+        // Same work, the busiest PE busy 80% of the run.
+        let waits = machine(0.4, 0.4, 2.0);
+        let e = explain([even, more_work, waits].iter()).unwrap();
+        assert_eq!(e.machines, 3);
+        let close = |(a, b): (f64, f64), (c, d): (f64, f64)| {
+            assert!(
+                (a - c).abs() < 1e-12 && (b - d).abs() < 1e-12,
+                "{a} {b} vs {c} {d}"
+            )
+        };
+        close(e.of_balance, (1.0 / 1.4, 1.0));
+        close(e.work, (1.0 / 1.4, 1.0));
+        close(e.busiest_busy, (0.8, 1.0));
+        assert!(e.text().contains("71–100%"), "{}", e.text());
+    }
+}

@@ -135,6 +135,25 @@ impl SimRecord {
     }
 }
 
+/// What a table's heading says of a pass: the rays and subspace visits of a ray-tracing pass;
+/// for the radiosity pass (which traces no eye rays) its threshold and the 1-PE machine's packet
+/// events `t1`.
+pub fn pass_summary(p: &PassRecord, t1: Option<&SimRecord>) -> String {
+    if p.pass == "radiosity" {
+        format!(
+            "radiosity pass, τ = {}, {} packet events on 1 PE",
+            p.threshold.map_or("–".into(), |t| format!("{t:.3}")),
+            t1.map_or("–".into(), |s| s.events.to_string())
+        )
+    } else {
+        format!(
+            "{} rays, {} subspace visits",
+            p.primary + p.secondary,
+            p.subspace_visits
+        )
+    }
+}
+
 /// `size` (default 512, 128 with `--quick`).
 pub fn size(ctx: &Ctx) -> Result<u32> {
     let size = ctx

@@ -104,6 +104,8 @@ struct Findings {
     e256x8: Option<f64>,
     #[serde(rename = "4096_blocks")]
     blocks_4096: Vec<Blocks4096>,
+    /// Efficiency against load balance, every machine above 1 PE.
+    explained: Option<lb::Explained>,
 }
 
 #[derive(Serialize)]
@@ -226,6 +228,7 @@ fn findings(m: &Measured<Run>, pe_counts: &[u32], blocks: &[u32]) -> Findings {
         e256x4: m.eff(256, 4),
         e256x8: m.eff(256, 8),
         blocks_4096,
+        explained: lb::explain(m.runs.iter().skip(1).map(|r| &r.sim)),
     }
 }
 
@@ -355,8 +358,10 @@ fn document(
     doc.paragraph(format!("Measured: `rtbench reproduce {}{}` — on the room (label `-radiosity`: the radiosity pass; else the ray-tracing pass) and on the SPD scenes (ray-tracing pass) at {size}×{size}, 32³ subspaces, 2D torus, skewed allocation, least-loaded dispatch to R RP blocks per PE, direct frame buffer. Efficiency = T(1 PE, 1 RP block) / (T × PEs × R) (003 eq. 25).", ctx.id, if ctx.quick { " --quick" } else { "" }));
     for (m, f) in measured.iter().zip(findings) {
         doc.heading(format!(
-            "{} (T(1 PE, 1 RP block) = {} clocks)",
-            m.pass.scene, m.t1_clocks
+            "{} (T(1 PE, 1 RP block) = {} clocks; {})",
+            m.pass.scene,
+            m.t1_clocks,
+            osp::pass_summary(&m.pass, m.runs.first().map(|r| &r.sim))
         ));
         let mut header = vec!["PEs".to_string()];
         header.extend(blocks.iter().map(|r| format!("R = {r}")));
@@ -400,6 +405,7 @@ fn document(
                 p.value("rt-4096-2500x")
             ));
         }
+        items.extend(f.explained.map(|e| e.text()));
         doc.list(items);
         doc.figure(
             format!("plots/{}-{}.svg", ctx.id, m.pass.scene),

@@ -123,6 +123,8 @@ struct Findings {
     /// At the largest 2D skewed run: its efficiency, the busiest PE's load over the mean, and
     /// the share of empty subspaces (the imbalance-vs-efficiency explanation).
     imbalance_2d_max: Option<(f64, f64)>,
+    /// Efficiency against load balance, every machine above 1 PE.
+    explained: Option<lb::Explained>,
 }
 
 #[derive(Serialize)]
@@ -278,6 +280,7 @@ fn findings(m: &Measured<Run>, max_pes: u32, above: f64) -> Findings {
             .filter(|r| r.dims == 2 && r.allocation == Allocation::Skewed.name())
             .max_by_key(|r| r.pes)
             .map(|r| (r.sim.efficiency, r.sim.imbalance)),
+        explained: lb::explain(m.runs.iter().skip(1).map(|r| &r.sim)),
     }
 }
 
@@ -414,11 +417,10 @@ fn document(
     doc.paragraph(format!("Measured: `rtbench reproduce {}{}` — on the room both passes (label `-radiosity`: 003's radiosity pass; otherwise the ray-tracing pass), on the SPD scenes the ray-tracing pass (1 primary ray per pixel centre, ≤ 3 reflections, no shadow rays) at {size}×{size}, 32³ subspaces, 1 RP block per PE, Table 4 costs, direct frame buffer; PEs up to {max_pes} (a 1D machine's PE count must divide the 32 subspaces of its axis, so 1D stops at 32; 3D has no skewed allocation in 003). Efficiency = T(1 PE) / (T × PEs).", ctx.id, if ctx.quick { " --quick" } else { "" }));
     for (m, f) in measured.iter().zip(findings) {
         doc.heading(format!(
-            "{} (T(1 PE) = {} clocks; {} rays, {} subspace visits)",
+            "{} (T(1 PE) = {} clocks; {})",
             m.pass.scene,
             m.t1_clocks,
-            m.pass.primary + m.pass.secondary,
-            m.pass.subspace_visits
+            osp::pass_summary(&m.pass, m.runs.first().map(|r| &r.sim))
         ));
         let mut header = vec!["PEs".to_string()];
         header.extend(COLUMNS.iter().map(|(d, a)| format!("{d}D {}", a.name())));
@@ -441,6 +443,7 @@ fn document(
                 Some((e, i)) => format!("Imbalance vs efficiency (2D skewed, largest PE count): efficiency {:.1}%, busiest PE / mean PE busy time {:.2}, 1/imbalance {:.1}%: the efficiency is {:.0}% of what the load balance allows.", e * 100.0, i, 100.0 / i, e * i * 100.0),
                 None => "Imbalance: no 2D skewed run.".into(),
             },
+            f.explained.map_or("No machine above 1 PE.".into(), |e| e.text()),
             match f.skewed_2d_256 {
                 Some(e) => format!("2D, 256 PEs, skewed above {:.0}%: {:.1}% ({}); 2D block at 256 PEs: {} (003, radiosity: about {:.0}%).", p.value("2d-256-above-60") * 100.0, e * 100.0, v(f.above_60_2d_256 == Some(true)), pct(f.block_2d_256), p.value("block-about-20") * 100.0),
                 None => "2D, 256 PEs: not run (max-pes below 256).".into(),
