@@ -145,11 +145,24 @@ struct Run {
     /// Rays traced, every kind (0 in rows saved before session 7, which did not keep it).
     #[serde(default)]
     rays: u64,
+    /// CPU seconds of preprocessing and tracing (0 in rows saved before session 8): against
+    /// the total it shows a run that did not get its core (a shared machine's times).
+    #[serde(default)]
+    cpu_s: f64,
 }
 
 impl Run {
     fn total_s(&self) -> f64 {
         self.preprocess_s + self.trace_s
+    }
+
+    /// CPU time over wall time, as a percentage ("-" for rows that did not keep it).
+    fn cpu_share(&self) -> String {
+        if self.cpu_s > 0.0 {
+            format!("{:.0}%", 100.0 * self.cpu_s / self.total_s().max(1e-9))
+        } else {
+            "-".into()
+        }
     }
 }
 
@@ -245,6 +258,7 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
     }
     pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    let cpu0 = workload::process_cpu_seconds();
     let t = std::time::Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let preprocess_s = t.elapsed().as_secs_f64();
@@ -285,6 +299,7 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
             .collect(),
         load_average,
         rays: r.stats.total,
+        cpu_s: workload::process_cpu_seconds() - cpu0,
     })
 }
 
@@ -644,7 +659,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
 fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Document {
     let mut doc = Document::new("nakamaru-4.1: basic method vs S+G and S+G+B");
     doc.paragraph(format!(
-        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-4.1{}`, {}×{}, breadth-first engine memory {}, cache {}, one thread; totals = preprocessing (S+G+B: with the hierarchy's build) + tracing (intersection and shading, out of core). Ratios are basic / method. MiB = 2^20 bytes.",
+        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-4.1{}`, {}×{}, breadth-first engine memory {}, cache {}, one thread; totals = preprocessing (S+G+B: with the hierarchy's build) + tracing (intersection and shading, out of core). Ratios are basic / method. MiB = 2^20 bytes. CPU / wall: the process's CPU time over its wall time per method; well below 100% the run waited for its core (a shared machine) or the disk, and its time says less.",
         p.source.cite(),
         p.source.machine.as_deref().unwrap_or(""),
         if quick { " --quick" } else { "" },
@@ -658,7 +673,8 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Doc
         &[
             "row", "objects", "split MiB", "generation s", "basic s", "S+G", "S+G+B", "(S+G+B / S+G)",
             "thesis S+G", "thesis S+G+B", "passes", "hierarchy boxes", "boxes read S+G+B / S+G",
-            "geometry loads", "bh build s", "peak RSS MiB", "images equal", "load avg",
+            "geometry loads", "bh build s", "peak RSS MiB", "images equal", "CPU / wall basic, S+G, S+G+B",
+            "load avg",
         ],
     );
     for m in measured {
@@ -688,6 +704,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Doc
             format!("{:.2}", m.sgb.bh_build_s),
             format!("{:.1}", peak as f64 / 1048576.0),
             (m.basic.sha256 == m.sg.sha256 && m.sg.sha256 == m.sgb.sha256).to_string(),
+            format!("{}, {}, {}", m.basic.cpu_share(), m.sg.cpu_share(), m.sgb.cpu_share()),
             m.sgb.load_average.clone(),
         ]);
     }
