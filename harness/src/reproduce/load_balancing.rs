@@ -11,12 +11,13 @@ use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Machine;
 use serde::Serialize;
 
-/// A load-balancing table of seed 003: seconds with `--quick`; in full, minutes per machine on
-/// the room's radiosity pass (saved as steps, `--resume`).
+/// A load-balancing table of seed 003: seconds with `--quick`; in full, `full` (a minute or two
+/// of CPU per machine on the room's radiosity pass, each saved as a step for `--resume`).
 pub const fn table(
     id: &'static str,
     source: &'static str,
     about: &'static str,
+    full: &'static str,
     claims: &'static [Claim],
     run: fn(&Ctx) -> Result<Output>,
 ) -> Table {
@@ -27,7 +28,7 @@ pub const fn table(
         about,
         runtime: Runtime {
             quick: "seconds",
-            full: "minutes",
+            full,
         },
         params: osp::PARAMS,
         claims,

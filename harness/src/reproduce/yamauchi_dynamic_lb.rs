@@ -21,6 +21,7 @@ pub const TABLE: Table = lb::table(
     "yamauchi-dynamic-lb",
     "§4.2.2, Figs. 30, 35",
     "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
+    "about 45 CPU minutes (25 room8 radiosity machines); resumable",
     &[
         Claim {
             key: "gains-stop-near-8",
