@@ -326,7 +326,7 @@ fn a_compressed_split_store_renders_the_plain_image_and_the_pass_cap_claims_none
     let render = |store: &str, extra: &[&str]| {
         let mut a = vec![
             "render", "--scene", store, "--engine", "breadth-first", "--size", "32", "--set",
-            "memory=1MiB", "--json",
+            "rays=200", "--json",
         ];
         for s in extra {
             a.extend(["--set", s]);
