@@ -328,8 +328,8 @@ impl BreadthFirst {
         // compressed bytes and the block index instead of `buffer`).
         let buffers = scene.held_bytes()
             + tree
-            .as_ref()
-            .map_or(0, |t| t.levels.len() as u64 * config.buffer);
+                .as_ref()
+                .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
         let per_ray = intersect::slot_bytes()
             + initial as u64 * reg_bytes
@@ -439,10 +439,7 @@ impl BreadthFirst {
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
         stats.insert("preprocess_codec_bytes".into(), pre_io.codec_bytes as f64);
-        stats.insert(
-            "store_stored_bytes".into(),
-            header.disk_bytes() as f64,
-        );
+        stats.insert("store_stored_bytes".into(), header.disk_bytes() as f64);
         stats.insert("store_reader_bytes".into(), scene.held_bytes() as f64);
         stats.insert(
             "store_plain_bytes".into(),

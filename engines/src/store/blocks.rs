@@ -84,12 +84,16 @@ impl BlockIndex {
     /// bounds a block can have. With `upto`, only the entries of blocks starting before that
     /// compressed offset are taken (a resumed write's checkpoint), and `stored` is that offset.
     fn read_checked(idx: &Path, stored: u64, upto: bool) -> io::Result<BlockIndex> {
-        let f = File::open(idx).map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", idx.display())))?;
+        let f = File::open(idx)
+            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", idx.display())))?;
         let len = f.metadata()?.len();
         // A resumed write may find part of an entry a stopped process left after the
         // checkpoint: it is cut off with the rest.
         if len < INDEX_HEADER || (!upto && (len - INDEX_HEADER) % INDEX_ENTRY as u64 != 0) {
-            return Err(invalid(idx, format!("{len} bytes: not a block index (truncated?)")));
+            return Err(invalid(
+                idx,
+                format!("{len} bytes: not a block index (truncated?)"),
+            ));
         }
         let mut r = io::BufReader::with_capacity(1 << 16, f);
         let mut h = [0u8; INDEX_HEADER as usize];
@@ -132,7 +136,10 @@ impl BlockIndex {
         }
         let last = ix.coff.last().map_or(0, |&c| stored - c);
         if (ix.coff.is_empty() && stored != 0) || last > max_compressed() {
-            return Err(invalid(idx, format!("the data file ({stored} bytes) does not end with the last block")));
+            return Err(invalid(
+                idx,
+                format!("the data file ({stored} bytes) does not end with the last block"),
+            ));
         }
         ix.total = unext;
         Ok(ix)
@@ -223,10 +230,12 @@ impl BlockRead {
             self.file.seek(SeekFrom::Start(coff))?;
         }
         self.scratch.resize(clen, 0);
-        self.file.read_exact(&mut self.scratch).map_err(|e| match e.kind() {
-            io::ErrorKind::UnexpectedEof => invalid(&self.path, format!("block {i} truncated")),
-            _ => e,
-        })?;
+        self.file
+            .read_exact(&mut self.scratch)
+            .map_err(|e| match e.kind() {
+                io::ErrorKind::UnexpectedEof => invalid(&self.path, format!("block {i} truncated")),
+                _ => e,
+            })?;
         self.fpos = coff + clen as u64;
         let n = self
             .dctx

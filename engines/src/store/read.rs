@@ -303,7 +303,10 @@ impl StoreHeader {
             if ix.total != bytes {
                 return Err(bad(
                     &self.dir,
-                    format!("{name}'s blocks hold {} bytes, header.json says {bytes}", ix.total),
+                    format!(
+                        "{name}'s blocks hold {} bytes, header.json says {bytes}",
+                        ix.total
+                    ),
                 ));
             }
             if ix.header_crc != crc {
@@ -562,7 +565,10 @@ impl BboxReader {
         if file.block_total().is_some_and(|t| t != want) {
             return Err(bad(
                 &path,
-                format!("{} bytes in blocks for {objects} objects (expected {want})", file.block_total().unwrap_or(0)),
+                format!(
+                    "{} bytes in blocks for {objects} objects (expected {want})",
+                    file.block_total().unwrap_or(0)
+                ),
             ));
         }
         check_file_header(&mut file, BBOX_MAGIC, &path)?;

@@ -4,9 +4,9 @@
 
 use super::io::{Codec, IoCounters, IoFile};
 use super::{
-    Layout, Surface, BBOX_FILE, BBOX_INDEX, GEOMETRY_INDEX, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
-    MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS, OBJECTS_FILE, OBJECTS_MAGIC,
-    VERSION,
+    Layout, Surface, BBOX_FILE, BBOX_INDEX, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_INDEX,
+    GEOMETRY_MAGIC, HEADER_FILE, MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS,
+    OBJECTS_FILE, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
@@ -441,7 +441,8 @@ impl StoreWriter {
                 if split_zstd {
                     // The data files' sizes (the counters also hold the indexes').
                     let size = |n: &str| {
-                        std::fs::metadata(self.dir.join(super::blocks::data_name(n))).map(|m| m.len())
+                        std::fs::metadata(self.dir.join(super::blocks::data_name(n)))
+                            .map(|m| m.len())
                     };
                     header["compression"] = json!(self.codec.name());
                     header["block_bytes"] = json!(super::blocks::BLOCK_BYTES);
