@@ -89,7 +89,8 @@ impl BlockIndex {
         let len = f.metadata()?.len();
         // A resumed write may find part of an entry a stopped process left after the
         // checkpoint: it is cut off with the rest.
-        if len < INDEX_HEADER || (!upto && (len - INDEX_HEADER) % INDEX_ENTRY as u64 != 0) {
+        if len < INDEX_HEADER || (!upto && !(len - INDEX_HEADER).is_multiple_of(INDEX_ENTRY as u64))
+        {
             return Err(invalid(
                 idx,
                 format!("{len} bytes: not a block index (truncated?)"),
