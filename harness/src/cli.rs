@@ -333,7 +333,9 @@ pub enum SceneCommand {
         layout: String,
         /// `none`, `gzip` / `gzip:LEVEL` (1-9, default 6 as gzip's): objects.bin.gz, or `zstd` /
         /// `zstd:LEVEL` (1-19, default 3): objects.bin.zst, read through the codec (seed 000
-        /// Table 3.3 used gzip; `--layout basic` only).
+        /// Table 3.3 used gzip). `--layout split` takes zstd only: bbox.bin.zst and
+        /// geometry.bin.zst as independently compressed 128 KiB blocks with an index
+        /// (bbox.bin.idx, geometry.bin.idx), so that seeks decompress only the block they land in.
         #[arg(long, default_value = "none")]
         compress: String,
         /// Also build the bounding-box hierarchy (bbox-K.bin, hierarchy.json; seed 000 §4.2.2
@@ -341,7 +343,7 @@ pub enum SceneCommand {
         #[arg(long)]
         hierarchy: bool,
         /// Write in segments of N objects, each made durable with a checkpoint
-        /// (`segments.json`; compressed: one gzip member or zstd frame per segment), in place: a store too
+        /// (`segments.json`; compressed: one gzip member, zstd frame or zstd block ends per segment), in place: a store too
         /// large for one session (seed 000 Table 4.3). Not with --hierarchy.
         #[arg(long, value_name = "N")]
         segment: Option<u64>,

@@ -309,3 +309,83 @@ fn compressed_stores_render_the_plain_image_and_refuse_damage() {
     std::fs::write(&f, &bytes[..bytes.len() - 100]).unwrap();
     expect_input_error(&args, "header.json says");
 }
+
+/// A zstd-compressed split store (blocks with an index) renders the plain split store's image
+/// with S+G and S+G+B, smaller on disk; a flipped byte exits 2 in one line. A render stopped
+/// by the pass cap claims no image.
+#[test]
+fn a_compressed_split_store_renders_the_plain_image_and_the_pass_cap_claims_none() {
+    let d = Dir::new("store-cli", "split-zstd");
+    let (plain, zst) = (d.join("plain"), d.join("zst"));
+    let p = json(&[
+        "scene", "store", "mount", "--sf", "5", "-o", &plain, "--json",
+    ]);
+    let z = json(&[
+        "scene",
+        "store",
+        "mount",
+        "--sf",
+        "5",
+        "-o",
+        &zst,
+        "--compress",
+        "zstd",
+        "--json",
+    ]);
+    assert_eq!(p["objects_bytes"], z["objects_bytes"]);
+    assert!(
+        z["stored_bytes"].as_u64() < p["stored_bytes"].as_u64(),
+        "{z}"
+    );
+    let render = |store: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "--scene",
+            store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "32",
+            "--set",
+            "rays=200",
+            "--json",
+        ];
+        for s in extra {
+            a.extend(["--set", *s]);
+        }
+        json(&a)
+    };
+    for sets in [&[][..], &["hierarchy=on"][..]] {
+        let (a, b) = (render(&plain, sets), render(&zst, sets));
+        assert_eq!(a["image"]["sha256"], b["image"]["sha256"], "{sets:?}");
+        assert_eq!(
+            a["counters"]["extra"]["bf_passes"],
+            b["counters"]["extra"]["bf_passes"]
+        );
+        assert!(b["counters"]["extra"]["io_codec_bytes"].as_u64().unwrap() > 0);
+    }
+    // The pass cap: one pass, no image.
+    let c = render(&zst, &["max_passes=1"]);
+    assert_eq!(c["counters"]["extra"]["bf_passes"], 1);
+    assert!(
+        c["image"]["sha256"].is_null() && c["image"]["incomplete"] == true,
+        "{c}"
+    );
+    // A flipped byte in the geometry blocks.
+    let f = format!("{zst}/geometry.bin.zst");
+    let mut bytes = std::fs::read(&f).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    std::fs::write(&f, &bytes).unwrap();
+    let out = rtbench(&[
+        "render",
+        "--scene",
+        &zst,
+        "--engine",
+        "breadth-first",
+        "--size",
+        "16",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).lines().count(), 1);
+}

@@ -142,6 +142,9 @@ pub struct BreadthFirstConfig {
     /// The grid rays are registered in (`grid=cuberoot|single|two-level` and its constants;
     /// seed 000 §4.3).
     pub grid: super::hires::config::GridKind,
+    /// Stop after this many passes (`max_passes=N`, [`super::cap`]); the run is then marked
+    /// incomplete (`bf_pass_cap_reached`) and its image is no answer.
+    pub max_passes: Option<u64>,
 }
 
 /// Hierarchy constants set by the user (`None`: the thesis's for the scene).
@@ -262,6 +265,7 @@ impl BreadthFirstConfig {
             ));
         }
         let max_rays: u64 = s.get("rays", 0u64)?;
+        let max_passes: u64 = s.get("max_passes", 0u64)?;
         let spill_codec: String = s.get("spill_codec", "none".to_string())?;
         let spill_codec = match spill_codec.as_str() {
             "none" => Codec::None,
@@ -347,6 +351,7 @@ impl BreadthFirstConfig {
             count,
             res: (res > 0).then_some(res),
             max_rays: (max_rays > 0).then_some(max_rays),
+            max_passes: (max_passes > 0).then_some(max_passes),
             spill_codec,
             secondary,
             hierarchy,

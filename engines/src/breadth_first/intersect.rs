@@ -69,6 +69,9 @@ pub struct Work {
     /// The high-resolution grid (`grid=two-level`, §4.3): its flags on disk, rays registered in
     /// its two-level grid; `voxels` then holds the grid's frame only, and `registered` nothing.
     pub(super) hires: Option<super::hires::HiRes>,
+    /// The pass cap (`max_passes`, [`super::cap`]) and the passes made so far, over all calls.
+    pub(super) max_passes: Option<u64>,
+    pub(super) passes_done: u64,
 }
 
 impl Work {
@@ -316,6 +319,9 @@ impl Work {
         let mut input_left = true;
         let mut pass = 0usize;
         loop {
+            if self.capped(rays, out, c) {
+                return Ok(());
+            }
             // Refill the free slots (Algorithm 3.5, "while memory not full of rays"); without
             // refill only once the batch in memory is done (Algorithm 3.3).
             let may_read = self.refill || self.slots.is_empty();
@@ -347,6 +353,7 @@ impl Work {
             self.register(count, c);
             self.sweep(any, test, c)?;
             *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
+            self.passes_done += 1;
             self.finish_pass(any, out, c);
         }
     }

@@ -21,7 +21,8 @@
 //! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers |
 //! | `registration` | `fixed:N`, `thesis`, `inverse`, `inverse:N` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
-//! | `buffer` | bytes | `64KiB` | each file buffer |
+//! | `buffer` | bytes | `64KiB` | each file buffer (a compressed split store's readers hold one 128 KiB block, its compressed bytes and the block index instead: `store_reader_bytes`) |
+//! | `max_passes` | count | `0` (none) | stop after N passes over all trace calls ([`cap`]): counters and times are those passes'; `bf_pass_cap_reached` > 0 says the run stopped so, and its image is no answer |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //! | `verify` | `full`, `records` | `full` | `full`: a store opened is read once and every record checked ([`crate::store::StoreHeader::verify`]) before preprocessing, outside the I/O counters (reported as `verify_bytes_read`, `verify_s`); `records`: only the records the algorithm reads are checked |
 //! | `layout` | `split`, `basic` | `split` | the store layout read: `basic` = one file of (box, object) records read whole on every sweep and in shading (seed 000 Ch.3, Algorithms 3.4–3.6); `split` = box and geometry files apart (Ch.4 "S"). A store of the other layout is refused |
@@ -67,6 +68,7 @@
 //! (`hr_subspace_side`, `hr_subspaces`, `hr_build_boxes_read`, `hr_build_nodes_culled`,
 //! `hr_build_objects_culled`, `hr_build_bytes_written`, `hr_build_s`).
 
+pub mod cap;
 pub mod config;
 pub mod hierarchy;
 pub mod hires;
@@ -74,6 +76,8 @@ pub mod intersect;
 pub mod spill;
 pub mod voxels;
 
+#[cfg(test)]
+mod cap_tests;
 #[cfg(test)]
 mod hierarchy_tests;
 #[cfg(test)]
@@ -320,12 +324,12 @@ impl BreadthFirst {
                 config.memory, grid_bytes, res3
             )));
         }
-        let buffers = match config.layout {
-            config::Layout::Split => 2 * config.buffer,
-            config::Layout::Basic => config.buffer,
-        } + tree
-            .as_ref()
-            .map_or(0, |t| t.levels.len() as u64 * config.buffer);
+        // The scene files' buffers (a compressed split store's readers hold a block, its
+        // compressed bytes and the block index instead of `buffer`).
+        let buffers = scene.held_bytes()
+            + tree
+                .as_ref()
+                .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
         let per_ray = intersect::slot_bytes()
             + initial as u64 * reg_bytes
@@ -435,10 +439,8 @@ impl BreadthFirst {
         stats.insert("preprocess_bytes_read".into(), pre_io.bytes_read as f64);
         stats.insert("preprocess_read_calls".into(), pre_io.read_calls as f64);
         stats.insert("preprocess_codec_bytes".into(), pre_io.codec_bytes as f64);
-        stats.insert(
-            "store_stored_bytes".into(),
-            (header.stored_bytes + header.bbox_bytes) as f64,
-        );
+        stats.insert("store_stored_bytes".into(), header.disk_bytes() as f64);
+        stats.insert("store_reader_bytes".into(), scene.held_bytes() as f64);
         stats.insert(
             "store_plain_bytes".into(),
             (header.geometry_bytes + header.bbox_bytes) as f64,
@@ -480,6 +482,8 @@ impl BreadthFirst {
             tree,
             cold: config.cold,
             hires,
+            max_passes: config.max_passes,
+            passes_done: 0,
         };
         Ok(BreadthFirst {
             config,

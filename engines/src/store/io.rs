@@ -19,6 +19,8 @@ use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
+use super::blocks::{self, BlockRead, BlockWrite};
+
 /// How a file's bytes are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Codec {
@@ -107,6 +109,9 @@ enum Backing {
     GzWrite(Box<GzEncoder<Counted<File>>>),
     ZsRead(Box<ZstdRead>),
     ZsWrite(Box<ZstdWrite>),
+    /// Independently compressed blocks with an index (the compressed split layout, [`blocks`]).
+    BlockRead(Box<BlockRead>),
+    BlockWrite(Box<BlockWrite>),
 }
 
 /// A reader of a compressed file: every gzip member or zstd frame in turn, as one stream.
@@ -156,6 +161,8 @@ impl Backing {
             Backing::GzWrite(e) => e.get_ref().inner.as_raw_fd(),
             Backing::ZsRead(d) => d.get_ref().get_ref().inner.as_raw_fd(),
             Backing::ZsWrite(e) => e.get_ref().inner.as_raw_fd(),
+            Backing::BlockRead(b) => b.raw_fd(),
+            Backing::BlockWrite(b) => b.raw_fd(),
         }
     }
 }
@@ -221,6 +228,66 @@ impl IoFile {
         Ok(Self::new(file, codec, path, buffer))
     }
 
+    /// A block-compressed file ([`blocks`]: `path` is the data file, its index beside it). The
+    /// buffer is one block, whatever was asked: a block is decompressed whole.
+    pub fn open_blocks(path: &Path) -> io::Result<IoFile> {
+        let b = BlockRead::open(path)?;
+        Ok(Self::new(
+            Backing::BlockRead(Box::new(b)),
+            Codec::Zstd(3),
+            path,
+            blocks::BLOCK_BYTES,
+        ))
+    }
+
+    /// A new block-compressed file at zstd `level`: each full buffer is one block.
+    pub fn create_blocks(path: &Path, level: i32) -> io::Result<IoFile> {
+        let b = BlockWrite::create(path, level)?;
+        let mut f = Self::new(
+            Backing::BlockWrite(Box::new(b)),
+            Codec::Zstd(level),
+            path,
+            blocks::BLOCK_BYTES,
+        );
+        f.io.bytes_written = 16;
+        f.io.write_calls = 1;
+        Ok(f)
+    }
+
+    /// As [`IoFile::append_codec`], for a block-compressed file: its data file `stored` bytes
+    /// long and its index cut back to the checkpoint.
+    pub fn append_blocks(path: &Path, level: i32, stored: u64, written: u64) -> io::Result<IoFile> {
+        let b = BlockWrite::append(path, level, stored, written)?;
+        let bytes = b.stored + b.index_bytes;
+        let mut f = Self::new(
+            Backing::BlockWrite(Box::new(b)),
+            Codec::Zstd(level),
+            path,
+            blocks::BLOCK_BYTES,
+        );
+        f.base = written;
+        f.io.bytes_written = bytes;
+        Ok(f)
+    }
+
+    /// The uncompressed size of a block-compressed file being read (its index's).
+    pub fn block_total(&self) -> Option<u64> {
+        match &self.file {
+            Backing::BlockRead(b) => Some(b.index.total),
+            _ => None,
+        }
+    }
+
+    /// Bytes this file holds in memory: its buffer, and for a block-compressed file the
+    /// compressed block and the index.
+    pub fn held_bytes(&self) -> u64 {
+        self.buf.len() as u64
+            + match &self.file {
+                Backing::BlockRead(b) => b.held_bytes(),
+                _ => 0,
+            }
+    }
+
     /// Takes up writing a file that a [`IoFile::checkpoint`] left `stored` bytes long on disk,
     /// `written` bytes of the stream (uncompressed) long: anything after the checkpoint (half a
     /// segment of a process that stopped) is cut off, and writing goes on from there (in a
@@ -270,9 +337,14 @@ impl IoFile {
                 f.sync_data()?;
                 return Ok(self.io.bytes_written);
             }
+            // The flush ended a block; the data file's size is the checkpoint.
+            Backing::BlockWrite(b) => {
+                b.sync()?;
+                return Ok(b.stored);
+            }
             Backing::GzWrite(e) => e.get_ref().inner.try_clone()?,
             Backing::ZsWrite(e) => e.get_ref().inner.try_clone()?,
-            Backing::GzRead(_) | Backing::ZsRead(_) => {
+            Backing::GzRead(_) | Backing::ZsRead(_) | Backing::BlockRead(_) => {
                 return Err(io::Error::other("checkpoint of a file being read"))
             }
         };
@@ -365,13 +437,63 @@ impl IoFile {
                 self.pos = (offset - self.base) as usize;
                 Ok(())
             }
-            Backing::GzWrite(_) | Backing::ZsWrite(_) => {
+            Backing::BlockRead(_) => {
+                // Anywhere: the block it lands in, read and decompressed (the one cached in the
+                // buffer was checked above).
+                let i = match &self.file {
+                    Backing::BlockRead(b) => b.index.block_of(offset),
+                    _ => unreachable!("matched above"),
+                };
+                match i {
+                    Some(i) => {
+                        self.load_block(i)?;
+                        self.pos = (offset - self.base) as usize;
+                    }
+                    None => {
+                        // At or past the end: the next read finds nothing.
+                        self.base = offset;
+                        self.pos = 0;
+                        self.len = 0;
+                    }
+                }
+                Ok(())
+            }
+            Backing::GzWrite(_) | Backing::ZsWrite(_) | Backing::BlockWrite(_) => {
                 Err(io::Error::other("seek in a file being written"))
             }
         }
     }
 
+    /// Block `i` of a block-compressed file into the buffer, counted: its compressed bytes, one
+    /// read call, a seek when it is not the block after the last one read.
+    fn load_block(&mut self, i: usize) -> io::Result<usize> {
+        let Backing::BlockRead(b) = &mut self.file else {
+            return Err(io::Error::other("not a block-compressed file"));
+        };
+        let l = b.load(i, &mut self.buf)?;
+        self.io.read_calls += 1;
+        self.io.bytes_read += l.clen as u64;
+        self.io.codec_bytes += l.ulen as u64;
+        self.io.seeks += l.seek as u64;
+        self.base = l.uoff;
+        self.pos = 0;
+        self.len = l.ulen;
+        Ok(l.ulen)
+    }
+
     fn fill(&mut self) -> io::Result<usize> {
+        if let Backing::BlockRead(b) = &self.file {
+            let next = self.base + self.len as u64;
+            return match b.index.block_of(next) {
+                Some(i) => self.load_block(i),
+                None => {
+                    self.base = next;
+                    self.pos = 0;
+                    self.len = 0;
+                    Ok(0)
+                }
+            };
+        }
         self.base += self.len as u64;
         self.pos = 0;
         self.len = 0;
@@ -402,7 +524,8 @@ impl IoFile {
                 self.io.codec_bytes += n as u64;
                 n
             }
-            Backing::GzWrite(_) | Backing::ZsWrite(_) => {
+            Backing::BlockRead(_) => unreachable!("read above"),
+            Backing::GzWrite(_) | Backing::ZsWrite(_) | Backing::BlockWrite(_) => {
                 return Err(io::Error::other("read from a file being written"))
             }
         };
@@ -464,7 +587,13 @@ impl IoFile {
                     self.io.write_calls = c.calls;
                     self.io.bytes_written = c.bytes;
                 }
-                Backing::GzRead(_) | Backing::ZsRead(_) => {
+                Backing::BlockWrite(b) => {
+                    b.block(self.base, &self.buf[..self.len])?;
+                    self.io.codec_bytes += self.len as u64;
+                    self.io.write_calls = b.calls;
+                    self.io.bytes_written = b.stored + b.index_bytes;
+                }
+                Backing::GzRead(_) | Backing::ZsRead(_) | Backing::BlockRead(_) => {
                     return Err(io::Error::other("write to a file being read"))
                 }
             }
@@ -491,7 +620,8 @@ impl IoFile {
                 self.io.bytes_written = c.bytes;
                 c.inner.sync_data()?;
             }
-            Backing::GzRead(_) | Backing::ZsRead(_) => {}
+            Backing::BlockWrite(b) => b.sync()?,
+            Backing::GzRead(_) | Backing::ZsRead(_) | Backing::BlockRead(_) => {}
         }
         Ok(self.io)
     }

@@ -58,6 +58,7 @@
 //! [`crate::geometry::prims_of`] makes (same triangulation), so the breadth-first engine tests
 //! the same `f32` triangles as every other engine.
 
+pub mod blocks;
 pub mod hierarchy;
 mod io;
 mod read;
@@ -132,7 +133,13 @@ pub const OBJECTS_FILE_GZ: &str = "objects.bin.gz";
 pub const OBJECTS_FILE_ZST: &str = "objects.bin.zst";
 pub const BBOX_FILE: &str = "bbox.bin";
 pub const GEOMETRY_FILE: &str = "geometry.bin";
+/// The block indexes of a compressed split store ([`blocks`]; the data files are
+/// `bbox.bin.zst` and `geometry.bin.zst`).
+pub const BBOX_INDEX: &str = "bbox.bin.idx";
+pub const GEOMETRY_INDEX: &str = "geometry.bin.idx";
 pub const MATERIALS_FILE: &str = "materials.bin";
 
+#[cfg(test)]
+mod blocks_tests;
 #[cfg(test)]
 pub(crate) mod tests;

@@ -1,6 +1,7 @@
 //! Reading a store: its header, the bounding-box file as a forward stream, and the geometry
 //! file with forward-only seeks (seed 000 §4.2.2, "G": geometry is read only when needed).
 
+use super::blocks;
 use super::io::{Codec, IoCounters, IoFile};
 use super::write::bbox_checksum;
 use super::{
@@ -29,9 +30,13 @@ pub struct StoreHeader {
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub layout: Layout,
-    /// How `objects.bin` is stored (basic layout), and its size on disk.
+    /// How `objects.bin` (basic layout) or `bbox.bin` and `geometry.bin` (split layout: zstd
+    /// blocks, [`super::blocks`]) are stored, and the size on disk of `objects.bin` or of
+    /// `geometry.bin`'s data file.
     pub codec: Codec,
     pub stored_bytes: u64,
+    /// The size on disk of `bbox.bin`'s data file (compressed split layout; else `bbox_bytes`).
+    pub bbox_stored_bytes: u64,
     /// Sizes of `bbox.bin` and `geometry.bin`, as recorded (and checked against the files); in
     /// the basic layout `bbox_bytes` is 0 and `geometry_bytes` is the size of `objects.bin`.
     pub bbox_bytes: u64,
@@ -154,12 +159,18 @@ impl StoreHeader {
             (Some(name), Layout::Basic) if Codec::from_header(name).is_some() => {
                 Codec::from_header(name).unwrap_or_default()
             }
+            (Some("zstd"), Layout::Split)
+                if v["block_bytes"].as_u64() == Some(super::blocks::BLOCK_BYTES as u64) =>
+            {
+                Codec::Zstd(3)
+            }
             _ => {
                 return Err(bad(
                     dir,
                     format!(
-                        "compression {} (gzip or zstd, basic layout only)",
-                        v["compression"]
+                        "compression {} (gzip or zstd in the basic layout, zstd blocks of {} bytes in the split one)",
+                        v["compression"],
+                        super::blocks::BLOCK_BYTES
                     ),
                 ))
             }
@@ -167,6 +178,10 @@ impl StoreHeader {
         let stored_bytes = match codec {
             Codec::None => geometry_bytes,
             Codec::Gzip(_) | Codec::Zstd(_) => count("stored_bytes")?,
+        };
+        let bbox_stored_bytes = match (codec, layout) {
+            (Codec::None, _) | (_, Layout::Basic) => bbox_bytes,
+            _ => count("bbox_stored_bytes")?,
         };
         let h = StoreHeader {
             dir: dir.to_path_buf(),
@@ -181,6 +196,7 @@ impl StoreHeader {
             layout,
             codec,
             stored_bytes,
+            bbox_stored_bytes,
             bbox_bytes,
             geometry_bytes,
         };
@@ -220,6 +236,9 @@ impl StoreHeader {
         if self.objects > 0 && !(self.bounds[0].is_finite() && self.bounds[1].is_finite()) {
             return Err(bad(dir, "header.json: bounds are not finite"));
         }
+        if self.layout == Layout::Split && self.codec != Codec::None {
+            return self.check_blocks(crc);
+        }
         let files: &[(&str, u64)] = match self.layout {
             Layout::Split => &[
                 (BBOX_FILE, self.bbox_bytes),
@@ -255,6 +274,55 @@ impl StoreHeader {
             }
         }
         Ok(())
+    }
+
+    /// The files of a compressed split store: each data file's size, its index against it and
+    /// against the uncompressed size header.json records, and the index's header against
+    /// header.json's checksum.
+    fn check_blocks(&self, crc: u32) -> io::Result<()> {
+        let files = [
+            (BBOX_FILE, self.bbox_bytes, self.bbox_stored_bytes),
+            (GEOMETRY_FILE, self.geometry_bytes, self.stored_bytes),
+        ];
+        for (name, bytes, stored) in files {
+            let data = self.dir.join(blocks::data_name(name));
+            let size = std::fs::metadata(&data)
+                .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", data.display())))?
+                .len();
+            if size != stored {
+                return Err(bad(
+                    &self.dir,
+                    format!(
+                        "{} has {size} bytes, header.json says {stored}",
+                        blocks::data_name(name)
+                    ),
+                ));
+            }
+            let ix = blocks::BlockIndex::read(&blocks::index_path(&data), stored)
+                .map_err(|e| bad(&self.dir, e))?;
+            if ix.total != bytes {
+                return Err(bad(
+                    &self.dir,
+                    format!(
+                        "{name}'s blocks hold {} bytes, header.json says {bytes}",
+                        ix.total
+                    ),
+                ));
+            }
+            if ix.header_crc != crc {
+                return Err(bad(
+                    &self.dir,
+                    format!("{name}'s block index does not match header.json (checksum)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Bytes of the store's record files on disk (compressed where they are; block indexes
+    /// not counted).
+    pub fn disk_bytes(&self) -> u64 {
+        self.stored_bytes + self.bbox_stored_bytes
     }
 
     /// Reads the whole store once (its own buffers, outside any engine's I/O counters) and checks
@@ -462,6 +530,18 @@ fn check_file_header(f: &mut IoFile, magic: &[u8; 8], path: &Path) -> io::Result
     Ok(())
 }
 
+/// `bbox.bin` or `geometry.bin` of a split store, as it is stored: as zstd blocks when
+/// `NAME.zst` is there (its buffer is then one block, [`super::blocks`]), else plain.
+fn open_split_file(dir: &Path, name: &str, buffer: usize) -> io::Result<(IoFile, PathBuf)> {
+    let z = dir.join(blocks::data_name(name));
+    if z.exists() {
+        Ok((IoFile::open_blocks(&z)?, z))
+    } else {
+        let path = dir.join(name);
+        Ok((IoFile::open(&path, buffer)?, path))
+    }
+}
+
 /// One record of the bounding-box file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BboxRecord {
@@ -480,8 +560,17 @@ pub struct BboxReader {
 
 impl BboxReader {
     pub fn open(dir: &Path, objects: u64, buffer: usize) -> io::Result<BboxReader> {
-        let path = dir.join(BBOX_FILE);
-        let mut file = IoFile::open(&path, buffer)?;
+        let (mut file, path) = open_split_file(dir, BBOX_FILE, buffer)?;
+        let want = FILE_HEADER + objects * BBOX_RECORD as u64;
+        if file.block_total().is_some_and(|t| t != want) {
+            return Err(bad(
+                &path,
+                format!(
+                    "{} bytes in blocks for {objects} objects (expected {want})",
+                    file.block_total().unwrap_or(0)
+                ),
+            ));
+        }
         check_file_header(&mut file, BBOX_MAGIC, &path)?;
         Ok(BboxReader {
             file,
@@ -543,9 +632,11 @@ pub struct GeometryReader {
 
 impl GeometryReader {
     pub fn open(dir: &Path, buffer: usize) -> io::Result<GeometryReader> {
-        let path = dir.join(GEOMETRY_FILE);
-        let size = std::fs::metadata(&path)?.len();
-        let mut file = IoFile::open(&path, buffer)?;
+        let (mut file, path) = open_split_file(dir, GEOMETRY_FILE, buffer)?;
+        let size = match file.block_total() {
+            Some(t) => t,
+            None => std::fs::metadata(&path)?.len(),
+        };
         check_file_header(&mut file, GEOMETRY_MAGIC, &path)?;
         Ok(GeometryReader {
             file,
@@ -809,6 +900,17 @@ impl SceneReader {
         match self {
             SceneReader::Split { geometry, .. } => geometry.file.position(),
             SceneReader::Basic(b) => b.file.position(),
+        }
+    }
+
+    /// Bytes the reader holds in memory: its file buffers, and for a compressed split store
+    /// each file's compressed block and block index.
+    pub fn held_bytes(&self) -> u64 {
+        match self {
+            SceneReader::Split { bbox, geometry, .. } => {
+                bbox.file.held_bytes() + geometry.file.held_bytes()
+            }
+            SceneReader::Basic(b) => b.file.held_bytes(),
         }
     }
 

@@ -4,9 +4,9 @@
 
 use super::io::{Codec, IoCounters, IoFile};
 use super::{
-    Layout, Surface, BBOX_FILE, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_MAGIC, HEADER_FILE,
-    MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS, OBJECTS_FILE, OBJECTS_MAGIC,
-    VERSION,
+    Layout, Surface, BBOX_FILE, BBOX_INDEX, BBOX_MAGIC, GEOMETRY_FILE, GEOMETRY_INDEX,
+    GEOMETRY_MAGIC, HEADER_FILE, MATERIALS_FILE, MATERIALS_MAGIC, MATERIAL_RECORD, MAX_LIGHTS,
+    OBJECTS_FILE, OBJECTS_MAGIC, VERSION,
 };
 use crate::geometry::{prims_of, Prim};
 use glam::{DVec3, Vec3};
@@ -74,6 +74,47 @@ pub struct StoreWriter {
     record: Vec<u8>,
 }
 
+/// The layouts a codec can store: gzip only the basic one (a split store's files are read with
+/// seeks, so they are compressed as zstd blocks, and there is no gzip block format here).
+fn check_codec(layout: Layout, codec: Codec) -> io::Result<()> {
+    match (layout, codec) {
+        (Layout::Split, Codec::Gzip(_)) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "a split store is compressed with zstd (blocks) only, not gzip",
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `bbox.bin` or `geometry.bin` of a split store: plain, or as zstd blocks (`NAME.zst` and its
+/// index) under `Codec::Zstd`; new, or taken up at a checkpoint's `state`.
+fn split_file(
+    dir: &Path,
+    name: &str,
+    codec: Codec,
+    state: Option<&FileState>,
+) -> io::Result<IoFile> {
+    match (codec, state) {
+        (Codec::Zstd(level), None) => {
+            IoFile::create_blocks(&dir.join(super::blocks::data_name(name)), level)
+        }
+        (Codec::Zstd(level), Some(s)) => IoFile::append_blocks(
+            &dir.join(super::blocks::data_name(name)),
+            level,
+            s.stored,
+            s.written,
+        ),
+        (_, None) => IoFile::create(&dir.join(name), WRITE_BUFFER),
+        (_, Some(s)) => IoFile::append_codec(
+            &dir.join(name),
+            WRITE_BUFFER,
+            Codec::None,
+            s.stored,
+            s.written,
+        ),
+    }
+}
+
 fn f32s(out: &mut Vec<u8>, v: &[f32]) {
     for x in v {
         out.extend_from_slice(&x.to_le_bytes());
@@ -112,26 +153,23 @@ impl StoreWriter {
         Self::create_with(dir, name, layout, Codec::None)
     }
 
-    /// As [`StoreWriter::create_layout`], `objects.bin` stored through `codec` (basic layout
-    /// only: a compressed file is read strictly forward).
+    /// As [`StoreWriter::create_layout`], its files stored through `codec`: the basic layout's
+    /// `objects.bin` as one gzip or zstd stream (it is read strictly forward), the split
+    /// layout's two files as zstd blocks with an index ([`super::blocks`]: they are read with
+    /// seeks).
     pub fn create_with(
         dir: &Path,
         name: &str,
         layout: Layout,
         codec: Codec,
     ) -> io::Result<StoreWriter> {
-        if codec != Codec::None && layout != Layout::Basic {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                "a compressed store needs the basic layout",
-            ));
-        }
+        check_codec(layout, codec)?;
         std::fs::create_dir_all(dir)?;
         // The header's checksum goes in at `finish`, when header.json is written.
         let (bbox, geometry) = match layout {
             Layout::Split => {
-                let mut bbox = IoFile::create(&dir.join(BBOX_FILE), WRITE_BUFFER)?;
-                let mut geometry = IoFile::create(&dir.join(GEOMETRY_FILE), WRITE_BUFFER)?;
+                let mut bbox = split_file(dir, BBOX_FILE, codec, None)?;
+                let mut geometry = split_file(dir, GEOMETRY_FILE, codec, None)?;
                 bbox.write_all(&file_header(BBOX_MAGIC, 0))?;
                 geometry.write_all(&file_header(GEOMETRY_MAGIC, 0))?;
                 (Some(bbox), geometry)
@@ -226,22 +264,11 @@ impl StoreWriter {
         codec: Codec,
         state: &WriteState,
     ) -> io::Result<StoreWriter> {
+        check_codec(layout, codec)?;
         let (bbox, geometry) = match (layout, &state.bbox) {
             (Layout::Split, Some(b)) => (
-                Some(IoFile::append_codec(
-                    &dir.join(BBOX_FILE),
-                    WRITE_BUFFER,
-                    Codec::None,
-                    b.stored,
-                    b.written,
-                )?),
-                IoFile::append_codec(
-                    &dir.join(GEOMETRY_FILE),
-                    WRITE_BUFFER,
-                    Codec::None,
-                    state.geometry.stored,
-                    state.geometry.written,
-                )?,
+                Some(split_file(dir, BBOX_FILE, codec, Some(b))?),
+                split_file(dir, GEOMETRY_FILE, codec, Some(&state.geometry))?,
             ),
             (Layout::Basic, None) => {
                 let file = codec.objects_file();
@@ -406,10 +433,22 @@ impl StoreWriter {
             "materials_bytes": materials_bytes,
             "materials_crc": materials_crc,
         });
+        let split_zstd = self.layout == Layout::Split && self.codec != Codec::None;
         match self.layout {
             Layout::Split => {
                 header["bbox_bytes"] = json!(bbox_bytes);
                 header["geometry_bytes"] = json!(geometry_bytes);
+                if split_zstd {
+                    // The data files' sizes (the counters also hold the indexes').
+                    let size = |n: &str| {
+                        std::fs::metadata(self.dir.join(super::blocks::data_name(n)))
+                            .map(|m| m.len())
+                    };
+                    header["compression"] = json!(self.codec.name());
+                    header["block_bytes"] = json!(super::blocks::BLOCK_BYTES);
+                    header["bbox_stored_bytes"] = json!(size(BBOX_FILE)?);
+                    header["stored_bytes"] = json!(size(GEOMETRY_FILE)?);
+                }
             }
             Layout::Basic => {
                 header["layout"] = json!("basic");
@@ -427,6 +466,8 @@ impl StoreWriter {
         // Tie the header to the files: its checksum in both files' headers.
         let crc = crc32fast::hash(text.as_bytes()).to_le_bytes();
         let files: &[&str] = match self.layout {
+            // The indexes' headers carry it: the data files are written compressed.
+            Layout::Split if split_zstd => &[BBOX_INDEX, GEOMETRY_INDEX],
             Layout::Split => &[BBOX_FILE, GEOMETRY_FILE],
             Layout::Basic if self.codec == Codec::None => &[OBJECTS_FILE],
             // Written compressed: its header cannot be patched in place.

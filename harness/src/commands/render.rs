@@ -42,8 +42,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         return Err(input(f));
     }
     let pixels = r.pixels();
-    let sha = hex(&Sha256::digest(pixels));
-    if let Some(png) = &a.png {
+    // A run the pass cap stopped (`max_passes`) has no image: the rays left were not traced.
+    let capped = pass_capped(&r.counters);
+    let sha = (!capped).then(|| hex(&Sha256::digest(pixels)));
+    if capped {
+        eprintln!("render: the pass cap (max_passes) stopped the run: its counters and times are its first passes'; no image");
+    } else if let Some(png) = &a.png {
         write_png(png, pixels, a.size)?;
     }
     let scene = &prepared.input.scene;
@@ -72,7 +76,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "memory": {"structure_bytes": engine.structure_bytes(), "geometry_bytes": g.bytes(), "peak_rss_bytes": workload::peak_rss_bytes()},
         "counters": r.counters,
         "build_stats": engine.build_stats(),
-        "image": {"width": a.size, "height": a.size, "sha256": sha},
+        "image": {"width": a.size, "height": a.size, "sha256": sha, "incomplete": capped},
     });
     if a.json {
         print_json(&v);
@@ -211,8 +215,12 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
     }
     let r = &ooc.render;
     let pixels = r.pixels();
-    let sha = hex(&Sha256::digest(pixels));
-    if let Some(png) = &a.png {
+    // A run the pass cap stopped (`max_passes`) has no image: the rays left were not traced.
+    let capped = pass_capped(&r.counters);
+    let sha = (!capped).then(|| hex(&Sha256::digest(pixels)));
+    if capped {
+        eprintln!("render: the pass cap (max_passes) stopped the run: its counters and times are its first passes'; no image");
+    } else if let Some(png) = &a.png {
         write_png(png, pixels, a.size)?;
     }
     let h = engine.header();
@@ -239,7 +247,7 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
         "counters": r.counters,
         "io": {"workload": ooc.io},
         "build_stats": rtbench_engines::Engine::build_stats(&engine),
-        "image": {"width": a.size, "height": a.size, "sha256": sha},
+        "image": {"width": a.size, "height": a.size, "sha256": sha, "incomplete": capped},
     });
     if a.json {
         print_json(&v);
@@ -256,4 +264,11 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
         );
     }
     Ok(())
+}
+
+/// Whether the breadth-first engine's pass cap stopped the run (`max_passes`).
+pub fn pass_capped(c: &rtbench_engines::Counters) -> bool {
+    c.extra
+        .get(rtbench_engines::breadth_first::cap::CAP_REACHED)
+        .is_some_and(|&n| n > 0)
 }

@@ -107,9 +107,9 @@ pub fn store(
         .parse()
         .map_err(|e| input(format!("--layout {layout}: {e}")))?;
     let codec = parse_codec(compress).map_err(|e| input(format!("--compress {compress}: {e}")))?;
-    if codec != Codec::None && layout != Layout::Basic {
+    if matches!(codec, Codec::Gzip(_)) && layout == Layout::Split {
         return Err(input(format!(
-            "--compress {compress}: a compressed store is read strictly forward, so it needs --layout basic"
+            "--compress {compress}: a split store is read with seeks, so it is compressed as zstd blocks: use --compress zstd[:LEVEL] or --layout basic"
         )));
     }
     if hierarchy && layout != Layout::Split {
@@ -185,7 +185,7 @@ pub fn store(
         "layout": layout.name(),
         "compression": codec.name(),
         "objects_bytes": header.geometry_bytes + header.bbox_bytes,
-        "stored_bytes": header.stored_bytes + header.bbox_bytes,
+        "stored_bytes": header.disk_bytes(),
         "scene": src.label(),
         "objects": header.objects,
         "primitives": header.primitives,

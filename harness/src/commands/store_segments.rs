@@ -30,9 +30,9 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
         .map_err(|e| input(format!("--layout {}: {e}", a.layout)))?;
     let codec =
         parse_codec(a.compress).map_err(|e| input(format!("--compress {}: {e}", a.compress)))?;
-    if codec.name() != "none" && layout != Layout::Basic {
+    if codec.name() == "gzip" && layout == Layout::Split {
         return Err(input(format!(
-            "--compress {}: a compressed store is read strictly forward, so it needs --layout basic",
+            "--compress {}: a split store is read with seeks, so it is compressed as zstd blocks: use --compress zstd[:LEVEL] or --layout basic",
             a.compress
         )));
     }
@@ -88,7 +88,7 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
     let (finished, objects, stored) = match &outcome {
         Outcome::Finished(_) => {
             let h = StoreHeader::read(out).map_err(|e| input(e.to_string()))?;
-            (true, h.objects, h.stored_bytes + h.bbox_bytes)
+            (true, h.objects, h.disk_bytes())
         }
         Outcome::Stopped => (
             false,

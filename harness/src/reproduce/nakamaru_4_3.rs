@@ -12,9 +12,17 @@
 //! (the report then says which steps are still to do). Where the basic method cannot be traced
 //! whole, `basic-fraction=N` traces every N-th band of image rows (a tile set, as
 //! `render --tile 1/N` makes it) and extrapolates its tracing time by the rows not traced: that
-//! row is labelled `model`, with the extrapolation written out. `--quick` runs small stand-ins
-//! (mount6, rings6, rings6m at 64×64) with the basic method both whole and on a quarter of the
-//! rows, which tests the model against a measurement.
+//! row is labelled `model`, with the extrapolation written out. Or `basic-passes=N` runs the
+//! basic method for its first N passes (the engine's `max_passes`) and extrapolates its tracing
+//! time by S+G's pass count: S+G uses the same high-resolution grid, the same rays and the same
+//! memory budget, so it makes the passes the basic method would (measured on `--quick`: the
+//! report's basic-model row gives both counts). `--quick` runs small stand-ins (mount6, rings6,
+//! rings6m at 64×64) with the basic method both whole and as the model (a quarter of the rows,
+//! or the first N passes), which tests the model against a measurement.
+//!
+//! The split store is zstd-compressed by default (`split-compress`; zstd blocks with an index,
+//! `rtbench_engines::store::blocks`): uncompressed, mount14's and rings368's split stores take
+//! ~55 GB and ~102 GB, more than the disk's free space.
 
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
@@ -69,6 +77,14 @@ const MAX_SECONDS: Param = Param {
     key: "max-seconds",
     help: "stop at the first checkpoint after this many seconds (default: no limit)",
 };
+const PASSES: Param = Param {
+    key: "basic-passes",
+    help: "trace the basic method for its first N passes only (max_passes=N) and extrapolate by S+G's pass count (a model; --quick: against the whole basic run)",
+};
+const SPLIT_COMPRESS: Param = Param {
+    key: "split-compress",
+    help: "the split store: zstd (default; zstd blocks, ~2-3x smaller, so that 10^9 objects fit the disk), zstd:LEVEL or none",
+};
 const FRACTION: Param = Param {
     key: "basic-fraction",
     help: "trace the basic method on every N-th band of rows only and extrapolate (a model; default 1: whole)",
@@ -83,7 +99,19 @@ pub const TABLE: Table = Table {
         quick: "a minute",
         full: "days to weeks (10^9 objects out of core, three methods); resumable by segment and step",
     },
-    params: &[ROWS, SIZE, MEMORY, CACHE, STORES, SPILL, SEGMENT, MAX_SECONDS, FRACTION],
+    params: &[
+        ROWS,
+        SIZE,
+        MEMORY,
+        CACHE,
+        STORES,
+        SPILL,
+        SEGMENT,
+        MAX_SECONDS,
+        FRACTION,
+        PASSES,
+        SPLIT_COMPRESS,
+    ],
     claims: &[
         Claim {
             key: "sgb-ratio",
@@ -98,7 +126,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "basic-model",
             fidelity: Fidelity::Model,
-            why: "basic tracing time extrapolated from a tile set of the image rows (--quick: against the whole image, measured)",
+            why: "basic tracing time extrapolated from a tile set of the image rows (basic-fraction) or from its first N passes by S+G's pass count (basic-passes); --quick: against the whole run, measured",
         },
         Claim {
             key: "view",
@@ -156,6 +184,12 @@ struct Run {
     rows_traced: u32,
     scale: f64,
     load_average: String,
+    /// Stopped by the pass cap (`basic-passes`): `passes` is the cap, the image no answer, and
+    /// `scale` = `passes_total` / `passes` once S+G's pass count is known (0 until then).
+    #[serde(default)]
+    capped: bool,
+    #[serde(default)]
+    passes_total: u64,
 }
 
 impl Run {
@@ -212,6 +246,8 @@ struct Setup {
     segment: u64,
     deadline: Option<Instant>,
     fraction: u32,
+    passes: Option<u64>,
+    split_codec: Codec,
     view: View,
 }
 
@@ -247,7 +283,7 @@ fn write_store(
             let h = StoreHeader::read(dir).map_err(|e| input(e.to_string()))?;
             Ok(Some(StoreStep {
                 objects: h.objects,
-                stored_bytes: h.stored_bytes + h.bbox_bytes,
+                stored_bytes: h.disk_bytes(),
                 seconds: log.done.iter().map(|d| d.seconds).sum(),
                 segments: log.done.len(),
             }))
@@ -285,16 +321,28 @@ fn trace(
         Some(t) => tiles::rows(t, s.size).len() as u32,
         None => s.size + 1,
     };
+    // A run the pass cap stopped has no image and no scale until S+G's passes are known.
+    let capped = crate::commands::render::pass_capped(&r.counters);
     Ok(Run {
         preprocess_s,
         trace_s: r.trace_s,
         passes: r.counters.extra.get("bf_passes").copied().unwrap_or(0),
         rays: r.stats.total,
-        sha256: hex(&Sha256::digest(r.pixels())),
+        sha256: if capped {
+            String::new()
+        } else {
+            hex(&Sha256::digest(r.pixels()))
+        },
         peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
         rows_traced,
-        scale: (s.size + 1) as f64 / rows_traced.max(1) as f64,
+        scale: if capped {
+            0.0
+        } else {
+            (s.size + 1) as f64 / rows_traced.max(1) as f64
+        },
         load_average,
+        capped,
+        passes_total: 0,
     })
 }
 
@@ -342,15 +390,26 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
         }
         eprintln!("nakamaru-4.3: {}: basic …", m.row);
         let basic_sets = [("layout", "basic")];
+        let cap = s.passes.map(|n| n.to_string());
+        let capped_sets = cap
+            .as_deref()
+            .map(|n| [("layout", "basic"), ("max_passes", n)]);
         if ctx.quick {
-            let t = ShardSpec { k: 1, n: 4 };
-            m.basic_tile = Some(trace(&dir, s, view, Some(t), &basic_sets)?);
+            // The model's test: the part beside the whole.
+            m.basic_tile = Some(match &capped_sets {
+                Some(sets) => trace(&dir, s, view, None, sets)?,
+                None => trace(&dir, s, view, Some(ShardSpec { k: 1, n: 4 }), &basic_sets)?,
+            });
+            m.basic = Some(trace(&dir, s, view, None, &basic_sets)?);
+        } else if let Some(sets) = &capped_sets {
+            m.basic = Some(trace(&dir, s, view, None, sets)?);
+        } else {
+            let tile = (s.fraction > 1).then_some(ShardSpec {
+                k: 1,
+                n: s.fraction,
+            });
+            m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
         }
-        let tile = (s.fraction > 1).then_some(ShardSpec {
-            k: 1,
-            n: s.fraction,
-        });
-        m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
         save(m)?;
         if !keep_basic {
             // The disk holds the basic and the split store of a 10^9-object scene only one
@@ -372,7 +431,7 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
         let dir = store("split");
         if m.split_store.is_none() {
             eprintln!("nakamaru-4.3: {}: split store (in segments) …", m.row);
-            match write_store(&src, &dir, Layout::Split, Codec::None, s)? {
+            match write_store(&src, &dir, Layout::Split, s.split_codec, s)? {
                 Some(st) => m.split_store = Some(st),
                 None => return Ok(false),
             }
@@ -386,6 +445,13 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
         eprintln!("nakamaru-4.3: {}: {name} …", m.row);
         let r = trace(&dir, s, view, None, sets)?;
         if name == "S+G" {
+            // The pass model's total: S+G's passes (the same grid, rays and memory budget).
+            for b in [m.basic.as_mut(), m.basic_tile.as_mut()].into_iter().flatten() {
+                if b.capped && b.passes > 0 {
+                    b.passes_total = r.passes;
+                    b.scale = r.passes as f64 / b.passes as f64;
+                }
+            }
             m.sg = Some(r);
         } else {
             m.sgb = Some(r);
@@ -403,6 +469,21 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .unwrap_or(if ctx.quick { 64 } else { 512 });
     workload::check_size(size)?;
     let fraction = ctx.params.number::<u32>(FRACTION.key, 1)?.unwrap_or(1);
+    let passes = ctx.params.number::<u64>(PASSES.key, 1)?;
+    if passes.is_some() && fraction > 1 {
+        return Err(input(
+            "nakamaru-4.3: basic-passes and basic-fraction are two models of one run: give one",
+        ));
+    }
+    let split_codec = match ctx.params.raw(SPLIT_COMPRESS.key).unwrap_or("zstd") {
+        c if c.starts_with("gzip") => {
+            return Err(input(format!(
+                "nakamaru-4.3: split-compress={c}: a split store is compressed as zstd blocks (zstd, zstd:LEVEL) or not at all (none)"
+            )))
+        }
+        c => crate::commands::scene::parse_codec(c)
+            .map_err(|e| input(format!("nakamaru-4.3: split-compress={c}: {e}")))?,
+    };
     let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;
     let segment = ctx
         .params
@@ -423,6 +504,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
         segment,
         deadline: max_seconds.map(|x| Instant::now() + Duration::from_secs_f64(x)),
         fraction,
+        passes,
+        split_codec,
         view,
     };
     let names: Vec<String> = match ctx.params.list(ROWS.key)? {
@@ -495,6 +578,24 @@ fn ratio(a: f64, b: f64) -> f64 {
 
 /// The extrapolation of a basic run, written out.
 fn model_text(r: &Run) -> String {
+    if r.capped {
+        return if r.passes_total == 0 {
+            format!(
+                "pre {:.1} s + trace {:.1} s (first {} passes) × (S+G's passes, not yet measured)",
+                r.preprocess_s, r.trace_s, r.passes
+            )
+        } else {
+            format!(
+                "pre {:.1} s + trace {:.1} s (first {} passes) × {} / {} (S+G's passes) = {:.1} s",
+                r.preprocess_s,
+                r.trace_s,
+                r.passes,
+                r.passes_total,
+                r.passes,
+                r.total_s()
+            )
+        };
+    }
     if r.scale == 1.0 {
         format!("{:.1} s measured", r.total_s())
     } else {
@@ -523,7 +624,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         };
         let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
         if let (Some(b), Some(sg), Some(sgb)) = (&m.basic, &m.sg, &m.sgb) {
-            let model = b.scale != 1.0;
+            let model = b.scale != 1.0 || b.capped;
             let tag = if model { " (basic: model)" } else { "" };
             for (claim, x, f) in [
                 ("sg-ratio", sg, (|r: &PublishedRow| r.sg) as fn(&PublishedRow) -> f64),
@@ -560,7 +661,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     "equal",
                     format!(
                         "{}{} / {} / {}",
-                        if model { "(basic: a tile set, not compared) " } else { "" },
+                        if model { "(basic: a model, not compared) " } else { "" },
                         &b.sha256[..12.min(b.sha256.len())],
                         &sg.sha256[..12.min(sg.sha256.len())],
                         &sgb.sha256[..12.min(sgb.sha256.len())]
@@ -597,12 +698,24 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         if let (Some(tile), Some(whole)) = (&m.basic_tile, &m.basic) {
             // The model against the measurement it stands in for (`--quick`).
             let e = ratio(tile.total_s(), whole.total_s());
+            let (what, passes) = if tile.capped {
+                (
+                    format!("{}: the first {} passes against the whole", m.row, tile.passes),
+                    format!(
+                        " (passes: basic {}, S+G {})",
+                        whole.passes,
+                        m.sg.as_ref().map_or("-".into(), |r| r.passes.to_string())
+                    ),
+                )
+            } else {
+                (format!("{}: a quarter of the rows against the whole", m.row), String::new())
+            };
             rows.push(
                 Row::new(
                     "basic-model",
-                    format!("{}: a quarter of the rows against the whole", m.row),
+                    what,
                     "within 25% of the measured time",
-                    format!("{} against {:.1} s measured: {e:.2}", model_text(tile), whole.total_s()),
+                    format!("{} against {:.1} s measured: {e:.2}{passes}", model_text(tile), whole.total_s()),
                     Kind::Ratio,
                     Verdict::of((0.75..=1.25).contains(&e)),
                 )
@@ -657,7 +770,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
 fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finished: bool) -> Document {
     let mut doc = Document::new("nakamaru-4.3: massive data, basic method vs S+G and S+G+B");
     doc.paragraph(format!(
-        "Published: {}. Measured: `rtbench reproduce nakamaru-4.3{}`, {}×{}, engine memory {}, cache {}, high-resolution grid for every method (as the thesis), basic store gzip level 1 in segments of {} objects.{}",
+        "Published: {}. Measured: `rtbench reproduce nakamaru-4.3{}`, {}×{}, engine memory {}, cache {}, high-resolution grid for every method (as the thesis), basic store gzip level 1 in segments of {} objects, split store {}.{}",
         p.source.cite(),
         if quick { " --quick" } else { "" },
         s.size,
@@ -665,6 +778,10 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
         s.memory,
         s.cache,
         s.segment,
+        match s.split_codec {
+            Codec::Zstd(l) => format!("zstd level {l} in blocks"),
+            _ => "uncompressed".into(),
+        },
         if finished { "" } else { " **Partial: stopped at a checkpoint; run again with --resume.**" }
     ));
     let mut t = DocTable::new(

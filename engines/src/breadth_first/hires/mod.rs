@@ -70,6 +70,9 @@ impl Work {
         let mut input_left = true;
         let mut pass = 0usize;
         loop {
+            if self.capped(rays, out, c) {
+                return Ok(());
+            }
             let may_read = self.refill || self.slots.is_empty();
             while may_read && input_left && self.slots.len() < self.capacity {
                 let Some((id, ray)) = rays.next() else {
@@ -110,6 +113,7 @@ impl Work {
             *c.extra.entry("bf_registrations".into()).or_insert(0) += h.cands.len() as u64;
             self.sweep(any, test, c)?;
             *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
+            self.passes_done += 1;
             // Algorithm 4.5: done when the hit lies before the sentinel (every voxel up to it
             // was swept or holds no box not met before), or the walk has no sentinel.
             let h = self.hires.as_mut().expect("hires");

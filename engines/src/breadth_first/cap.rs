@@ -1,0 +1,44 @@
+//! The pass cap (`max_passes=N`): the run stops after its first N passes (over all its trace
+//! calls), every counter and time of those passes kept, and says so (`bf_pass_cap_reached`).
+//!
+//! Why: seed 000's basic method cannot finish 10^9 objects within a session (Table 4.3: 27 to
+//! 110 hours on the thesis's machine), and each of its passes sweeps the whole store, so the
+//! time of a few passes and the pass count bound its total (`nakamaru-4.3`'s `basic-passes=N`
+//! model). The image of a capped run is not an answer: the rays left are answered MISS without
+//! a sweep, and the harness claims no image for it.
+
+use super::intersect::Work;
+use crate::{Counters, Hit, Ray};
+
+/// The counter a capped run sets (> 0: the run stopped at the cap; no image).
+pub const CAP_REACHED: &str = "bf_pass_cap_reached";
+
+impl Work {
+    /// Whether the cap is reached. Then the rays in memory and the rest of `rays` are answered
+    /// MISS (no test, no counter), and [`CAP_REACHED`] is set when any ray was left.
+    pub(super) fn capped(
+        &mut self,
+        rays: &mut dyn Iterator<Item = (u32, Ray)>,
+        out: &mut dyn FnMut(u32, Hit),
+        c: &mut Counters,
+    ) -> bool {
+        if self.max_passes.is_none_or(|m| self.passes_done < m) {
+            return false;
+        }
+        let mut left = !self.slots.is_empty();
+        for s in self.slots.drain(..) {
+            out(s.id, Hit::MISS);
+        }
+        if let Some(h) = self.hires.as_mut() {
+            h.walks.clear();
+        }
+        for (id, _) in rays {
+            out(id, Hit::MISS);
+            left = true;
+        }
+        if left {
+            *c.extra.entry(CAP_REACHED.into()).or_insert(0) = 1;
+        }
+        true
+    }
+}
