@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::{expect_input_error, json, Dir};
+use common::{expect_input_error, json, store_scene, Dir};
 use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::Command;
@@ -187,17 +187,7 @@ fn crc32(parts: &[&[u8]]) -> u32 {
 fn a_hierarchy_that_disagrees_with_its_level_below_exits_2() {
     let d = Dir::new("faults-cli", "bh");
     let store = d.join("tetra4");
-    json(&[
-        "scene",
-        "store",
-        "tetra",
-        "--sf",
-        "4",
-        "-o",
-        &store,
-        "--hierarchy",
-        "--json",
-    ]);
+    store_scene("tetra", "4", &store, &["--hierarchy"]);
     // Level-1 node 0 (after the 16-byte file header; 44-byte records: 6 × f32 box, u64 end,
     // u32 children, u32 objects, u32 CRC of level, index and the first 40 bytes): its box shrunk
     // to its min corner, the checksum made right, so only the check against level 0 can tell.

@@ -4,24 +4,14 @@
 
 mod common;
 
-use common::{expect_input_error, json, render_breadth_first, rtbench, Dir};
+use common::{expect_input_error, json, render_breadth_first, rtbench, store_scene, Dir};
 use serde_json::Value;
 
 #[test]
 fn hierarchy_renders_the_same_image_and_skips() {
     let d = Dir::new("bh-cli", "render");
     let store = d.join("mount5");
-    let s = json(&[
-        "scene",
-        "store",
-        "mount",
-        "--sf",
-        "5",
-        "-o",
-        &store,
-        "--hierarchy",
-        "--json",
-    ]);
+    let s = store_scene("mount", "5", &store, &["--hierarchy"]);
     assert!(!s["hierarchy_levels"].as_array().unwrap().is_empty());
     let sg = render_breadth_first(&store, &["memory=2MiB"]);
     let sgb = render_breadth_first(&store, &["memory=2MiB", "hierarchy=on", "cache=cold"]);
@@ -56,17 +46,7 @@ fn hierarchy_renders_the_same_image_and_skips() {
 fn a_damaged_hierarchy_exits_2() {
     let d = Dir::new("bh-cli", "bad");
     let store = d.join("tetra4");
-    json(&[
-        "scene",
-        "store",
-        "tetra",
-        "--sf",
-        "4",
-        "-o",
-        &store,
-        "--hierarchy",
-        "--json",
-    ]);
+    store_scene("tetra", "4", &store, &["--hierarchy"]);
     let args = |set: &'static str| -> Vec<String> {
         [
             "render",

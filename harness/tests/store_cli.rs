@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{expect_input_error, json, rtbench, Dir};
+use common::{expect_input_error, json, rtbench, store_scene, Dir};
 use serde_json::Value;
 
 #[test]
@@ -317,21 +317,8 @@ fn compressed_stores_render_the_plain_image_and_refuse_damage() {
 fn a_compressed_split_store_renders_the_plain_image_and_the_pass_cap_claims_none() {
     let d = Dir::new("store-cli", "split-zstd");
     let (plain, zst) = (d.join("plain"), d.join("zst"));
-    let p = json(&[
-        "scene", "store", "mount", "--sf", "5", "-o", &plain, "--json",
-    ]);
-    let z = json(&[
-        "scene",
-        "store",
-        "mount",
-        "--sf",
-        "5",
-        "-o",
-        &zst,
-        "--compress",
-        "zstd",
-        "--json",
-    ]);
+    let p = store_scene("mount", "5", &plain, &[]);
+    let z = store_scene("mount", "5", &zst, &["--compress", "zstd"]);
     assert_eq!(p["objects_bytes"], z["objects_bytes"]);
     assert!(
         z["stored_bytes"].as_u64() < p["stored_bytes"].as_u64(),

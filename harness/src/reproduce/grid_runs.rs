@@ -60,10 +60,6 @@ pub fn resolve(scene: &str, sf: u32) -> Result<SceneSource> {
     SceneSource::resolve(scene, Some(sf), None, hash)
 }
 
-fn reset_peak_rss() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
 pub fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
@@ -90,7 +86,7 @@ pub struct Setup {
 
 /// Traces the store at `dir` with S+G+B and `grid` settings.
 pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> {
-    reset_peak_rss();
+    workload::reset_peak_rss();
     let load_average = load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),

@@ -215,17 +215,6 @@ fn resolve(scene: &str, sf: u32) -> Result<SceneSource> {
     SceneSource::resolve(scene, Some(sf), None, hash)
 }
 
-/// Starts the peak RSS afresh (Linux `clear_refs` 5), so that each run reports its own.
-fn reset_peak_rss() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_default()
-}
-
 /// Streams the scene into a store of `layout` at `dir`; returns (header, seconds).
 fn write_store(src: &SceneSource, dir: &Path, layout: Layout) -> Result<(StoreHeader, f64)> {
     let t = std::time::Instant::now();
@@ -246,8 +235,8 @@ struct Setup<'a> {
 }
 
 fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
-    reset_peak_rss();
-    let load_average = load_average();
+    workload::reset_peak_rss();
+    let load_average = super::grid_runs::load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.into()),
         ("verify".into(), "records".into()),

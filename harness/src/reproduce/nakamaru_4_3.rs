@@ -251,10 +251,6 @@ struct Setup {
     view: View,
 }
 
-fn reset_peak_rss() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
 /// Writes (or goes on writing) the store at `dir`; `None` when stopped by the deadline.
 fn write_store(
     src: &crate::source::Source,
@@ -298,7 +294,7 @@ fn trace(
     tile: Option<ShardSpec>,
     extra: &[(&str, &str)],
 ) -> Result<Run> {
-    reset_peak_rss();
+    workload::reset_peak_rss();
     let load_average = super::grid_runs::load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),

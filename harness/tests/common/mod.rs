@@ -68,6 +68,14 @@ pub fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// `scene store SCENE --sf SF -o OUT EXTRA… --json`, which must succeed.
+pub fn store_scene(scene: &str, sf: &str, out: &str, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["scene", "store", scene, "--sf", sf, "-o", out];
+    args.extend_from_slice(extra);
+    args.push("--json");
+    json(&args)
+}
+
 /// `render --scene STORE --engine breadth-first --size 48 --set S… --json`.
 pub fn render_breadth_first(store: &str, sets: &[&str]) -> serde_json::Value {
     let mut args = vec![
