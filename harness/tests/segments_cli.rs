@@ -166,3 +166,41 @@ fn nakamaru_4_3_stops_at_a_checkpoint_and_finishes_resumed() {
         .join(".partial/nakamaru-4.3/stores")
         .exists());
 }
+
+/// rings368 and rings368m share their stores. Both basic runs come before the split store is
+/// written, so the basic store (~47 GB) is gone before the split store (~24 GB) is written: the
+/// disk holds them only one after the other. The second row takes the first's stores as they
+/// are, without streaming the scene again.
+#[test]
+fn nakamaru_4_3_runs_a_scenes_basic_rows_before_its_split_store() {
+    let d = Dir::new("seg-cli", "order");
+    let out = d.join("out");
+    let r = rtbench(&[
+        "reproduce",
+        "nakamaru-4.3",
+        "--out",
+        &out,
+        "--set",
+        "rows=rings2,rings2m",
+        "--set",
+        "size=16",
+        "--set",
+        "segment=100",
+        "--set",
+        "cache=warm",
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    let at = |s: &str| err.find(s).unwrap_or_else(|| panic!("no {s:?} in {err}"));
+    assert!(at("rings2m: basic …") < at("rings2: split store"), "{err}");
+    assert_eq!(err.matches("basic store").count(), 1, "{err}");
+    assert_eq!(err.matches("split store").count(), 1, "{err}");
+    let v: Value =
+        serde_json::from_slice(&std::fs::read(Path::new(&out).join("nakamaru-4.3.json")).unwrap())
+            .unwrap();
+    let m = &v["measured"];
+    assert_eq!(m[0]["basic_store"], m[1]["basic_store"]);
+    assert_eq!(m[0]["split_store"], m[1]["split_store"]);
+    assert!(m[1]["objects"].as_u64().unwrap() > 0);
+    assert_eq!(v["finished"], true);
+}

@@ -9,7 +9,10 @@
 //! in sessions: the basic store (gzip-compressed: the basic method reads it strictly forward,
 //! §3.4) and the split store are written in segments (`rtbench_engines::store::segments`), each
 //! segment a checkpoint; `max-seconds=S` stops the run at the first checkpoint past S seconds
-//! (the report then says which steps are still to do). Where the basic method cannot be traced
+//! (the report then says which steps are still to do). A scene's rows share its stores and run
+//! in the order the disk allows: every row's basic steps first, the basic store removed after
+//! the last, then the split store and every row's S+G and S+G+B (rings368's basic and split
+//! stores, ~47 and ~24 GB, are never on disk together). Where the basic method cannot be traced
 //! whole, `basic-fraction=N` traces every N-th band of image rows (a tile set, as
 //! `render --tile 1/N` makes it) and extrapolates its tracing time by the rows not traced: that
 //! row is labelled `model`, with the extrapolation written out. Or `basic-passes=N` runs the
@@ -190,6 +193,10 @@ struct Run {
     capped: bool,
     #[serde(default)]
     passes_total: u64,
+    /// The process's CPU seconds over the run (0 in rows saved before they were kept): a run
+    /// that waited for a core shows CPU / wall well under 1.
+    #[serde(default)]
+    cpu_s: f64,
 }
 
 impl Run {
@@ -307,6 +314,7 @@ fn trace(
     }
     pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    let cpu0 = workload::process_cpu_seconds();
     let t = Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let preprocess_s = t.elapsed().as_secs_f64();
@@ -339,6 +347,7 @@ fn trace(
         load_average,
         capped,
         passes_total: 0,
+        cpu_s: workload::process_cpu_seconds() - cpu0,
     })
 }
 
@@ -359,60 +368,76 @@ fn past(s: &Setup) -> bool {
     s.deadline.is_some_and(|d| Instant::now() >= d)
 }
 
-/// Measures what is left of one row; returns whether it is complete.
-fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Result<bool> {
-    let cp = ctx.checkpoint;
-    let key = format!("{}-{}-{}-{}", m.row, s.size, s.memory, s.cache);
-    let save = |m: &Measured| cp.save(&key, m);
-    if let Some(saved) = cp.load::<Measured>(&key)? {
-        *m = saved;
+fn row_key(m: &Measured, s: &Setup) -> String {
+    format!("{}-{}-{}-{}", m.row, s.size, s.memory, s.cache)
+}
+
+fn store_dir(m: &Measured, s: &Setup, kind: &str) -> PathBuf {
+    s.stores.join(format!("{}{}-{kind}", m.scene, m.sf))
+}
+
+/// The basic method's steps of one row: its store (gzip, in segments) and its run (whole, a
+/// tile set or the first N passes). Returns whether they are done. The store is removed after
+/// the last row that needs it (`keep_basic` false), before any split store of the scene is
+/// written: the disk holds a 10^9-object scene's basic and split stores only one after the
+/// other (rings368's ~47 GB and ~24 GB).
+fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Result<bool> {
+    if m.basic.is_some() {
+        return Ok(true);
+    }
+    if past(s) {
+        return Ok(false);
     }
     let src = super::grid_runs::resolve(&m.scene, m.sf)?;
-    let store = |kind: &str| s.stores.join(format!("{}{}-{kind}", m.scene, m.sf));
+    let save = |m: &Measured| ctx.checkpoint.save(&row_key(m, s), m);
     let view = (m.view == "m").then_some(&s.view);
-    // The basic store, its run (whole or a tile set), then the split store and S+G, S+G+B.
-    if m.basic.is_none() {
+    let dir = store_dir(m, s, "basic");
+    if m.basic_store.is_none() {
+        eprintln!("nakamaru-4.3: {}: basic store (gzip, in segments) …", m.row);
+        match write_store(&src, &dir, Layout::Basic, Codec::Gzip(1), s)? {
+            Some(st) => m.basic_store = Some(st),
+            None => return Ok(false),
+        }
+        save(m)?;
+        // A budget spent on the store stops here, so that the next session starts the run.
         if past(s) {
             return Ok(false);
         }
-        let dir = store("basic");
-        if m.basic_store.is_none() {
-            eprintln!("nakamaru-4.3: {}: basic store (gzip, in segments) …", m.row);
-            match write_store(&src, &dir, Layout::Basic, Codec::Gzip(1), s)? {
-                Some(st) => m.basic_store = Some(st),
-                None => return Ok(false),
-            }
-            save(m)?;
-        }
-        eprintln!("nakamaru-4.3: {}: basic …", m.row);
-        let basic_sets = [("layout", "basic")];
-        let cap = s.passes.map(|n| n.to_string());
-        let capped_sets = cap
-            .as_deref()
-            .map(|n| [("layout", "basic"), ("max_passes", n)]);
-        if ctx.quick {
-            // The model's test: the part beside the whole.
-            m.basic_tile = Some(match &capped_sets {
-                Some(sets) => trace(&dir, s, view, None, sets)?,
-                None => trace(&dir, s, view, Some(ShardSpec { k: 1, n: 4 }), &basic_sets)?,
-            });
-            m.basic = Some(trace(&dir, s, view, None, &basic_sets)?);
-        } else if let Some(sets) = &capped_sets {
-            m.basic = Some(trace(&dir, s, view, None, sets)?);
-        } else {
-            let tile = (s.fraction > 1).then_some(ShardSpec {
-                k: 1,
-                n: s.fraction,
-            });
-            m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
-        }
-        save(m)?;
-        if !keep_basic {
-            // The disk holds the basic and the split store of a 10^9-object scene only one
-            // after the other.
-            let _ = std::fs::remove_dir_all(&dir);
-        }
     }
+    eprintln!("nakamaru-4.3: {}: basic …", m.row);
+    let basic_sets = [("layout", "basic")];
+    let cap = s.passes.map(|n| n.to_string());
+    let capped_sets = cap
+        .as_deref()
+        .map(|n| [("layout", "basic"), ("max_passes", n)]);
+    if ctx.quick {
+        // The model's test: the part beside the whole.
+        m.basic_tile = Some(match &capped_sets {
+            Some(sets) => trace(&dir, s, view, None, sets)?,
+            None => trace(&dir, s, view, Some(ShardSpec { k: 1, n: 4 }), &basic_sets)?,
+        });
+        m.basic = Some(trace(&dir, s, view, None, &basic_sets)?);
+    } else if let Some(sets) = &capped_sets {
+        m.basic = Some(trace(&dir, s, view, None, sets)?);
+    } else {
+        let tile = (s.fraction > 1).then_some(ShardSpec {
+            k: 1,
+            n: s.fraction,
+        });
+        m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
+    }
+    save(m)?;
+    if !keep_basic {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Ok(true)
+}
+
+/// The split store (zstd blocks by default), S+G and S+G+B of one row; returns whether done.
+fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
+    let src = super::grid_runs::resolve(&m.scene, m.sf)?;
+    let save = |m: &Measured| ctx.checkpoint.save(&row_key(m, s), m);
+    let view = (m.view == "m").then_some(&s.view);
     for (name, sets) in [
         ("S+G", &[("layout", "split")][..]),
         ("S+G+B", &[("layout", "split"), ("hierarchy", "on")][..]),
@@ -424,7 +449,7 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
         if past(s) {
             return Ok(false);
         }
-        let dir = store("split");
+        let dir = store_dir(m, s, "split");
         if m.split_store.is_none() {
             eprintln!("nakamaru-4.3: {}: split store (in segments) …", m.row);
             match write_store(&src, &dir, Layout::Split, s.split_codec, s)? {
@@ -433,6 +458,9 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
             }
             m.objects = m.split_store.as_ref().map_or(0, |st| st.objects);
             save(m)?;
+            if past(s) {
+                return Ok(false);
+            }
         }
         if view.is_some() && m.objects_in_view.is_none() {
             m.objects_in_view = Some(count_in_view(&dir, &s.view, s.size)?);
@@ -453,6 +481,67 @@ fn measure_row(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Resu
             m.sgb = Some(r);
         }
         save(m)?;
+    }
+    Ok(true)
+}
+
+/// A scene's rows share its stores: row `i` takes the `kind` store step of an earlier row of
+/// its scene (`before`) when that store is still on disk, rather than streaming the scene's
+/// 10^9 objects through the generator again only to find every segment written.
+fn share_store(measured: &mut [Measured], before: &[usize], i: usize, s: &Setup, kind: &str) {
+    let pick = |m: &Measured| {
+        if kind == "basic" {
+            m.basic_store.clone()
+        } else {
+            m.split_store.clone()
+        }
+    };
+    if pick(&measured[i]).is_some() {
+        return;
+    }
+    let Some(st) = before.iter().find_map(|&j| pick(&measured[j])) else {
+        return;
+    };
+    if StoreHeader::read(&store_dir(&measured[i], s, kind)).is_err() {
+        return;
+    }
+    let m = &mut measured[i];
+    if kind == "basic" {
+        m.basic_store = Some(st);
+    } else {
+        m.objects = st.objects;
+        m.split_store = Some(st);
+    }
+}
+
+/// The rows' steps in the order the disk allows: scene by scene (a scene's rows share its
+/// stores), first every row's basic steps, the basic store removed after the last of them,
+/// then every row's split steps. Returns whether all rows are done.
+fn measure_rows(ctx: &Ctx, measured: &mut [Measured], s: &Setup) -> Result<bool> {
+    let base = |m: &Measured| format!("{}{}", m.scene, m.sf);
+    let mut scenes: Vec<String> = Vec::new();
+    for m in measured.iter() {
+        if !scenes.contains(&base(m)) {
+            scenes.push(base(m));
+        }
+    }
+    for scene in &scenes {
+        let group: Vec<usize> = (0..measured.len())
+            .filter(|&i| base(&measured[i]) == *scene)
+            .collect();
+        for (k, &i) in group.iter().enumerate() {
+            let keep_basic = group[k + 1..].iter().any(|&j| measured[j].basic.is_none());
+            share_store(measured, &group[..k], i, s, "basic");
+            if !measure_basic(ctx, &mut measured[i], s, keep_basic)? {
+                return Ok(false);
+            }
+        }
+        for (k, &i) in group.iter().enumerate() {
+            share_store(measured, &group[..k], i, s, "split");
+            if !measure_split(ctx, &mut measured[i], s)? {
+                return Ok(false);
+            }
+        }
     }
     Ok(true)
 }
@@ -514,13 +603,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             .collect(),
     };
     let mut measured = Vec::new();
-    let mut finished = true;
-    let bases: Vec<String> = names
-        .iter()
-        .map(|n| n.strip_suffix('m').unwrap_or(n).to_string())
-        .collect();
-    for (i, name) in names.iter().enumerate() {
-        let keep_basic = bases[i + 1..].contains(&bases[i]);
+    for name in &names {
         let view = if name.ends_with('m') && name.starts_with("rings") {
             "m"
         } else {
@@ -536,16 +619,12 @@ fn run(ctx: &Ctx) -> Result<Output> {
             view: view.to_string(),
             ..Default::default()
         };
-        if finished {
-            finished = measure_row(ctx, &mut m, &s, keep_basic)?;
-        } else if let Some(saved) = ctx.checkpoint.load::<Measured>(&format!(
-            "{}-{}-{}-{}",
-            m.row, s.size, s.memory, s.cache
-        ))? {
+        if let Some(saved) = ctx.checkpoint.load::<Measured>(&row_key(&m, &s))? {
             m = saved;
         }
         measured.push(m);
     }
+    let finished = measure_rows(ctx, &mut measured, &s)?;
     if finished {
         // Stores no row still needs.
         let _ = std::fs::remove_dir_all(&s.stores);
