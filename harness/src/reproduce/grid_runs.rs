@@ -47,11 +47,24 @@ pub struct GridRun {
     pub subspaces: u64,
     pub grid_build_s: f64,
     pub load_average: String,
+    /// The process's CPU seconds over the run (0 in runs saved before it was kept).
+    #[serde(default)]
+    pub cpu_s: f64,
 }
 
 impl GridRun {
     pub fn total_s(&self) -> f64 {
         self.preprocess_s + self.trace_s
+    }
+
+    /// CPU / wall of the run: well under 100% when it waited for a core or for the disk, so
+    /// that a time measured beside other work is seen as such ("-" when not kept).
+    pub fn cpu_share(&self) -> String {
+        if self.cpu_s > 0.0 {
+            format!("{:.0}%", 100.0 * self.cpu_s / self.total_s().max(1e-9))
+        } else {
+            "-".into()
+        }
     }
 }
 
@@ -104,6 +117,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         .collect();
     pairs.extend(settings.iter().cloned());
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    let cpu0 = workload::process_cpu_seconds();
     let t = std::time::Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let preprocess_s = t.elapsed().as_secs_f64();
@@ -142,6 +156,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         subspaces: bs("hr_subspaces") as u64,
         grid_build_s: bs("hr_build_s"),
         load_average,
+        cpu_s: workload::process_cpu_seconds() - cpu0,
     })
 }
 

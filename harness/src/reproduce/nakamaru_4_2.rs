@@ -331,7 +331,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Doc
         &[
             "row", "objects", "grid", "cells per axis", "upper/lower", "total s", "ratio", "thesis",
             "cells visited", "box tests", "lower / direct registrations", "direct turned away",
-            "lower grids used", "grid MiB read", "passes", "peak RSS MiB", "load avg",
+            "lower grids used", "grid MiB read", "passes", "peak RSS MiB", "CPU / wall", "load avg",
         ],
     );
     for m in measured {
@@ -362,6 +362,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Doc
                 format!("{:.1}", run.grid_bytes_read as f64 / 1048576.0),
                 run.passes.to_string(),
                 format!("{:.1}", run.peak_rss_bytes as f64 / 1048576.0),
+                run.cpu_share(),
                 run.load_average.clone(),
             ]);
         }

@@ -912,7 +912,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
     doc.table(t);
     let mut split = DocTable::new(
         "Preprocessing and tracing (Table 4.4's split), seconds; basic tracing extrapolated where marked",
-        &["row", "method", "preprocess s", "trace s", "rows traced", "scale", "rays", "image sha256", "load avg"],
+        &["row", "method", "preprocess s", "trace s", "rows traced", "scale", "rays", "image sha256", "CPU / wall", "load avg"],
     );
     for m in measured {
         for (name, r) in [("basic", &m.basic), ("basic ¼ (quick)", &m.basic_tile), ("S+G", &m.sg), ("S+G+B", &m.sgb)] {
@@ -926,6 +926,12 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                     format!("{:.2}", r.scale),
                     r.rays.to_string(),
                     format!("{}…", &r.sha256[..12.min(r.sha256.len())]),
+                    // A run that waited for a core or for the disk shows well under 100%.
+                    if r.cpu_s > 0.0 {
+                        format!("{:.0}%", 100.0 * r.cpu_s / (r.preprocess_s + r.trace_s).max(1e-9))
+                    } else {
+                        "-".into()
+                    },
                     r.load_average.clone(),
                 ]);
             }

@@ -430,7 +430,7 @@ fn document(
         &[
             "row", "objects", "capped cells", "capped s", "high-res cells", "upper/lower",
             "high-res s", "capped box tests", "high-res box tests", "subspaces", "grid MiB read",
-            "peak RSS MiB", "load avg",
+            "peak RSS MiB", "CPU / wall capped, high-res", "load avg",
         ],
     );
     for m in measured {
@@ -451,6 +451,7 @@ fn document(
                 "{:.1}",
                 c.peak_rss_bytes.max(h.peak_rss_bytes) as f64 / 1048576.0
             ),
+            format!("{}, {}", c.cpu_share(), h.cpu_share()),
             h.load_average.clone(),
         ]);
     }
