@@ -98,23 +98,59 @@ pub fn list(as_json: bool) -> Result<()> {
         print_json(&json!(rows));
         return Ok(());
     }
+    // The full runtime's head ("days", "about 1.5 CPU hours") in the column, its detail in
+    // `--json`; the columns as wide as their longest entry, so that every line stays aligned.
+    let head = |t: &Table| {
+        let f = t.runtime.full;
+        f[..f.find([';', '(']).unwrap_or(f.len())]
+            .trim()
+            .to_string()
+    };
+    let w = |f: &dyn Fn(&Table) -> String, title: &str| {
+        TABLES
+            .iter()
+            .map(|t| f(t).chars().count())
+            .max()
+            .unwrap_or(0)
+            .max(title.len())
+    };
+    let (wt, wq, wf) = (
+        w(&|t| t.source.to_string(), "table"),
+        w(&|t| t.runtime.quick.to_string(), "--quick"),
+        w(&head, "full"),
+    );
+    let pad = |s: &str, n: usize| format!("{s}{}", " ".repeat(n.saturating_sub(s.chars().count())));
     println!(
-        "{:<20} {:<4} {:<26} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} about",
-        "id", "seed", "table", "F", "S", "M", "NR", "--quick", "full"
+        "{:<20} {:<4} {} {:>3} {:>3} {:>3} {:>3}  {} {} {:<6} about",
+        "id",
+        "seed",
+        pad("table", wt),
+        "F",
+        "S",
+        "M",
+        "NR",
+        pad("--quick", wq),
+        pad("full", wf),
+        "resume"
     );
     for t in TABLES {
         let n = |f: Fidelity| t.claims.iter().filter(|c| c.fidelity == f).count();
         println!(
-            "{:<20} {:<4} {:<26} {:>3} {:>3} {:>3} {:>3}  {:<9} {:<9} {}",
+            "{:<20} {:<4} {} {:>3} {:>3} {:>3} {:>3}  {} {} {:<6} {}",
             t.id,
             t.seed,
-            t.source,
+            pad(t.source, wt),
             n(Fidelity::Faithful),
             n(Fidelity::Substituted),
             n(Fidelity::Model),
             n(Fidelity::NotReproducible),
-            t.runtime.quick,
-            t.runtime.full,
+            pad(t.runtime.quick, wq),
+            pad(&head(t), wf),
+            if t.runtime.full.contains("resumable") {
+                "yes"
+            } else {
+                "-"
+            },
             t.about
         );
     }
