@@ -199,6 +199,12 @@ impl SegmentedWriter {
         &self.log
     }
 
+    /// Seconds since the last checkpoint (or since this run's first new object): the last,
+    /// short segment's time, which no checkpoint logs, when read just before [`Self::finish`].
+    pub fn since_checkpoint(&self) -> f64 {
+        self.segment_start.elapsed().as_secs_f64()
+    }
+
     /// Objects on disk at the last checkpoint.
     pub fn objects_done(&self) -> u64 {
         self.log.state.objects

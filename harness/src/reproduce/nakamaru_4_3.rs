@@ -280,15 +280,18 @@ fn write_store(
     }
     src.stream(&mut w)?;
     let log = w.log().clone();
+    // The last segment ends at `finish`, not at a checkpoint: its time is taken here.
+    let tail = Instant::now() - Duration::from_secs_f64(w.since_checkpoint());
     match w.finish().map_err(cannot)? {
         Outcome::Stopped => Ok(None),
         Outcome::Finished(_) => {
             let h = StoreHeader::read(dir).map_err(|e| input(e.to_string()))?;
+            let logged = log.done.iter().fold(0.0, |a, d| a + d.seconds);
             Ok(Some(StoreStep {
                 objects: h.objects,
                 stored_bytes: h.disk_bytes(),
-                seconds: log.done.iter().map(|d| d.seconds).sum(),
-                segments: log.done.len(),
+                seconds: logged + tail.elapsed().as_secs_f64(),
+                segments: log.done.len() + usize::from(h.objects > log.state.objects),
             }))
         }
     }
