@@ -443,7 +443,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             peak_rss: [m.basic.peak_rss_bytes, m.sg.peak_rss_bytes, m.sgb.peak_rss_bytes],
         })
         .collect();
-    per_ray_table(&mut doc, &points, size);
+    per_ray::table(&mut doc, &points, size);
     let charts = per_ray::charts(ctx.id, &points, size);
     let mut out = Output::new(
         Result_ {
@@ -460,34 +460,6 @@ fn run(ctx: &Ctx) -> Result<Output> {
     );
     out.charts = charts;
     Ok(out)
-}
-
-/// Issue 19's benchmark in numbers: per scene, the time per eye ray at its smallest and largest
-/// row and the growth between them, per method (the plots are `plots/<id>-per-ray-<scene>.svg`).
-fn per_ray_table(doc: &mut Document, points: &[SizePoint], size: u32) {
-    let mut t = DocTable::new(
-        "Time per eye ray (preprocessing + tracing over the (size+1)² eye rays, each with its ray tree): smallest and largest row per scene, growth = largest / smallest",
-        &["scene", "objects", "basic µs", "S+G µs", "S+G+B µs", "growth basic / S+G / S+G+B"],
-    );
-    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
-    scenes.sort();
-    scenes.dedup();
-    for scene in scenes {
-        let mut ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
-        ps.sort_by_key(|p| p.objects);
-        let us = |p: &SizePoint, k: usize| format!("{:.0}", 1e6 * per_ray::per_eye_ray(p.seconds[k], size));
-        let (a, b) = (ps[0], ps[ps.len() - 1]);
-        let g = per_ray::growth(points, scene);
-        t.push(vec![
-            scene.to_string(),
-            if ps.len() > 1 { format!("{} → {}", a.objects, b.objects) } else { a.objects.to_string() },
-            format!("{} → {}", us(a, 0), us(b, 0)),
-            format!("{} → {}", us(a, 1), us(b, 1)),
-            format!("{} → {}", us(a, 2), us(b, 2)),
-            g.map_or("-".into(), |(_, _, g)| format!("{:.2} / {:.2} / {:.2}", g[0], g[1], g[2])),
-        ]);
-    }
-    doc.table(t);
 }
 
 fn ratio(a: f64, b: f64) -> f64 {

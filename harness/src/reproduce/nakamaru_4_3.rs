@@ -27,6 +27,7 @@
 //! `rtbench_engines::store::blocks`): uncompressed, mount14's and rings368's split stores take
 //! ~55 GB and ~102 GB, more than the disk's free space.
 
+use super::per_ray::{self, SizePoint};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
 use crate::commands::render::hex;
@@ -130,6 +131,11 @@ pub const TABLE: Table = Table {
             key: "basic-model",
             fidelity: Fidelity::Model,
             why: "basic tracing time extrapolated from a tile set of the image rows (basic-fraction) or from its first N passes by S+G's pass count (basic-passes); --quick: against the whole run, measured",
+        },
+        Claim {
+            key: "per-ray-growth",
+            fidelity: Fidelity::Substituted,
+            why: "issue 19's goal, not the thesis's: S+G+B's time per eye ray grows less than 2× from 10^6 to 10^9 objects; judged on this machine with every method on the high-resolution grid, from the row nearest 10^6 objects (give it in rows=, e.g. mount10) to a row of at least 5·10^8",
         },
         Claim {
             key: "view",
@@ -632,9 +638,12 @@ fn run(ctx: &Ctx) -> Result<Output> {
         // Stores no row still needs.
         let _ = std::fs::remove_dir_all(&s.stores);
     }
-    let rows = rows(&p, &measured, &s);
-    let doc = document(&p, &measured, &s, ctx.quick, finished);
-    Ok(Output::new(
+    let points = size_points(&measured);
+    let mut rows = rows(&p, &measured, &s);
+    rows.extend(growth_rows(&points, size));
+    let mut doc = document(&p, &measured, &s, ctx.quick, finished);
+    per_ray::table(&mut doc, &points, size);
+    let mut out = Output::new(
         Result_ {
             id: ctx.id,
             published: raw,
@@ -647,7 +656,67 @@ fn run(ctx: &Ctx) -> Result<Output> {
         },
         rows,
         doc,
-    ))
+    );
+    out.charts = per_ray::charts(ctx.id, &points, size);
+    Ok(out)
+}
+
+/// The rows whose three methods are measured, as points of the time-per-ray benchmark; the
+/// rings368m view is a series of its own ("rings-view-m"): other eye rays.
+fn size_points(measured: &[Measured]) -> Vec<SizePoint> {
+    measured
+        .iter()
+        .filter_map(|m| {
+            let (b, sg, sgb) = (m.basic.as_ref()?, m.sg.as_ref()?, m.sgb.as_ref()?);
+            (b.scale > 0.0).then(|| SizePoint {
+                scene: if m.view == "m" {
+                    format!("{}-view-m", m.scene)
+                } else {
+                    m.scene.clone()
+                },
+                objects: m.objects,
+                seconds: [b.total_s(), sg.total_s(), sgb.total_s()],
+                peak_rss: [b.peak_rss_bytes, sg.peak_rss_bytes, sgb.peak_rss_bytes],
+            })
+        })
+        .collect()
+}
+
+/// Issue 19's goal per scene: S+G+B's time per eye ray from the point nearest 10^6 objects to
+/// the largest, judged when those are within 3× of 10^6 and at least 5·10^8.
+fn growth_rows(points: &[SizePoint], size: u32) -> Vec<Row> {
+    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
+    scenes.sort();
+    scenes.dedup();
+    scenes
+        .into_iter()
+        .filter_map(|scene| {
+            let ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
+            let near = |p: &&SizePoint| ((p.objects.max(1) as f64).log10() - 6.0).abs();
+            let a = *ps.iter().min_by(|x, y| near(x).total_cmp(&near(y)))?;
+            let b = *ps.iter().max_by_key(|p| p.objects)?;
+            if a.objects >= b.objects {
+                return None;
+            }
+            let per = |p: &SizePoint| per_ray::per_eye_ray(p.seconds[2], size);
+            let g = per(b) / per(a).max(1e-12);
+            let judged = near(&a) <= 3f64.log10() && b.objects >= 500_000_000;
+            Some(Row::new(
+                "per-ray-growth",
+                scene.to_string(),
+                "< 2× from 10^6 to 10^9 objects (issue 19's goal)",
+                format!(
+                    "S+G+B {:.1} µs → {:.1} µs per eye ray, {} → {} objects: {g:.2}×",
+                    1e6 * per(a),
+                    1e6 * per(b),
+                    a.objects,
+                    b.objects
+                ),
+                Kind::Ratio,
+                if judged { Verdict::of(g < 2.0) } else { Verdict::Shown },
+            ))
+        })
+        .collect()
 }
 
 fn ratio(a: f64, b: f64) -> f64 {
@@ -942,4 +1011,41 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
     }
     doc.table(split);
     doc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(scene: &str, objects: u64, sgb_s: f64) -> SizePoint {
+        SizePoint {
+            scene: scene.into(),
+            objects,
+            seconds: [10.0 * sgb_s, 2.0 * sgb_s, sgb_s],
+            peak_rss: [0; 3],
+        }
+    }
+
+    /// The goal is judged from the row nearest 10^6 objects to a row of at least 5·10^8, and
+    /// only then; a curve that stops short is shown, not judged.
+    #[test]
+    fn the_per_ray_goal_is_judged_from_near_a_million_to_at_least_half_a_billion() {
+        let pts = [
+            point("mount", 131_076, 1.0),
+            point("mount", 2_097_156, 10.0),
+            point("mount", 536_870_916, 25.0),
+            point("rings", 1_000_000, 10.0),
+            point("rings", 1_000_787_041, 19.0),
+            point("tetra", 1_048_576, 1.0),
+            point("tetra", 16_777_216, 1.5),
+        ];
+        let rows = growth_rows(&pts, 1);
+        let v: Vec<(String, Verdict)> = rows.iter().map(|r| (r.subject.clone(), r.verdict)).collect();
+        assert_eq!(v.len(), 3);
+        // mount: 2,097,156 is the row nearest 10^6; 25 / 10 = 2.5× does not hold.
+        assert_eq!(v[0], ("mount".into(), Verdict::Fails));
+        assert!(rows[0].measured.contains("2.50×"), "{}", rows[0].measured);
+        assert_eq!(v[1], ("rings".into(), Verdict::Holds));
+        assert_eq!(v[2], ("tetra".into(), Verdict::Shown));
+    }
 }

@@ -1,12 +1,13 @@
 //! Time per ray against scene size for the three methods of seed 000 Chapter 4 (basic, S+G,
 //! S+G+B), with each run's peak RSS beside it: issue 19's benchmark ("time per ray from 10^5 to
 //! 10^9 objects on one plot; memory flat"). One chart per scene, from the rows a reproduction
-//! measured (`nakamaru-4.1`). The time is preprocessing + tracing over the eye rays, (size + 1)²
+//! measured (`nakamaru-4.1`, and `nakamaru-4.3`, whose rows reach 10^9 objects). The time is preprocessing + tracing over the eye rays, (size + 1)²
 //! pixel corners, each with its whole ray tree (shadow, reflected, refracted rays): every row
 //! saved before session 7 kept no count of the other rays, and the eye rays are the same for the
 //! three methods and every size.
 
 use rtbench_reports::plot::{Chart, LegendAt, Panel, Point, Series, XyPanel};
+use rtbench_reports::{Document, Table as DocTable};
 
 /// One row: a scene at one size, each method's total seconds and peak RSS bytes.
 pub struct SizePoint {
@@ -83,6 +84,40 @@ pub fn charts(id: &str, points: &[SizePoint], size: u32) -> Vec<Chart> {
             }
         })
         .collect()
+}
+
+/// Issue 19's benchmark in numbers: per scene, the time per eye ray at its smallest and largest
+/// row and the growth between them, per method (the plots are `plots/<id>-per-ray-<scene>.svg`).
+pub fn table(doc: &mut Document, points: &[SizePoint], size: u32) {
+    let mut t = DocTable::new(
+        "Time per eye ray (preprocessing + tracing over the (size+1)² eye rays, each with its ray tree): smallest and largest row per scene, growth = largest / smallest",
+        &["scene", "objects", "basic µs", "S+G µs", "S+G+B µs", "growth basic / S+G / S+G+B"],
+    );
+    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
+    scenes.sort();
+    scenes.dedup();
+    for scene in scenes {
+        let mut ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
+        ps.sort_by_key(|p| p.objects);
+        let us = |p: &SizePoint, k: usize| format!("{:.0}", 1e6 * per_eye_ray(p.seconds[k], size));
+        let (a, b) = (ps[0], ps[ps.len() - 1]);
+        let g = growth(points, scene);
+        t.push(vec![
+            scene.to_string(),
+            if ps.len() > 1 {
+                format!("{} → {}", a.objects, b.objects)
+            } else {
+                a.objects.to_string()
+            },
+            format!("{} → {}", us(a, 0), us(b, 0)),
+            format!("{} → {}", us(a, 1), us(b, 1)),
+            format!("{} → {}", us(a, 2), us(b, 2)),
+            g.map_or("-".into(), |(_, _, g)| {
+                format!("{:.2} / {:.2} / {:.2}", g[0], g[1], g[2])
+            }),
+        ]);
+    }
+    doc.table(t);
 }
 
 /// Growth of the time per ray between the smallest and largest size of a scene, per method.
