@@ -670,6 +670,20 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Doc
         ]);
     }
     doc.table(t);
+    // The table's cost: what a full run takes, summed over rows measured in different runs.
+    let sum = |f: &dyn Fn(&Measured) -> f64| measured.iter().map(f).fold(0.0, |a, x| a + x);
+    let (g, b, sg, sgb) = (
+        sum(&|m| m.generation_s),
+        sum(&|m| m.basic.total_s()),
+        sum(&|m| m.sg.total_s()),
+        sum(&|m| m.sgb.total_s()),
+    );
+    doc.paragraph(format!(
+        "Measured time over these {} rows: split-store generation {g:.0} s, basic {b:.0} s, S+G {sg:.0} s, S+G+B {sgb:.0} s; {:.0} s = {:.2} h in all (the basic stores' writing and the cache drops between runs not included).",
+        measured.len(),
+        g + b + sg + sgb,
+        (g + b + sg + sgb) / 3600.0
+    ));
     let mut io = DocTable::new(
         "Bytes read and seeks per stage (engine: preprocessing and intersection; workload: shading and spill files)",
         &[
