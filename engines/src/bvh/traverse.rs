@@ -23,7 +23,7 @@ use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
 use super::tree::MAX_DEPTH;
 use crate::engine::Counters;
-use crate::geometry::aabb::SlabRay;
+use super::ray_setup;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::triangle_simd::{LaneHits, PacketKernel};
 use crate::geometry::Prim;
@@ -99,7 +99,7 @@ impl Tally {
 #[inline(always)]
 fn triangle_setup<const W: bool>(dir: glam::Vec3) -> WatertightRay {
     if W {
-        WatertightRay::new(dir)
+        ray_setup::watertight(dir)
     } else {
         WatertightRay {
             kx: 0,
@@ -168,10 +168,10 @@ fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bo
     stack: &mut [Entry; STACK_SIZE],
     tally: &mut Tally,
 ) -> Hit {
-    if !ray.is_traceable() {
+    if !ray_setup::traceable(ray) {
         return Hit::MISS;
     }
-    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
+    let tr = T::prepare_ray(ray, bvh.extent);
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();
@@ -296,10 +296,10 @@ fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
     stack: &mut [u32; STACK_SIZE],
     tally: &mut Tally,
 ) -> bool {
-    if !ray.is_traceable() {
+    if !ray_setup::traceable(ray) {
         return false;
     }
-    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
+    let tr = T::prepare_ray(ray, bvh.extent);
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();
