@@ -48,6 +48,8 @@ pub fn watertight(d: glam::Vec3) -> WatertightRay {
     const AXES: [[(usize, usize); 2]; 3] = [[(1, 2), (2, 1)], [(2, 0), (0, 2)], [(0, 1), (1, 0)]];
     let dz = c[kz];
     let (kx, ky) = AXES[kz][(dz < 0.0) as usize];
+    // Tells the compiler the table's axes are in range (no bounds checks below).
+    let (kx, ky) = (kx.min(2), ky.min(2));
     WatertightRay {
         kx,
         ky,
