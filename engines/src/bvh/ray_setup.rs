@@ -17,10 +17,10 @@ use crate::ray::Ray;
 /// a finite `x` and NaN for ±∞ or NaN, so the sum of the six is 0 exactly when origin and
 /// direction are finite; `tmin` and `tmax` must only not be NaN (`tmax` may be +∞).
 #[inline(always)]
+#[allow(clippy::eq_op)] // `x - x` is the finiteness test, not a mistake.
 pub fn traceable(ray: &Ray) -> bool {
     let (o, d) = (ray.origin, ray.dir);
     let z = ((o.x - o.x) + (o.y - o.y)) + ((o.z - o.z) + (d.x - d.x)) + ((d.y - d.y) + (d.z - d.z));
-    #[allow(clippy::eq_op)]
     let ordered = (ray.tmin == ray.tmin) & (ray.tmax == ray.tmax);
     (z == 0.0) & ordered
 }
@@ -132,11 +132,18 @@ mod tests {
             let d = Vec3::new(next(), next(), next());
             out.push(Ray::new(o, d, 0.0, f32::INFINITY));
         }
-        let specials = [0.0, -0.0, 1e-20, -1e-20, 1e-18, -1e-18, 0.5, -0.5, 1.0, -1.0];
+        let specials = [
+            0.0, -0.0, 1e-20, -1e-20, 1e-18, -1e-18, 0.5, -0.5, 1.0, -1.0,
+        ];
         for &x in &specials {
             for &y in &specials {
                 for &z in &specials {
-                    out.push(Ray::new(Vec3::new(1.0, -2.0, 3.0), Vec3::new(x, y, z), 0.1, 7.0));
+                    out.push(Ray::new(
+                        Vec3::new(1.0, -2.0, 3.0),
+                        Vec3::new(x, y, z),
+                        0.1,
+                        7.0,
+                    ));
                 }
             }
         }

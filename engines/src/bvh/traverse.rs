@@ -21,9 +21,9 @@
 use super::box_test::ChildTest;
 use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
+use super::ray_setup;
 use super::tree::MAX_DEPTH;
 use crate::engine::Counters;
-use super::ray_setup;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::geometry::triangle_simd::{LaneHits, PairKernel};
 use crate::geometry::Prim;

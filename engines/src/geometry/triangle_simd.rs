@@ -933,8 +933,7 @@ mod tests {
     fn pairs_give_the_single_tests_answers() {
         fn pairs<P: PairKernel>(prepare: impl Fn(Vec3, Vec3) -> P::Ray) -> usize {
             let (tris, rays) = cases();
-            let packets: Vec<TrianglePacket<4>> =
-                tris.chunks(4).map(TrianglePacket::new).collect();
+            let packets: Vec<TrianglePacket<4>> = tris.chunks(4).map(TrianglePacket::new).collect();
             let mut hits = 0;
             for w in packets.windows(2) {
                 for &(o, d) in &rays {
