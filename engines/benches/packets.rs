@@ -1,5 +1,7 @@
 //! Packets against Embree's packets on coherent generations (issue 20, acceptance 2):
-//! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]`.
+//! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]
+//! [--engines LABEL,...]` (`--engines`: only the engines whose label starts with one of these, e.g.
+//! `"embree single,bvh4 single"`; bvh8 single is always built, it makes the shadow rays).
 //!
 //! Two generations of each scene, as the SPD workload makes them but grouped so that a batch is
 //! coherent: the eye rays through the (size+1)² pixel corners, row by row, and the shadow rays
