@@ -1,5 +1,7 @@
 //! Packets against Embree's packets on coherent generations (issue 20, acceptance 2):
-//! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]`.
+//! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]
+//! [--engines LABEL,...]` (`--engines`: only the engines whose label starts with one of these, e.g.
+//! `"embree single,bvh4 single"`; bvh8 single is always built, it makes the shadow rays).
 //!
 //! Two generations of each scene, as the SPD workload makes them but grouped so that a batch is
 //! coherent: the eye rays through the (size+1)² pixel corners, row by row, and the shadow rays
@@ -48,10 +50,11 @@ const ENGINES: &[Setup] = &[
         "embree",
         &[("threads", "1"), ("api", "packet16")],
     ),
+    ("bvh4 single", "bvh4", &[]),
 ];
 
 /// The pairs timed: (engine, Embree yardstick), indices into `ENGINES`.
-const PAIRS: &[(usize, usize)] = &[(1, 4), (2, 5), (0, 3), (1, 0)];
+const PAIRS: &[(usize, usize)] = &[(1, 4), (2, 5), (0, 3), (1, 0), (6, 3)];
 
 fn eye_rays(scene: &rtbench_scenes::Scene, size: u32) -> Vec<Ray> {
     // The workload's camera (harness/src/workload/camera.rs, `Camera::corner_ray`): the eye
@@ -129,6 +132,9 @@ fn main() {
     // `--once`: every engine traces each generation once, untimed and unchecked (for counting
     // instructions per entry point under callgrind).
     let mut once = false;
+    // `--engines L1,L2`: only the engines whose label starts with one of these (bvh8 single,
+    // which makes the shadow rays and the reference answers, is always built).
+    let mut only: Option<Vec<String>> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -136,6 +142,10 @@ fn main() {
             "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).expect("--pairs P"),
             "--bench" => {}
             "--once" => once = true,
+            "--engines" => {
+                let l = args.next().expect("--engines LABEL,LABEL");
+                only = Some(l.split(',').map(str::to_string).collect());
+            }
             s if !s.starts_with('-') => {
                 let (name, sf) = match s.split_once(':') {
                     Some((n, f)) => (n, Some(f.parse().expect("SCENE:SF"))),
@@ -160,15 +170,25 @@ fn main() {
             scene: scene.clone(),
             geometry,
         };
-        let engines: Vec<Box<dyn Engine>> = ENGINES
+        let wanted = |k: usize| {
+            k == 0
+                || only
+                    .as_ref()
+                    .is_none_or(|o| o.iter().any(|p| ENGINES[k].0.starts_with(p.as_str())))
+        };
+        let engines: Vec<Option<Box<dyn Engine>>> = ENGINES
             .iter()
-            .map(|(_, name, set)| {
-                let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
-                build_engine(name, &input, s.collect()).expect("engine")
+            .enumerate()
+            .map(|(k, (_, name, set))| {
+                wanted(k).then(|| {
+                    let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
+                    build_engine(name, &input, s.collect()).expect("engine")
+                })
             })
             .collect();
+        let first = engines[0].as_ref().expect("bvh8 single").as_ref();
         let eye = eye_rays(&scene, size);
-        let eye_hits = closest(engines[0].as_ref(), &eye, &mut Counters::default());
+        let eye_hits = closest(first, &eye, &mut Counters::default());
         let shadow = shadow_rays(&scene, &eye, &eye_hits);
         let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
         println!(
@@ -185,16 +205,18 @@ fn main() {
                 .join(" ")
         );
         if once {
-            for e in &engines {
+            for e in engines.iter().flatten() {
                 std::hint::black_box(closest(e.as_ref(), &eye, &mut Counters::default()));
                 std::hint::black_box(any(e.as_ref(), &shadow, &mut Counters::default()));
             }
             continue;
         }
         // Answers: every engine against bvh8's single-ray traversal.
-        let shadow_want = any(engines[0].as_ref(), &shadow, &mut Counters::default());
+        let shadow_want = any(first, &shadow, &mut Counters::default());
         for (k, (label, _, _)) in ENGINES.iter().enumerate().skip(1) {
-            let e = engines[k].as_ref();
+            let Some(e) = engines[k].as_deref() else {
+                continue;
+            };
             let h = closest(e, &eye, &mut Counters::default());
             let same_object = h
                 .iter()
@@ -216,10 +238,13 @@ fn main() {
         }
         for (gen, is_eye) in [("eye", true), ("shadow", false)] {
             for &(a, b) in PAIRS {
+                if engines[a].is_none() || engines[b].is_none() {
+                    continue;
+                }
                 let mut ratios = Vec::with_capacity(pairs);
                 for p in 0..pairs {
                     let time = |k: usize| {
-                        let e = engines[k].as_ref();
+                        let e = engines[k].as_deref().expect("built");
                         let mut c = Counters::default();
                         seconds(|| {
                             if is_eye {

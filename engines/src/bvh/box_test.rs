@@ -16,12 +16,19 @@
 use super::node::WideNode;
 use crate::geometry::aabb::SlabRay;
 use crate::geometry::lanes::Scalar;
+use crate::ray::Ray;
 
 /// One slab test of a ray against the N children of a node.
 pub trait ChildTest<const N: usize> {
     /// The ray as this test wants it (splatted into SIMD registers for the SIMD forms).
     type Ray: Copy;
     fn prepare(r: &SlabRay) -> Self::Ray;
+    /// [`Self::prepare`] of `SlabRay::new(ray, extent)`: the SIMD forms compute it in SSE
+    /// registers, bit for bit the same ([`super::ray_setup`]).
+    #[inline(always)]
+    fn prepare_ray(ray: &Ray, extent: f32) -> Self::Ray {
+        Self::prepare(&SlabRay::new(ray, extent))
+    }
     /// Bit `i` set when child `i`'s box overlaps `[tmin, tmax]` along the ray; `dist[i]` is
     /// then its entry distance.
     fn test(node: &WideNode<N>, r: &Self::Ray, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32;
@@ -142,10 +149,22 @@ impl<const N: usize> ChildTest<N> for ScalarPerBox {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::node::{WideNode, PLANES};
+    use super::super::ray_setup::slab_lanes;
     use super::ChildTest;
     use crate::geometry::aabb::SlabRay;
     use crate::geometry::lanes::{Avx8, Sse4};
+    use crate::ray::Ray;
     use std::arch::x86_64::*;
+
+    /// Offsets of the near and far plane rows from the sign bits of `slab_lanes`.
+    #[inline(always)]
+    fn offsets_from_signs(neg: u32, n: usize) -> ([usize; 3], [usize; 3]) {
+        let bit = |a: usize| ((neg >> a) & 1) as usize;
+        (
+            [bit(0) * n, (2 + bit(1)) * n, (4 + bit(2)) * n],
+            [(1 - bit(0)) * n, (3 - bit(1)) * n, (5 - bit(2)) * n],
+        )
+    }
 
     /// Offsets (in floats) of the near and far plane rows of a node of width `n`; each is
     /// `row · n` with `row < PLANES`, so a load of `n` floats from there stays in the node.
@@ -192,6 +211,29 @@ mod x86 {
         #[inline(always)]
         fn prefetch(p: *const u8) {
             prefetch_lines(p, 2)
+        }
+
+        #[inline(always)]
+        fn prepare_ray(ray: &Ray, extent: f32) -> SlabRayLanes<__m128> {
+            let (rdir, on, of, neg) = slab_lanes(ray, extent);
+            let (near, far) = offsets_from_signs(neg, 4);
+            // SAFETY: SSE is part of the x86-64 baseline; the shuffles only move lanes.
+            unsafe {
+                let splat = |v: __m128| {
+                    [
+                        _mm_shuffle_ps::<0x00>(v, v),
+                        _mm_shuffle_ps::<0x55>(v, v),
+                        _mm_shuffle_ps::<0xaa>(v, v),
+                    ]
+                };
+                SlabRayLanes {
+                    rdir: splat(rdir),
+                    org_near: splat(on),
+                    org_far: splat(of),
+                    near,
+                    far,
+                }
+            }
         }
 
         #[inline(always)]
@@ -260,6 +302,30 @@ mod x86 {
         #[inline(always)]
         fn prefetch(p: *const u8) {
             prefetch_lines(p, 4)
+        }
+
+        #[inline(always)]
+        fn prepare_ray(ray: &Ray, extent: f32) -> SlabRayLanes<__m256> {
+            let (rdir, on, of, neg) = slab_lanes(ray, extent);
+            let (near, far) = offsets_from_signs(neg, 8);
+            // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`), which run
+            // only on CPUs with both; the shuffles and broadcasts only move lanes.
+            unsafe {
+                let splat = |v: __m128| {
+                    [
+                        _mm256_broadcastss_ps(v),
+                        _mm256_broadcastss_ps(_mm_shuffle_ps::<0x55>(v, v)),
+                        _mm256_broadcastss_ps(_mm_shuffle_ps::<0xaa>(v, v)),
+                    ]
+                };
+                SlabRayLanes {
+                    rdir: splat(rdir),
+                    org_near: splat(on),
+                    org_far: splat(of),
+                    near,
+                    far,
+                }
+            }
         }
 
         #[inline(always)]

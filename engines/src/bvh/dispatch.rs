@@ -135,7 +135,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::closest_batch::<$n, $test, Sse4>(bvh, rays, hits, t, c)
+                traverse::closest_batch::<$n, $test, Avx8>(bvh, rays, hits, t, c)
             }
 
             #[target_feature(enable = "avx2,fma")]
@@ -146,7 +146,7 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                traverse::any_batch::<$n, $test, Sse4>(bvh, rays, out, t, c)
+                traverse::any_batch::<$n, $test, Avx8>(bvh, rays, out, t, c)
             }
         };
     }

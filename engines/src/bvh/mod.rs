@@ -22,6 +22,7 @@ pub mod dispatch;
 pub mod leaf;
 pub mod node;
 pub mod packet;
+pub mod ray_setup;
 pub mod stats;
 pub mod traverse;
 pub mod tree;

@@ -21,11 +21,11 @@
 use super::box_test::ChildTest;
 use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range, WideNode};
+use super::ray_setup;
 use super::tree::MAX_DEPTH;
 use crate::engine::Counters;
-use crate::geometry::aabb::SlabRay;
 use crate::geometry::kernels::f32::WatertightRay;
-use crate::geometry::triangle_simd::{LaneHits, PacketKernel};
+use crate::geometry::triangle_simd::{LaneHits, PairKernel};
 use crate::geometry::Prim;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
@@ -99,7 +99,7 @@ impl Tally {
 #[inline(always)]
 fn triangle_setup<const W: bool>(dir: glam::Vec3) -> WatertightRay {
     if W {
-        WatertightRay::new(dir)
+        ray_setup::watertight(dir)
     } else {
         WatertightRay {
             kx: 0,
@@ -110,6 +110,25 @@ fn triangle_setup<const W: bool>(dir: glam::Vec3) -> WatertightRay {
             sz: 0.0,
         }
     }
+}
+
+/// The hits of a pair test as testing its two packets one after the other counts them: all of
+/// the first packet's, and those of the second nearer than the first's nearest.
+#[inline(always)]
+fn pair_hits(lanes: &LaneHits<8>, mask: u32) -> u64 {
+    let (a, mut b) = (mask & 0xf, mask >> PACKET);
+    if a != 0 && b != 0 {
+        let near = lanes.t[lanes.nearest(a)];
+        let mut kept = 0;
+        while b != 0 {
+            let i = b.trailing_zeros() as usize;
+            b &= b - 1;
+            kept += (lanes.t[PACKET + i] < near) as u32;
+        }
+        b = kept;
+        return (a.count_ones() + b) as u64;
+    }
+    (a.count_ones() + b.count_ones()) as u64
 }
 
 #[inline(always)]
@@ -123,7 +142,7 @@ fn triangle_test<const W: bool>() -> TriangleTest {
 
 /// Closest hits of a batch of rays.
 #[inline(always)]
-pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
+pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
     bvh: &Bvh<N>,
     rays: &[Ray],
     hits: &mut [Hit],
@@ -143,7 +162,7 @@ pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
 
 /// Any-hit answers of a batch of rays.
 #[inline(always)]
-pub fn any_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
+pub fn any_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
     bvh: &Bvh<N>,
     rays: &[Ray],
     out: &mut [bool],
@@ -162,19 +181,20 @@ pub fn any_batch<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>>(
 }
 
 #[inline(always)]
-fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
+fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [Entry; STACK_SIZE],
     tally: &mut Tally,
 ) -> Hit {
-    if !ray.is_traceable() {
+    if !ray_setup::traceable(ray) {
         return Hit::MISS;
     }
-    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
+    let tr = T::prepare_ray(ray, bvh.extent);
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();
+    let mut pair_lanes = LaneHits::default();
     let mut r = *ray;
     let mut best = Hit::MISS;
     let mut dist = [0.0f32; N];
@@ -244,7 +264,28 @@ fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bo
         } else if is_packet_leaf(cur) {
             let (packets, count) = leaf_packets(bvh, cur);
             tally.prims += count as u64;
-            for p in packets {
+            // Two packets per test (`PairKernel`), both against the segment as it was before
+            // them. Testing them one after the other would test the second against the first's
+            // nearest hit: the nearest of the eight lanes (the first packet's on a tie of t) is
+            // the hit that would have kept, and `prim_hits` counts the second packet's hits
+            // only where they are nearer than the first's.
+            let mut pairs = packets.chunks_exact(2);
+            for pair in &mut pairs {
+                let (a, b) = (&pair[0], &pair[1]);
+                let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, r.tmin, r.tmax, &mut pair_lanes);
+                if mask != 0 {
+                    let i = pair_lanes.nearest(mask);
+                    tally.prim_hits += pair_hits(&pair_lanes, mask);
+                    r.tmax = pair_lanes.t[i];
+                    best = Hit {
+                        t: pair_lanes.t[i],
+                        object: pair[i / PACKET].object[i % PACKET],
+                        u: pair_lanes.u[i],
+                        v: pair_lanes.v[i],
+                    };
+                }
+            }
+            for p in pairs.remainder() {
                 let mask = P::test::<W>(&p.tri, &pr, r.tmin, r.tmax, &mut lanes);
                 if mask != 0 {
                     tally.prim_hits += mask.count_ones() as u64;
@@ -290,19 +331,20 @@ fn closest<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bo
 }
 
 #[inline(always)]
-fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
+fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [u32; STACK_SIZE],
     tally: &mut Tally,
 ) -> bool {
-    if !ray.is_traceable() {
+    if !ray_setup::traceable(ray) {
         return false;
     }
-    let tr = T::prepare(&SlabRay::new(ray, bvh.extent));
+    let tr = T::prepare_ray(ray, bvh.extent);
     let wt = triangle_setup::<W>(ray.dir);
     let pr = P::prepare(ray.origin, ray.dir, &wt);
     let mut lanes = LaneHits::default();
+    let mut pair_lanes = LaneHits::default();
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
@@ -327,11 +369,30 @@ fn any<const N: usize, T: ChildTest<N>, P: PacketKernel<PACKET>, const W: bool>(
             }
         } else if is_packet_leaf(cur) {
             let (packets, count) = leaf_packets(bvh, cur);
-            for (n, p) in packets.iter().enumerate() {
+            // Two packets per test (`PairKernel`); the counters as if tested one by one.
+            let mut pairs = packets.chunks_exact(2);
+            for (n, pair) in (&mut pairs).enumerate() {
+                let (a, b) = (&pair[0].tri, &pair[1].tri);
+                let mask = P::test_pair::<W>(a, b, &pr, ray.tmin, ray.tmax, &mut pair_lanes);
+                if mask != 0 {
+                    // The leaf stops at the first packet with a hit: its triangles and those
+                    // before it.
+                    let (first, m) = if mask & 0xf != 0 {
+                        (2 * n, mask & 0xf)
+                    } else {
+                        (2 * n + 1, mask >> PACKET)
+                    };
+                    tally.prims += count.min((first + 1) * PACKET) as u64;
+                    tally.prim_hits += m.count_ones() as u64;
+                    return true;
+                }
+            }
+            let done = packets.len() - pairs.remainder().len();
+            for (n, p) in pairs.remainder().iter().enumerate() {
                 let mask = P::test::<W>(&p.tri, &pr, ray.tmin, ray.tmax, &mut lanes);
                 if mask != 0 {
                     // The leaf stops at this packet: its triangles and those before it.
-                    tally.prims += count.min((n + 1) * PACKET) as u64;
+                    tally.prims += count.min((done + n + 1) * PACKET) as u64;
                     tally.prim_hits += mask.count_ones() as u64;
                     return true;
                 }

@@ -133,6 +133,11 @@ const MIN_RCP_INPUT: f32 = 1e-18;
 const ROUNDINGS: f32 = 4.0 * f32::EPSILON;
 
 impl SlabRay {
+    /// [`MIN_RCP_INPUT`], for set-ups that compute the same values in SIMD lanes.
+    pub const MIN_RCP_INPUT: f32 = MIN_RCP_INPUT;
+    /// [`ROUNDINGS`], likewise.
+    pub const ROUNDINGS: f32 = ROUNDINGS;
+
     /// `extent`: the largest absolute coordinate of any box the ray will be tested against
     /// (the scene's bounds).
     #[inline]

@@ -113,6 +113,41 @@ pub trait PacketKernel<const K: usize> {
     ) -> u32;
 }
 
+/// Two packets of 4 tested at once against the same segment (issue 20, session 9): the AVX2
+/// form puts packet `a` in the low 4 lanes and `b` in the high 4 of one 8-lane test, so a leaf
+/// of 5–8 triangles costs one test's arithmetic instead of two. Lane by lane the same
+/// operations as [`PacketKernel::test`], so each lane's hit and `(t, u, v)` are the same bits.
+/// The other forms test the two one after the other (the default).
+pub trait PairKernel: PacketKernel<4> {
+    /// Bit `lane` set when triangle `lane` of `a` is hit in `(tmin, tmax)`, bit `4 + lane`
+    /// for `b`; `hits` then holds its `(t, u, v)` in that lane.
+    #[inline(always)]
+    fn test_pair<const W: bool>(
+        a: &TrianglePacket<4>,
+        b: &TrianglePacket<4>,
+        r: &Self::Ray,
+        tmin: f32,
+        tmax: f32,
+        hits: &mut LaneHits<8>,
+    ) -> u32 {
+        let mut h = LaneHits::<4>::default();
+        let mut mask = 0;
+        for (half, p) in [a, b].into_iter().enumerate() {
+            let m = Self::test::<W>(p, r, tmin, tmax, &mut h);
+            if m != 0 {
+                let at = 4 * half;
+                hits.t[at..at + 4].copy_from_slice(&h.t);
+                hits.u[at..at + 4].copy_from_slice(&h.u);
+                hits.v[at..at + 4].copy_from_slice(&h.v);
+            }
+            mask |= m << (4 * half);
+        }
+        mask
+    }
+}
+
+impl PairKernel for Scalar {}
+
 /// The ray as the scalar form wants it (lane by lane through the scalar kernels; any width; the
 /// fallback and the reference).
 #[derive(Clone, Copy)]
@@ -229,7 +264,7 @@ pub fn closest_with<const K: usize, P: PacketKernel<K>>(
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{LaneHits, PacketKernel, TrianglePacket};
+    use super::{LaneHits, PacketKernel, PairKernel, TrianglePacket};
     use crate::geometry::kernels::f32::WatertightRay;
     use crate::geometry::lanes::{Avx8, Sse4};
     use crate::geometry::TriangleTest;
@@ -437,42 +472,54 @@ mod x86 {
         d: [L; 3],
         /// sx, sy, sz of the watertight set-up.
         s: [L; 3],
-        /// kx, ky, kz of the watertight set-up.
+        /// The origin on the set-up's axes: o[kx], o[ky], o[kz] (so the per-packet code
+        /// indexes no array by a run-time axis, which kept the ray in memory; issue 20).
+        ok: [L; 3],
+        /// kx, ky, kz of the watertight set-up, each < 3.
         k: [usize; 3],
     }
 
     #[inline(always)]
     unsafe fn prepare<L: Lanes>(o: Vec3, d: Vec3, wt: &WatertightRay) -> TriangleRayLanes<L> {
+        // Clamped so that a hand-made `WatertightRay` cannot make a row load leave the packet.
+        let k = [wt.kx.min(2), wt.ky.min(2), wt.kz.min(2)];
+        let oa = o.to_array();
+        // Written out (no `map`: its closure was not inlined into the AVX2 kernels).
         TriangleRayLanes {
             o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
             d: [L::splat(d.x), L::splat(d.y), L::splat(d.z)],
             s: [L::splat(wt.sx), L::splat(wt.sy), L::splat(wt.sz)],
-            k: [wt.kx, wt.ky, wt.kz],
+            ok: [L::splat(oa[k[0]]), L::splat(oa[k[1]]), L::splat(oa[k[2]])],
+            k,
         }
     }
 
     /// Row `a` (an axis, < 3) of vertex `i` (< 3) of a packet of `L::K` lanes.
+    ///
+    /// Safety: `i < 3`, `a < 3`, `K == L::K`, and the lanes' instruction set present.
     #[inline(always)]
     unsafe fn row<L: Lanes, const K: usize>(p: &TrianglePacket<K>, i: usize, a: usize) -> L {
         debug_assert!(K == L::K && i < 3 && a < 3);
-        L::load(p.v[i][a].as_ptr())
+        // Unchecked: `a` is an axis of the ray's set-up, not a constant, and the bounds checks
+        // cost 6 instructions a packet.
+        L::load((p.v.as_ptr() as *const f32).add((3 * i + a) * K))
     }
 
-    /// The watertight test (`kernels.rs`, `triangle_watertight`) on every lane.
+    /// The watertight test (`kernels.rs`, `triangle_watertight`) on every lane; `row(i, a)`
+    /// loads coordinate `a` of vertex `i` of every lane (one packet, or two side by side).
     #[inline(always)]
     unsafe fn watertight<L: Lanes, const K: usize>(
-        p: &TrianglePacket<K>,
+        row: impl Fn(usize, usize) -> L,
         r: &TriangleRayLanes<L>,
         tmin: f32,
         tmax: f32,
         hits: &mut LaneHits<K>,
     ) -> u32 {
-        let [kx, ky, kz] = r.k;
         // The vertices relative to the origin, on the three axes of the ray's set-up.
-        let rel = |i: usize, a: usize| row::<L, K>(p, i, a).sub(r.o[a]);
-        let (a_x, a_y, a_z) = (rel(0, kx), rel(0, ky), rel(0, kz));
-        let (b_x, b_y, b_z) = (rel(1, kx), rel(1, ky), rel(1, kz));
-        let (c_x, c_y, c_z) = (rel(2, kx), rel(2, ky), rel(2, kz));
+        let rel = |i: usize, j: usize| row(i, r.k[j]).sub(r.ok[j]);
+        let (a_x, a_y, a_z) = (rel(0, 0), rel(0, 1), rel(0, 2));
+        let (b_x, b_y, b_z) = (rel(1, 0), rel(1, 1), rel(1, 2));
+        let (c_x, c_y, c_z) = (rel(2, 0), rel(2, 1), rel(2, 2));
         let (sx, sy, sz) = (r.s[0], r.s[1], r.s[2]);
         let ax = a_x.sub(sx.mul(a_z));
         let ay = a_y.sub(sy.mul(a_z));
@@ -548,15 +595,15 @@ mod x86 {
     /// order for cross and dot products.
     #[inline(always)]
     unsafe fn moller<L: Lanes, const K: usize>(
-        p: &TrianglePacket<K>,
+        row: impl Fn(usize, usize) -> L,
         r: &TriangleRayLanes<L>,
         tmin: f32,
         tmax: f32,
         hits: &mut LaneHits<K>,
     ) -> u32 {
-        let v0 = [0, 1, 2].map(|a| row::<L, K>(p, 0, a));
-        let e1 = [0, 1, 2].map(|a| row::<L, K>(p, 1, a).sub(v0[a]));
-        let e2 = [0, 1, 2].map(|a| row::<L, K>(p, 2, a).sub(v0[a]));
+        let v0 = [0, 1, 2].map(|a| row(0, a));
+        let e1 = [0, 1, 2].map(|a| row(1, a).sub(v0[a]));
+        let e2 = [0, 1, 2].map(|a| row(2, a).sub(v0[a]));
         let cross = |a: [L; 3], b: [L; 3]| {
             [
                 a[1].mul(b[2]).sub(b[1].mul(a[2])),
@@ -619,10 +666,94 @@ mod x86 {
             // floats of `p.v` (`row`: vertex and axis < 3), every store writes one row of 4
             // floats of `hits` or of a local array of 4.
             unsafe {
+                let row = |i, a| row::<_, 4>(p, i, a);
                 if W {
-                    watertight(p, r, tmin, tmax, hits)
+                    watertight(row, r, tmin, tmax, hits)
                 } else {
-                    moller(p, r, tmin, tmax, hits)
+                    moller(row, r, tmin, tmax, hits)
+                }
+            }
+        }
+    }
+
+    impl PairKernel for Sse4 {}
+
+    /// Packets of 4 in AVX2 code: one packet in the low 4 lanes (the SSE form's arithmetic),
+    /// two side by side in all 8 ([`PairKernel`]). Only for code that has checked
+    /// [`Avx8::available`] (the BVH's AVX2 + FMA entry points).
+    impl PacketKernel<4> for Avx8 {
+        type Ray = TriangleRayLanes<__m256>;
+
+        #[inline(always)]
+        fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray {
+            // SAFETY: only reached from code run after `Avx8::available()` (this form's
+            // contract); `set1` only broadcasts.
+            unsafe { prepare(origin, dir, wt) }
+        }
+
+        #[inline(always)]
+        fn test<const W: bool>(
+            p: &TrianglePacket<4>,
+            r: &Self::Ray,
+            tmin: f32,
+            tmax: f32,
+            hits: &mut LaneHits<4>,
+        ) -> u32 {
+            // SAFETY: AVX is present (this form's contract); the casts take the low 4 lanes
+            // of each splat (no instruction). Every load reads one row of 4 floats of `p.v`,
+            // every store writes one row of 4 floats of `hits` or of a local array of 4.
+            unsafe {
+                let low = |x: [__m256; 3]| {
+                    [
+                        _mm256_castps256_ps128(x[0]),
+                        _mm256_castps256_ps128(x[1]),
+                        _mm256_castps256_ps128(x[2]),
+                    ]
+                };
+                let r4 = TriangleRayLanes::<__m128> {
+                    o: low(r.o),
+                    d: low(r.d),
+                    s: low(r.s),
+                    ok: low(r.ok),
+                    k: r.k,
+                };
+                let row = |i, a| row::<__m128, 4>(p, i, a);
+                if W {
+                    watertight(row, &r4, tmin, tmax, hits)
+                } else {
+                    moller(row, &r4, tmin, tmax, hits)
+                }
+            }
+        }
+    }
+
+    impl PairKernel for Avx8 {
+        #[inline(always)]
+        fn test_pair<const W: bool>(
+            a: &TrianglePacket<4>,
+            b: &TrianglePacket<4>,
+            r: &Self::Ray,
+            tmin: f32,
+            tmax: f32,
+            hits: &mut LaneHits<8>,
+        ) -> u32 {
+            // SAFETY: AVX is present (this form's contract). Each load reads one row of 4
+            // floats of `a.v` (low lanes) and the same row of `b.v` (high lanes); every store
+            // writes one row of 8 floats of `hits` or of a local array of 8.
+            unsafe {
+                let row = |i: usize, c: usize| {
+                    debug_assert!(i < 3 && c < 3);
+                    // Unchecked as in `row`: `c` is an axis of the set-up (< 3).
+                    let at = (3 * i + c) * 4;
+                    _mm256_loadu2_m128(
+                        (b.v.as_ptr() as *const f32).add(at),
+                        (a.v.as_ptr() as *const f32).add(at),
+                    )
+                };
+                if W {
+                    watertight(row, r, tmin, tmax, hits)
+                } else {
+                    moller(row, r, tmin, tmax, hits)
                 }
             }
         }
@@ -652,10 +783,11 @@ mod x86 {
             // contract). Every load reads one row of 8 floats of `p.v`, every store writes one
             // row of 8 floats of `hits` or of a local array of 8.
             unsafe {
+                let row = |i, a| row::<_, 8>(p, i, a);
                 if W {
-                    watertight(p, r, tmin, tmax, hits)
+                    watertight(row, r, tmin, tmax, hits)
                 } else {
-                    moller(p, r, tmin, tmax, hits)
+                    moller(row, r, tmin, tmax, hits)
                 }
             }
         }
@@ -793,6 +925,58 @@ mod tests {
     fn packets_give_the_scalar_kernels_answers() {
         check::<4>("closest4", closest4);
         check::<8>("closest8", closest8);
+    }
+
+    /// A pair test gives, lane by lane, the two packets' single tests (same mask bits, same
+    /// t, u, v bits), on the AVX2 form (when the CPU has it) and the default form.
+    #[test]
+    fn pairs_give_the_single_tests_answers() {
+        fn pairs<P: PairKernel>(prepare: impl Fn(Vec3, Vec3) -> P::Ray) -> usize {
+            let (tris, rays) = cases();
+            let packets: Vec<TrianglePacket<4>> = tris.chunks(4).map(TrianglePacket::new).collect();
+            let mut hits = 0;
+            for w in packets.windows(2) {
+                for &(o, d) in &rays {
+                    let r = prepare(o, d);
+                    for tmax in [f32::INFINITY, 2.0] {
+                        let mut pair = LaneHits::<8>::default();
+                        let m = P::test_pair::<true>(&w[0], &w[1], &r, 0.0, tmax, &mut pair);
+                        for (half, p) in w.iter().enumerate() {
+                            let mut h = LaneHits::<4>::default();
+                            let want = P::test::<true>(p, &r, 0.0, tmax, &mut h);
+                            assert_eq!((m >> (4 * half)) & 0xf, want, "ray {o} {d}");
+                            for lane in (0..4).filter(|l| want & (1 << l) != 0) {
+                                let at = 4 * half + lane;
+                                let bits = |t: f32, u: f32, v: f32| {
+                                    [t.to_bits(), u.to_bits(), v.to_bits()]
+                                };
+                                assert_eq!(
+                                    bits(pair.t[at], pair.u[at], pair.v[at]),
+                                    bits(h.t[lane], h.u[lane], h.v[lane])
+                                );
+                                hits += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            hits
+        }
+        let scalar = pairs::<Scalar>(|o, d| {
+            <Scalar as PacketKernel<4>>::prepare(o, d, &WatertightRay::new(d))
+        });
+        assert!(scalar > 100, "only {scalar} hits");
+        #[cfg(target_arch = "x86_64")]
+        if Avx8::available() {
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn avx() -> usize {
+                pairs::<Avx8>(|o, d| {
+                    <Avx8 as PacketKernel<4>>::prepare(o, d, &WatertightRay::new(d))
+                })
+            }
+            // SAFETY: the CPU has AVX2 and FMA (checked just above).
+            assert_eq!(unsafe { avx() }, scalar);
+        }
     }
 
     #[test]
