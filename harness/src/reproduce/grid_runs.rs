@@ -60,11 +60,17 @@ impl GridRun {
     /// CPU / wall of the run: well under 100% when it waited for a core or for the disk, so
     /// that a time measured beside other work is seen as such ("-" when not kept).
     pub fn cpu_share(&self) -> String {
-        if self.cpu_s > 0.0 {
-            format!("{:.0}%", 100.0 * self.cpu_s / self.total_s().max(1e-9))
-        } else {
-            "-".into()
-        }
+        cpu_share(self.cpu_s, self.total_s())
+    }
+}
+
+/// CPU / wall of a run as "NN%", "-" when its CPU seconds were not kept (0): the one format of
+/// the out-of-core reproductions' "CPU / wall" columns.
+pub fn cpu_share(cpu_s: f64, wall_s: f64) -> String {
+    if cpu_s > 0.0 {
+        format!("{:.0}%", 100.0 * cpu_s / wall_s.max(1e-9))
+    } else {
+        "-".into()
     }
 }
 

@@ -158,11 +158,7 @@ impl Run {
 
     /// CPU time over wall time, as a percentage ("-" for rows that did not keep it).
     fn cpu_share(&self) -> String {
-        if self.cpu_s > 0.0 {
-            format!("{:.0}%", 100.0 * self.cpu_s / self.total_s().max(1e-9))
-        } else {
-            "-".into()
-        }
+        super::grid_runs::cpu_share(self.cpu_s, self.total_s())
     }
 }
 

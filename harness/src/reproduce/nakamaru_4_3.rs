@@ -999,11 +999,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                     r.rays.to_string(),
                     format!("{}…", &r.sha256[..12.min(r.sha256.len())]),
                     // A run that waited for a core or for the disk shows well under 100%.
-                    if r.cpu_s > 0.0 {
-                        format!("{:.0}%", 100.0 * r.cpu_s / (r.preprocess_s + r.trace_s).max(1e-9))
-                    } else {
-                        "-".into()
-                    },
+                    super::grid_runs::cpu_share(r.cpu_s, r.preprocess_s + r.trace_s),
                     r.load_average.clone(),
                 ]);
             }
