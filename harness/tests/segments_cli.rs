@@ -203,4 +203,14 @@ fn nakamaru_4_3_runs_a_scenes_basic_rows_before_its_split_store() {
     assert_eq!(m[0]["split_store"], m[1]["split_store"]);
     assert!(m[1]["objects"].as_u64().unwrap() > 0);
     assert_eq!(v["finished"], true);
+    // `progress=on`: one stderr line per pass of every run (basic, S+G and S+G+B of both rows).
+    let passes: u64 = (0..2)
+        .flat_map(|i| ["basic", "sg", "sgb"].map(|k| m[i][k]["passes"].as_u64().unwrap()))
+        .sum();
+    assert!(passes >= 6, "{passes}");
+    assert_eq!(
+        err.matches("breadth-first: pass ").count() as u64,
+        passes,
+        "{err}"
+    );
 }

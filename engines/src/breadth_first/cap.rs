@@ -1,4 +1,5 @@
-//! The pass cap (`max_passes=N`): the run stops after its first N passes (over all its trace
+//! The pass count: a pass ends here ([`Work::end_pass`]: the counters, and a line on stderr
+//! with `progress=on`), and the pass cap (`max_passes=N`) stops the run: the run stops after its first N passes (over all its trace
 //! calls), every counter and time of those passes kept, and says so (`bf_pass_cap_reached`).
 //!
 //! Why: seed 000's basic method cannot finish 10^9 objects within a session (Table 4.3: 27 to
@@ -14,6 +15,25 @@ use crate::{Counters, Hit, Ray};
 pub const CAP_REACHED: &str = "bf_pass_cap_reached";
 
 impl Work {
+    /// A pass is over: `bf_passes` and the count the cap reads, and with `progress=on` one line
+    /// on stderr (a 10^9-object run makes one pass in tens of minutes and nothing else to see).
+    pub(super) fn end_pass(&mut self, c: &mut Counters) {
+        *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
+        self.passes_done += 1;
+        if let Some(t0) = self.progress {
+            let cap = self
+                .max_passes
+                .map(|m| format!(" of at most {m}"))
+                .unwrap_or_default();
+            eprintln!(
+                "breadth-first: pass {}{cap} done: {} rays in memory, {:.1} s since the engine opened",
+                self.passes_done,
+                self.slots.len(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
+    }
+
     /// Whether the cap is reached. Then the rays in memory and the rest of `rays` are answered
     /// MISS (no test, no counter), and [`CAP_REACHED`] is set when any ray was left.
     pub(super) fn capped(

@@ -145,6 +145,8 @@ pub struct BreadthFirstConfig {
     /// Stop after this many passes (`max_passes=N`, [`super::cap`]); the run is then marked
     /// incomplete (`bf_pass_cap_reached`) and its image is no answer.
     pub max_passes: Option<u64>,
+    /// One line on stderr after every pass (`progress=on`): a 10^9-object run takes hours.
+    pub progress: bool,
 }
 
 /// Hierarchy constants set by the user (`None`: the thesis's for the scene).
@@ -266,6 +268,11 @@ impl BreadthFirstConfig {
         }
         let max_rays: u64 = s.get("rays", 0u64)?;
         let max_passes: u64 = s.get("max_passes", 0u64)?;
+        let progress = match s.get("progress", "off".to_string())?.as_str() {
+            "on" => true,
+            "off" => false,
+            v => return Err(bad("progress", v, "on or off")),
+        };
         let spill_codec: String = s.get("spill_codec", "none".to_string())?;
         let spill_codec = match spill_codec.as_str() {
             "none" => Codec::None,
@@ -352,6 +359,7 @@ impl BreadthFirstConfig {
             res: (res > 0).then_some(res),
             max_rays: (max_rays > 0).then_some(max_rays),
             max_passes: (max_passes > 0).then_some(max_passes),
+            progress,
             spill_codec,
             secondary,
             hierarchy,

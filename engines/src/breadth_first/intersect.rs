@@ -72,6 +72,8 @@ pub struct Work {
     /// The pass cap (`max_passes`, [`super::cap`]) and the passes made so far, over all calls.
     pub(super) max_passes: Option<u64>,
     pub(super) passes_done: u64,
+    /// When the engine opened, for the `progress=on` line after every pass.
+    pub(super) progress: Option<std::time::Instant>,
 }
 
 impl Work {
@@ -352,8 +354,7 @@ impl Work {
             let count = self.registration_count(self.slots.len());
             self.register(count, c);
             self.sweep(any, test, c)?;
-            *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
-            self.passes_done += 1;
+            self.end_pass(c);
             self.finish_pass(any, out, c);
         }
     }

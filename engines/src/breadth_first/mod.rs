@@ -22,6 +22,7 @@
 //! | `registration` | `fixed:N`, `thesis`, `inverse`, `inverse:N` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
 //! | `buffer` | bytes | `64KiB` | each file buffer (a compressed split store's readers hold one 128 KiB block, its compressed bytes and the block index instead: `store_reader_bytes`) |
+//! | `progress` | `on`, `off` | `off` | one line on stderr after every pass: the pass, the rays it held, the cap if any, the seconds since the engine opened |
 //! | `max_passes` | count | `0` (none) | stop after N passes over all trace calls ([`cap`]): counters and times are those passes'; `bf_pass_cap_reached` > 0 says the run stopped so, and its image is no answer |
 //! | `triangle` | `watertight`, `moller` | `watertight` | the shared triangle kernel |
 //! | `verify` | `full`, `records` | `full` | `full`: a store opened is read once and every record checked ([`crate::store::StoreHeader::verify`]) before preprocessing, outside the I/O counters (reported as `verify_bytes_read`, `verify_s`); `records`: only the records the algorithm reads are checked |
@@ -484,6 +485,7 @@ impl BreadthFirst {
             hires,
             max_passes: config.max_passes,
             passes_done: 0,
+            progress: config.progress.then(std::time::Instant::now),
         };
         Ok(BreadthFirst {
             config,

@@ -317,6 +317,8 @@ fn trace(
         ("verify".into(), "records".into()),
         ("cache".into(), s.cache.clone()),
         ("grid".into(), "two-level".into()),
+        // Hours per run at 10^9 objects: a line per pass on stderr.
+        ("progress".into(), "on".into()),
     ];
     if let Some(sp) = &s.spill {
         pairs.push(("spill".into(), sp.clone()));

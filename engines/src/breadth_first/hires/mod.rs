@@ -112,8 +112,7 @@ impl Work {
             h.reg.register(&h.cands);
             *c.extra.entry("bf_registrations".into()).or_insert(0) += h.cands.len() as u64;
             self.sweep(any, test, c)?;
-            *c.extra.entry("bf_passes".into()).or_insert(0) += 1;
-            self.passes_done += 1;
+            self.end_pass(c);
             // Algorithm 4.5: done when the hit lies before the sentinel (every voxel up to it
             // was swept or holds no box not met before), or the walk has no sentinel.
             let h = self.hires.as_mut().expect("hires");
