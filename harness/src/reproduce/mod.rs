@@ -12,6 +12,7 @@
 
 mod checkpoint;
 mod claims;
+mod invocation;
 mod params;
 mod published;
 mod table;
@@ -176,7 +177,9 @@ pub fn run(
         params: &params,
         checkpoint: &checkpoint,
     };
-    let output = (table.run)(&ctx)?;
+    let clock = invocation::Invocation::start();
+    let mut output = (table.run)(&ctx)?;
+    clock.stamp(&mut output, resume);
     writer::write(table, out, output, as_json)?;
     Ok(())
 }
