@@ -299,7 +299,8 @@ impl Splitter for Binned {
                         blocks(lc as usize, self.block) as u32,
                         blocks(rc as usize, self.block) as u32,
                     );
-                    let c = l.half_area() * lb as f32 + self.right_area[i as u8 as usize] * rb as f32;
+                    let c =
+                        l.half_area() * lb as f32 + self.right_area[i as u8 as usize] * rb as f32;
                     if best.is_none_or(|b| c < b.2) {
                         best = Some((a, k as u32 + 1, c));
                     }
