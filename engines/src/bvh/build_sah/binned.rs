@@ -98,6 +98,23 @@ struct BinMap {
 }
 
 impl BinMap {
+    /// `nb` equal bins per axis over the centroid bounds `cb`.
+    fn new(cb: &Aabb, nb: usize) -> BinMap {
+        let ext = Vec3A::from(cb.extent());
+        // Bins per unit length on each axis; 0 on a flat axis puts everything in bin 0, where
+        // no plane has primitives on both sides.
+        let scale = Vec3A::select(
+            ext.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(nb as f32 * (1.0 - 1e-6)) / ext,
+            Vec3A::ZERO,
+        );
+        BinMap {
+            lo: Vec3A::from(cb.lo),
+            scale,
+            last: Vec3A::splat((nb - 1) as f32),
+        }
+    }
+
     #[inline(always)]
     fn bin_of(&self, c: Vec3A) -> [u32; 4] {
         let t = ((c - self.lo) * self.scale).max(Vec3A::ZERO).min(self.last);
@@ -233,20 +250,7 @@ impl Splitter for Binned {
         // clearing and sweeping 3 × 32 bins would dominate the millions of splits near the
         // leaves.
         let nb = self.nb.min(2 * r.len());
-        let ext = Vec3A::from(cb.extent());
-        let cb_lo = Vec3A::from(cb.lo);
-        // Bins per unit length on each axis; 0 on a flat axis puts everything in bin 0, where
-        // no plane has primitives on both sides.
-        let scale = Vec3A::select(
-            ext.cmpgt(Vec3A::ZERO),
-            Vec3A::splat(nb as f32 * (1.0 - 1e-6)) / ext,
-            Vec3A::ZERO,
-        );
-        let map = BinMap {
-            lo: cb_lo,
-            scale,
-            last: Vec3A::splat((nb - 1) as f32),
-        };
+        let map = BinMap::new(&cb, nb);
         let (start, end) = (r.start - self.off, r.end - self.off);
         // Every bin is empty between splits (the sweeps below empty the ones they used), so
         // no clearing pass is needed.
@@ -370,5 +374,130 @@ impl Splitter for Binned {
     fn into_order(self) -> Vec<u32> {
         debug_assert_eq!(self.off, 0, "the order of a fork");
         self.ids
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Boxes in a few tight clusters (so most bins are empty), with repeated centres.
+    fn clustered(n: usize, seed: u64) -> BuildPrims {
+        let mut x = seed;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 40) as f32) / (1u64 << 24) as f32
+        };
+        let bounds: Vec<Aabb> = (0..n)
+            .map(|i| {
+                let cluster = Vec3::new((i % 3) as f32 * 10.0, (i % 5) as f32 * 3.0, 0.0);
+                let jitter = if i % 4 == 0 {
+                    Vec3::ZERO
+                } else {
+                    Vec3::new(next(), next(), next())
+                };
+                let lo = cluster + jitter;
+                Aabb::new(lo, lo + Vec3::new(next(), next(), next()) * 0.5)
+            })
+            .collect();
+        let centroid = bounds.iter().map(|b| b.centre()).collect();
+        BuildPrims { bounds, centroid }
+    }
+
+    /// Every plane of every axis evaluated from scratch, in the order the sweeps visit them:
+    /// (axis, left ids sorted, cost).
+    fn brute_force(p: &BuildPrims, r: &Range, nb: usize, block: usize) -> (usize, Vec<u32>, f32) {
+        let map = BinMap::new(&r.centroids, nb);
+        let boxes: Vec<Box3A> = p
+            .bounds
+            .iter()
+            .map(|b| Box3A {
+                lo: b.lo.into(),
+                hi: b.hi.into(),
+            })
+            .collect();
+        let mut best: Option<(usize, u32, f32)> = None;
+        for a in 0..3 {
+            for plane in 1..nb as u32 {
+                let (mut l, mut r, mut lc, mut rc) = (Box3A::EMPTY, Box3A::EMPTY, 0, 0);
+                for b in &boxes {
+                    if map.bin_of(b.centre())[a] < plane {
+                        l.grow(b);
+                        lc += 1;
+                    } else {
+                        r.grow(b);
+                        rc += 1;
+                    }
+                }
+                if lc > 0 && rc > 0 {
+                    let (lb, rb) = (blocks(lc, block), blocks(rc, block));
+                    let c = l.half_area() * lb as f32 + r.half_area() * rb as f32;
+                    if best.is_none_or(|b| c < b.2) {
+                        best = Some((a, plane, c));
+                    }
+                }
+            }
+        }
+        let (a, plane, c) = best.expect("a plane with both sides filled");
+        let left = (0..boxes.len() as u32)
+            .filter(|&i| map.bin_of(boxes[i as usize].centre())[a] < plane)
+            .collect();
+        (a, left, split_cost(c, r.bounds.half_area()))
+    }
+
+    /// The split search (filled bins only, the partition's compare against the plane) chooses
+    /// the plane a search of every plane does, with the same cost to the bit, on ranges whose
+    /// bins are mostly empty, with 2n bins (small ranges) and with 32.
+    #[test]
+    fn split_equals_every_plane_searched() {
+        for (n, seed) in [(3, 1), (7, 2), (16, 3), (40, 4), (300, 5)] {
+            for block in [1, 4] {
+                let p = clustered(n, seed);
+                let mut s = Binned::new(&p, 32).with_block(block);
+                let root = s.root();
+                let (axis, want_left, want_cost) = brute_force(&p, &root, 32.min(2 * n), block);
+                let split = s.split(&root, None, false);
+                let mut left = s.ids(&split.left).to_vec();
+                left.sort_unstable();
+                assert_eq!(
+                    (split.axis, left, split.cost.to_bits()),
+                    (axis, want_left, want_cost.to_bits()),
+                    "n {n} block {block}"
+                );
+                // Both sides bounded as the partition went.
+                assert_eq!(split.left.bounds, p.bounds_of(s.ids(&split.left)));
+                assert_eq!(split.right.bounds, p.bounds_of(s.ids(&split.right)));
+            }
+        }
+    }
+
+    /// The float clamp before one conversion gives the bins the old clamp after a saturating
+    /// conversion gave, at and around every bin edge, beyond both ends, and for NaN.
+    #[test]
+    fn bins_as_saturating_conversion_gave() {
+        let nb: usize = 24;
+        let map = BinMap {
+            lo: Vec3A::ZERO,
+            scale: Vec3A::ONE,
+            last: Vec3A::splat((nb - 1) as f32),
+        };
+        let old = |t: f32| (t.max(0.0) as u32).min(nb as u32 - 1);
+        for k in -3..nb as i32 + 3 {
+            for t in [
+                k as f32,
+                (k as f32).next_down(),
+                (k as f32).next_up(),
+                k as f32 + 0.5,
+            ] {
+                assert_eq!(map.bin_of(Vec3A::splat(t))[0], old(t), "t {t}");
+            }
+        }
+        for t in [f32::INFINITY, f32::NEG_INFINITY, 1e30, -1e30] {
+            assert_eq!(map.bin_of(Vec3A::splat(t))[1], old(t), "t {t}");
+        }
+        assert_eq!(map.bin_of(Vec3A::splat(f32::NAN))[2], 0);
     }
 }
