@@ -83,23 +83,26 @@ fn node(
 ) -> u32 {
     let n = &bin.nodes[i as usize];
     let (first, count) = span[i as usize];
-    let children = match n.kind {
+    // The children in a fixed array (no allocation per node: the collapse makes one wide node
+    // per 3-4 binary ones).
+    let mut kids = [0u32; MAX_WIDTH];
+    let mut len = match n.kind {
         BuildKind::Inner { children, len } if !leaves.is_leaf((first, count)) => {
-            children[..len as usize].to_vec()
+            kids[..len as usize].copy_from_slice(&children[..len as usize]);
+            len as usize
         }
         _ => return out.push(n.bounds, BuildKind::Leaf { first, count }),
     };
-    let mut kids = children;
-    while kids.len() < width {
+    while len < width {
         // Open the child of largest area among those too big to be a leaf; when none is
         // left, slots still free go to splitting leaf-sized subtrees, which costs no extra
         // node and leaves fewer primitives per leaf.
-        let best = kids
+        let best = kids[..len]
             .iter()
             .enumerate()
             .filter(|&(_, &k)| {
-                matches!(bin.nodes[k as usize].kind, BuildKind::Inner { len, .. }
-                    if kids.len() - 1 + len as usize <= width)
+                matches!(bin.nodes[k as usize].kind, BuildKind::Inner { len: l, .. }
+                    if len - 1 + l as usize <= width)
             })
             .map(|(slot, &k)| {
                 let big = !leaves.is_leaf(span[k as usize]);
@@ -108,17 +111,21 @@ fn node(
             .filter(|&(_, big, _)| big || leaves.split_leaves)
             .max_by(|a, b| a.1.cmp(&b.1).then(a.2.total_cmp(&b.2)));
         let Some((slot, _, _)) = best else { break };
-        let grand = bin.children(kids[slot]).to_vec();
-        kids.splice(slot..slot + 1, grand);
+        // Replace the child in `slot` by its own children, keeping the order.
+        let grand = bin.children(kids[slot]);
+        let g = grand.len();
+        kids.copy_within(slot + 1..len, slot + g);
+        kids[slot..slot + g].copy_from_slice(grand);
+        len += g - 1;
     }
     let me = out.push(n.bounds, n.kind);
     let mut wide = [0u32; MAX_WIDTH];
-    for (slot, &k) in kids.iter().enumerate() {
+    for (slot, &k) in kids[..len].iter().enumerate() {
         wide[slot] = node(bin, span, k, width, leaves, out);
     }
     out.nodes[me as usize].kind = BuildKind::Inner {
         children: wide,
-        len: kids.len() as u8,
+        len: len as u8,
     };
     me
 }

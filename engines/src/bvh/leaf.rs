@@ -44,42 +44,54 @@ pub fn lay_out<const N: usize>(
     packets: bool,
 ) -> Leaves {
     let mut out = Leaves::default();
+    if packets {
+        // Reserved once (exactly, when every leaf is of triangles): growing one by one
+        // reallocated and copied the 160-byte packets.
+        let leaf_refs = std::iter::once(*root).chain(
+            nodes
+                .iter()
+                .flat_map(|n| n.child[..n.len as usize].iter().copied()),
+        );
+        let most: usize = leaf_refs
+            .filter(|&r| is_leaf(r) && r != EMPTY_SLOT)
+            .map(|r| leaf_range(r).1.div_ceil(PACKET))
+            .sum();
+        out.packets.reserve_exact(most);
+    }
     let mut place = |r: u32| -> u32 {
         if !is_leaf(r) || r == EMPTY_SLOT {
             return r;
         }
         let (first, count) = leaf_range(r);
         let ids = &order[first..first + count];
-        let tris: Option<Vec<[glam::Vec3; 3]>> = ids
+        let all_triangles = ids
             .iter()
-            .map(|&i| match geometry.prims[i as usize] {
-                Prim::Triangle(t) => Some(t),
-                _ => None,
-            })
-            .collect();
-        match tris {
-            Some(tris) if packets => {
-                let at = out.packets.len() as u32;
-                for (t, o) in tris.chunks(PACKET).zip(ids.chunks(PACKET)) {
-                    let mut object = [u32::MAX; PACKET];
-                    for (slot, &i) in object.iter_mut().zip(o) {
-                        *slot = geometry.prim_object[i as usize];
+            .all(|&i| matches!(geometry.prims[i as usize], Prim::Triangle(_)));
+        if packets && all_triangles {
+            let at = out.packets.len() as u32;
+            for o in ids.chunks(PACKET) {
+                // The packet's triangles gathered on the stack (no allocation per leaf).
+                let mut tris = [[glam::Vec3::ZERO; 3]; PACKET];
+                let mut object = [u32::MAX; PACKET];
+                for (lane, &i) in o.iter().enumerate() {
+                    if let Prim::Triangle(t) = geometry.prims[i as usize] {
+                        tris[lane] = t;
                     }
-                    out.packets.push(LeafPacket {
-                        tri: TrianglePacket::new(t),
-                        object,
-                    });
+                    object[lane] = geometry.prim_object[i as usize];
                 }
-                packet_leaf_ref(at, count as u32)
+                out.packets.push(LeafPacket {
+                    tri: TrianglePacket::new(&tris[..o.len()]),
+                    object,
+                });
             }
-            _ => {
-                let at = out.prims.len() as u32;
-                for &i in ids {
-                    out.prims.push(geometry.prims[i as usize]);
-                    out.objects.push(geometry.prim_object[i as usize]);
-                }
-                super::node::leaf_ref(at, count as u32)
+            packet_leaf_ref(at, count as u32)
+        } else {
+            let at = out.prims.len() as u32;
+            for &i in ids {
+                out.prims.push(geometry.prims[i as usize]);
+                out.objects.push(geometry.prim_object[i as usize]);
             }
+            super::node::leaf_ref(at, count as u32)
         }
     };
     *root = place(*root);
