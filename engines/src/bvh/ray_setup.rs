@@ -39,6 +39,17 @@ fn traceable_scalar(ray: &Ray) -> bool {
     (z == 0.0) & ordered
 }
 
+/// The ray's octant: bit `a` set when the direction is negative on axis `a`, as the sign
+/// bits of `slab_lanes` (`1 / safe(d)` keeps the sign bit of `d`, −0 included) and
+/// `SlabRay::negative`.
+#[inline(always)]
+pub fn octant(ray: &Ray) -> u32 {
+    let d = ray.dir;
+    (d.x.is_sign_negative() as u32)
+        | (d.y.is_sign_negative() as u32) << 1
+        | (d.z.is_sign_negative() as u32) << 2
+}
+
 /// [`WatertightRay::new`] without the branches of the axis choice: `kz` is the axis of the
 /// largest direction component (the first of equal ones, as there), `kx`, `ky` the next two,
 /// swapped when `d[kz] < 0`.
@@ -234,6 +245,7 @@ mod tests {
                 assert_eq!(lanes(far), bits(want.org_rdir_far), "{r:?}");
                 let n = want.negative;
                 assert_eq!(neg, n[0] as u32 | (n[1] as u32) << 1 | (n[2] as u32) << 2);
+                assert_eq!(octant(r), neg, "{r:?}");
             }
         }
     }

@@ -160,6 +160,43 @@ fn triangle_test<const W: bool>() -> TriangleTest {
     }
 }
 
+/// `OCT` of a traversal whose box test takes the plane rows from the ray at run time.
+const ANY_OCTANT: u32 = 8;
+
+/// The ray's node test: with the plane rows of octant `OCT` as constants, or
+/// ([`ANY_OCTANT`]) from the ray.
+#[inline(always)]
+fn node_test<const N: usize, T: ChildTest<N>, const OCT: u32>(
+    node: &WideNode<N>,
+    tr: &T::Ray,
+    tmin: f32,
+    tmax: f32,
+    dist: &mut [f32; N],
+) -> u32 {
+    if OCT < ANY_OCTANT {
+        T::test_octant::<OCT>(node, tr, tmin, tmax, dist)
+    } else {
+        T::test(node, tr, tmin, tmax, dist)
+    }
+}
+
+/// `f::<generics…, OCT>(args…)` with `OCT` the octant `oct` (0–7) as a constant: one loop
+/// per octant (issue 20, session 10), as the SIMD box tests want ([`ChildTest::OCTANTS`]).
+macro_rules! by_octant {
+    ($oct:expr, $f:ident::<$($g:tt),*>($($arg:expr),*)) => {
+        match $oct {
+            0 => $f::<$($g),*, 0>($($arg),*),
+            1 => $f::<$($g),*, 1>($($arg),*),
+            2 => $f::<$($g),*, 2>($($arg),*),
+            3 => $f::<$($g),*, 3>($($arg),*),
+            4 => $f::<$($g),*, 4>($($arg),*),
+            5 => $f::<$($g),*, 5>($($arg),*),
+            6 => $f::<$($g),*, 6>($($arg),*),
+            _ => $f::<$($g),*, 7>($($arg),*),
+        }
+    };
+}
+
 /// Closest hits of a batch of rays.
 #[inline(always)]
 pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
@@ -173,13 +210,14 @@ pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
     let mut tally = Tally::default();
     let mut lanes = Lanes::default();
     for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        let (s, l, t) = (&mut stack, &mut lanes, &mut tally);
         *hit = match test {
-            TriangleTest::Watertight => {
-                closest::<N, T, P, true>(bvh, ray, &mut stack, &mut lanes, &mut tally)
-            }
-            TriangleTest::Moller => {
-                closest::<N, T, P, false>(bvh, ray, &mut stack, &mut lanes, &mut tally)
-            }
+            TriangleTest::Watertight if T::OCTANTS => by_octant!(
+                ray_setup::octant(ray),
+                closest::<N, T, P, true>(bvh, ray, s, l, t)
+            ),
+            TriangleTest::Watertight => closest::<N, T, P, true, ANY_OCTANT>(bvh, ray, s, l, t),
+            TriangleTest::Moller => closest::<N, T, P, false, ANY_OCTANT>(bvh, ray, s, l, t),
         };
     }
     tally.add_to(counters, rays.len());
@@ -198,20 +236,23 @@ pub fn any_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
     let mut tally = Tally::default();
     let mut lanes = Lanes::default();
     for (ray, o) in rays.iter().zip(out.iter_mut()) {
+        let (s, l, t) = (&mut stack, &mut lanes, &mut tally);
         *o = match test {
-            TriangleTest::Watertight => {
-                any::<N, T, P, true>(bvh, ray, &mut stack, &mut lanes, &mut tally)
+            TriangleTest::Watertight if T::OCTANTS => {
+                by_octant!(
+                    ray_setup::octant(ray),
+                    any::<N, T, P, true>(bvh, ray, s, l, t)
+                )
             }
-            TriangleTest::Moller => {
-                any::<N, T, P, false>(bvh, ray, &mut stack, &mut lanes, &mut tally)
-            }
+            TriangleTest::Watertight => any::<N, T, P, true, ANY_OCTANT>(bvh, ray, s, l, t),
+            TriangleTest::Moller => any::<N, T, P, false, ANY_OCTANT>(bvh, ray, s, l, t),
         };
     }
     tally.add_to(counters, rays.len());
 }
 
 #[inline(always)]
-fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
+fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT: u32>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [Entry; STACK_SIZE],
@@ -227,7 +268,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
         one: lanes,
         pair: pair_lanes,
     } = lanes;
-    let mut tmax = ray.tmax;
+    let (tmin, mut tmax) = (ray.tmin, ray.tmax);
     let mut best = Hit::MISS;
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
@@ -237,7 +278,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let node = &bvh.nodes[cur as usize];
             tally.nodes += 1;
             tally.boxes += node.len as u64;
-            let mut mask = T::test(node, &tr, ray.tmin, tmax, &mut dist);
+            let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -338,7 +379,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let mut pairs = packets.chunks_exact(2);
             for pair in &mut pairs {
                 let (a, b) = (&pair[0], &pair[1]);
-                let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, ray.tmin, tmax, pair_lanes);
+                let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, tmin, tmax, pair_lanes);
                 if mask != 0 {
                     let i = pair_lanes.nearest(mask);
                     tally.prim_hits += pair_hits(&pair_lanes, mask);
@@ -352,7 +393,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
                 }
             }
             for p in pairs.remainder() {
-                let mask = P::test::<W>(&p.tri, &pr, ray.tmin, tmax, lanes);
+                let mask = P::test::<W>(&p.tri, &pr, tmin, tmax, lanes);
                 if mask != 0 {
                     tally.prim_hits += mask.count_ones() as u64;
                     let i = lanes.nearest(mask);
@@ -398,7 +439,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
 }
 
 #[inline(always)]
-fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
+fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT: u32>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [u32; STACK_SIZE],
@@ -414,6 +455,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
         one: lanes,
         pair: pair_lanes,
     } = lanes;
+    let (tmin, tmax) = (ray.tmin, ray.tmax);
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
@@ -422,7 +464,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let node = &bvh.nodes[cur as usize];
             tally.nodes += 1;
             tally.boxes += node.len as u64;
-            let mut mask = T::test(node, &tr, ray.tmin, ray.tmax, &mut dist);
+            let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -442,7 +484,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let mut pairs = packets.chunks_exact(2);
             for (n, pair) in (&mut pairs).enumerate() {
                 let (a, b) = (&pair[0].tri, &pair[1].tri);
-                let mask = P::test_pair::<W>(a, b, &pr, ray.tmin, ray.tmax, pair_lanes);
+                let mask = P::test_pair::<W>(a, b, &pr, tmin, tmax, pair_lanes);
                 if mask != 0 {
                     // The leaf stops at the first packet with a hit: its triangles and those
                     // before it.
@@ -458,7 +500,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             }
             let done = packets.len() - pairs.remainder().len();
             for (n, p) in pairs.remainder().iter().enumerate() {
-                let mask = P::test::<W>(&p.tri, &pr, ray.tmin, ray.tmax, lanes);
+                let mask = P::test::<W>(&p.tri, &pr, tmin, tmax, lanes);
                 if mask != 0 {
                     // The leaf stops at this packet: its triangles and those before it.
                     tally.prims += count.min((done + n + 1) * PACKET) as u64;

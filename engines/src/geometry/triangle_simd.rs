@@ -508,9 +508,31 @@ mod x86 {
         }
     }
 
-    /// `kz` of the watertight set-up by the bits (a.x > a.y, a.y > a.z, a.x > a.z) of the
-    /// direction's magnitudes `a`: `WatertightRay::new`'s comparisons as a table.
-    const KZ: [usize; 8] = [2, 2, 1, 2, 2, 0, 1, 0];
+    /// The row of [`AXES`] and [`PERM`], `2 kz + (d[kz] < 0)`, by a key of six bits: bits
+    /// 0–2 (a.x > a.y, a.y > a.z, a.z ≥ a.x) of the direction's magnitudes `a`, bits 3–5 the
+    /// signs `d < 0`. `kz` is `WatertightRay::new`'s choice: `a.x > a.y ? (a.x > a.z ? 0 : 2)
+    /// : (a.y > a.z ? 1 : 2)`, with `a.x > a.z` the negation of bit 2.
+    const ROW: [u8; 64] = {
+        let mut t = [0u8; 64];
+        let mut key = 0;
+        while key < 64 {
+            let (x_y, y_z, x_z) = (key & 1 != 0, key & 2 != 0, key & 4 == 0);
+            let kz = if x_y {
+                if x_z {
+                    0
+                } else {
+                    2
+                }
+            } else if y_z {
+                1
+            } else {
+                2
+            };
+            t[key] = (2 * kz + ((key >> (3 + kz)) & 1)) as u8;
+            key += 1;
+        }
+        t
+    };
     /// (kx, ky) by `2 kz + (d[kz] < 0)` (swapped when negative), as `WatertightRay::new`;
     /// rows 6 and 7 only pad the table to a power of two. Every entry is < 3.
     const AXES: [[usize; 2]; 8] = [
@@ -549,12 +571,13 @@ mod x86 {
         let o = _mm_loadu_ps(p);
         let d = _mm_loadu_ps(p.add(4));
         let a = _mm_andnot_ps(_mm_set1_ps(-0.0), d);
-        // Lanes 0, 1: a.x > a.y, a.y > a.z; then lane 0: a.x > a.z.
-        let next = _mm_movemask_ps(_mm_cmpgt_ps(a, _mm_shuffle_ps::<0b00_00_10_01>(a, a)));
-        let z = _mm_movemask_ps(_mm_cmpgt_ps(a, _mm_shuffle_ps::<0b00_01_00_10>(a, a)));
-        let kz = KZ[((next & 3) | ((z & 1) << 2)) as usize];
-        let neg = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) as usize;
-        let row = (2 * kz + ((neg >> kz) & 1)) & 7;
+        // a against (a.y, a.z, a.x): lanes 0, 1 by `>`, lane 2 by `≥` (the key of `ROW`).
+        let next = _mm_shuffle_ps::<0b00_00_10_01>(a, a);
+        let axes = _mm_blend_ps::<0b0100>(_mm_cmpgt_ps(a, next), _mm_cmpge_ps(a, next));
+        let neg = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) & 7;
+        let key = (_mm_movemask_ps(axes) & 7) | (neg << 3);
+        let row = ROW[key as usize] as usize & 7;
+        let kz = row >> 1;
         let [kx, ky] = AXES[row];
         let perm = _mm_loadu_si128(PERM[row].as_ptr() as *const __m128i);
         let dk = _mm_permutevar_ps(d, perm);
