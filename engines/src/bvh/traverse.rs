@@ -382,7 +382,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const 
                 let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, tmin, tmax, pair_lanes);
                 if mask != 0 {
                     let i = pair_lanes.nearest(mask);
-                    tally.prim_hits += pair_hits(&pair_lanes, mask);
+                    tally.prim_hits += pair_hits(pair_lanes, mask);
                     tmax = pair_lanes.t[i];
                     best = Hit {
                         t: pair_lanes.t[i],
