@@ -1,7 +1,8 @@
 //! Packets against Embree's packets on coherent generations (issue 20, acceptance 2):
 //! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]
-//! [--engines LABEL,...]` (`--engines`: only the engines whose label starts with one of these, e.g.
-//! `"embree single,bvh4 single"`; bvh8 single is always built, it makes the shadow rays).
+//! [--engines LABEL,...] [--tessellate RES]` (`--engines`: only the engines whose label starts with
+//! one of these, e.g. `"embree single,bvh4 single"`; bvh8 single is always built, it makes the
+//! shadow rays; `--tessellate`: the scenes as triangles, SPD `-t RES`).
 //!
 //! Two generations of each scene, as the SPD workload makes them but grouped so that a batch is
 //! coherent: the eye rays through the (size+1)² pixel corners, row by row, and the shadow rays
@@ -132,6 +133,9 @@ fn main() {
     // `--once`: every engine traces each generation once, untimed and unchecked (for counting
     // instructions per entry point under callgrind).
     let mut once = false;
+    // `--tessellate RES`: the scenes tessellated (SPD `-t RES`; 001's setting, `kimura-simd`,
+    // is RES 3), so every engine traces triangles only.
+    let mut tessellate: Option<u32> = None;
     // `--engines L1,L2`: only the engines whose label starts with one of these (bvh8 single,
     // which makes the shadow rays and the reference answers, is always built).
     let mut only: Option<Vec<String>> = None;
@@ -142,6 +146,13 @@ fn main() {
             "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).expect("--pairs P"),
             "--bench" => {}
             "--once" => once = true,
+            "--tessellate" => {
+                tessellate = Some(
+                    args.next()
+                        .and_then(|s| s.parse().ok())
+                        .expect("--tessellate RES"),
+                )
+            }
             "--engines" => {
                 let l = args.next().expect("--engines LABEL,LABEL");
                 only = Some(l.split(',').map(str::to_string).collect());
@@ -164,6 +175,7 @@ fn main() {
         if let Some(sf) = sf {
             opts.size_factor = sf;
         }
+        opts.tessellate = tessellate;
         let scene = Arc::new(generate_scene(program, &opts).expect("scene"));
         let geometry = Arc::new(Geometry::from_scene(&scene));
         let input = BuildInput {
@@ -192,9 +204,10 @@ fn main() {
         let shadow = shadow_rays(&scene, &eye, &eye_hits);
         let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
         println!(
-            "{} sf {}: {} eye rays ({} hit), {} shadow rays to {} lights one at a time; load {}",
+            "{} sf {}{}: {} eye rays ({} hit), {} shadow rays to {} lights one at a time; load {}",
             program.name(),
             opts.size_factor,
+            tessellate.map_or(String::new(), |t| format!(" tessellated {t}")),
             eye.len(),
             eye_hits.iter().filter(|h| h.is_hit()).count(),
             shadow.len(),

@@ -32,6 +32,22 @@ pub trait ChildTest<const N: usize> {
     /// Bit `i` set when child `i`'s box overlaps `[tmin, tmax]` along the ray; `dist[i]` is
     /// then its entry distance.
     fn test(node: &WideNode<N>, r: &Self::Ray, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32;
+    /// Whether [`Self::test_octant`] is worth a traversal loop per octant (the SIMD forms,
+    /// whose plane rows then become constants; issue 20, session 10).
+    const OCTANTS: bool = false;
+    /// [`Self::test`] for a ray whose direction is negative on the axes of the bits of `NEG`
+    /// (`slab_lanes`' sign bits): the same answer, with the near and far plane rows known at
+    /// compile time, so the loop keeps no row offsets (6 loads a node).
+    #[inline(always)]
+    fn test_octant<const NEG: u32>(
+        node: &WideNode<N>,
+        r: &Self::Ray,
+        tmin: f32,
+        tmax: f32,
+        dist: &mut [f32; N],
+    ) -> u32 {
+        Self::test(node, r, tmin, tmax, dist)
+    }
     /// Asks for the node-sized block of memory at `p` to be brought into the cache (a hint;
     /// nothing for the scalar form).
     #[inline(always)]
@@ -255,6 +271,8 @@ mod x86 {
             }
         }
 
+        const OCTANTS: bool = true;
+
         #[inline(always)]
         fn test(
             node: &WideNode<4>,
@@ -263,33 +281,60 @@ mod x86 {
             tmax: f32,
             dist: &mut [f32; 4],
         ) -> u32 {
-            let base = node.planes.as_ptr() as *const f32;
-            // SAFETY: SSE is part of the x86-64 baseline, and `FMA` is only set in the kernels
-            // reached through the feature-checked AVX2 + FMA entry points (`super::dispatch`). `planes` is 6
-            // rows of 4 contiguous floats (repr(C) arrays) and every offset is `row · 4` with
-            // `row < 6` (`plane_offsets`), so each unaligned load reads 4 floats inside the
-            // node; the store writes exactly the 4 floats of `dist`.
-            unsafe {
-                let plane = |off: usize, a: usize, org: &[__m128; 3]| {
-                    let p = _mm_loadu_ps(base.add(off));
-                    if FMA {
-                        _mm_fmsub_ps(p, r.rdir[a], org[a])
-                    } else {
-                        _mm_sub_ps(_mm_mul_ps(p, r.rdir[a]), org[a])
-                    }
-                };
-                let (on, of) = (&r.org_near, &r.org_far);
-                let t_near = _mm_max_ps(
-                    _mm_max_ps(plane(r.near[0], 0, on), plane(r.near[1], 1, on)),
-                    _mm_max_ps(plane(r.near[2], 2, on), _mm_set1_ps(tmin)),
-                );
-                let t_far = _mm_min_ps(
-                    _mm_min_ps(plane(r.far[0], 0, of), plane(r.far[1], 1, of)),
-                    _mm_min_ps(plane(r.far[2], 2, of), _mm_set1_ps(tmax)),
-                );
-                _mm_storeu_ps(dist.as_mut_ptr(), t_near);
-                _mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32
-            }
+            slab4::<FMA>(node, r, r.near, r.far, tmin, tmax, dist)
+        }
+
+        #[inline(always)]
+        fn test_octant<const NEG: u32>(
+            node: &WideNode<4>,
+            r: &SlabRayLanes<__m128>,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 4],
+        ) -> u32 {
+            let (near, far) = offsets_from_signs(NEG & 7, 4);
+            slab4::<FMA>(node, r, near, far, tmin, tmax, dist)
+        }
+    }
+
+    /// The SSE slab test with the near and far plane rows at `near`, `far` (offsets in floats,
+    /// each `row · 4` with `row < 6`: `offsets_from_signs`).
+    #[inline(always)]
+    fn slab4<const FMA: bool>(
+        node: &WideNode<4>,
+        r: &SlabRayLanes<__m128>,
+        near: [usize; 3],
+        far: [usize; 3],
+        tmin: f32,
+        tmax: f32,
+        dist: &mut [f32; 4],
+    ) -> u32 {
+        let base = node.planes.as_ptr() as *const f32;
+        // SAFETY: SSE is part of the x86-64 baseline, and `FMA` is only set in the kernels
+        // reached through the feature-checked AVX2 + FMA entry points (`super::dispatch`).
+        // `planes` is 6 rows of 4 contiguous floats (repr(C) arrays) and every offset is
+        // `row · 4` with `row < 6` (`offsets_from_signs`, `plane_offsets`), so each unaligned
+        // load reads 4 floats inside the node; the store writes exactly the 4 floats of `dist`.
+        unsafe {
+            let plane = |off: usize, a: usize, org: &[__m128; 3]| {
+                let p = _mm_loadu_ps(base.add(off));
+                if FMA {
+                    _mm_fmsub_ps(p, r.rdir[a], org[a])
+                } else {
+                    _mm_sub_ps(_mm_mul_ps(p, r.rdir[a]), org[a])
+                }
+            };
+            let (on, of) = (&r.org_near, &r.org_far);
+            let t_near = _mm_max_ps(
+                _mm_max_ps(plane(near[0], 0, on), plane(near[1], 1, on)),
+                _mm_max_ps(plane(near[2], 2, on), _mm_set1_ps(tmin)),
+            );
+            let t_far = _mm_min_ps(
+                _mm_min_ps(plane(far[0], 0, of), plane(far[1], 1, of)),
+                _mm_min_ps(plane(far[2], 2, of), _mm_set1_ps(tmax)),
+            );
+            _mm_storeu_ps(dist.as_mut_ptr(), t_near);
+            _mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32
         }
     }
 
@@ -357,6 +402,8 @@ mod x86 {
             }
         }
 
+        const OCTANTS: bool = true;
+
         #[inline(always)]
         fn test(
             node: &WideNode<8>,
@@ -365,28 +412,56 @@ mod x86 {
             tmax: f32,
             dist: &mut [f32; 8],
         ) -> u32 {
-            let base = node.planes.as_ptr() as *const f32;
-            // SAFETY: AVX2 and FMA are present (only reached through the feature-checked entry
-            // points of `avx2_entry!`). `planes` is 6 rows of 8 contiguous floats and every offset is
-            // `row · 8` with `row < 6` (`plane_offsets`), so each unaligned load reads 8 floats
-            // inside the node; the store writes exactly the 8 floats of `dist`.
-            unsafe {
-                // t = plane · rdir − org · rdir in one rounding (Embree's `madd` form).
-                let plane = |off: usize, a: usize, org: &[__m256; 3]| {
-                    _mm256_fmsub_ps(_mm256_loadu_ps(base.add(off)), r.rdir[a], org[a])
-                };
-                let (on, of) = (&r.org_near, &r.org_far);
-                let t_near = _mm256_max_ps(
-                    _mm256_max_ps(plane(r.near[0], 0, on), plane(r.near[1], 1, on)),
-                    _mm256_max_ps(plane(r.near[2], 2, on), _mm256_set1_ps(tmin)),
-                );
-                let t_far = _mm256_min_ps(
-                    _mm256_min_ps(plane(r.far[0], 0, of), plane(r.far[1], 1, of)),
-                    _mm256_min_ps(plane(r.far[2], 2, of), _mm256_set1_ps(tmax)),
-                );
-                _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
-                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32
-            }
+            slab8(node, r, r.near, r.far, tmin, tmax, dist)
+        }
+
+        #[inline(always)]
+        fn test_octant<const NEG: u32>(
+            node: &WideNode<8>,
+            r: &SlabRayLanes<__m256>,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 8],
+        ) -> u32 {
+            let (near, far) = offsets_from_signs(NEG & 7, 8);
+            slab8(node, r, near, far, tmin, tmax, dist)
+        }
+    }
+
+    /// The AVX2 slab test with the near and far plane rows at `near`, `far` (offsets in
+    /// floats, each `row · 8` with `row < 6`: `offsets_from_signs`).
+    #[inline(always)]
+    fn slab8(
+        node: &WideNode<8>,
+        r: &SlabRayLanes<__m256>,
+        near: [usize; 3],
+        far: [usize; 3],
+        tmin: f32,
+        tmax: f32,
+        dist: &mut [f32; 8],
+    ) -> u32 {
+        let base = node.planes.as_ptr() as *const f32;
+        // SAFETY: AVX2 and FMA are present (only reached through the feature-checked entry
+        // points of `avx2_entry!`). `planes` is 6 rows of 8 contiguous floats and every offset
+        // is `row · 8` with `row < 6` (`offsets_from_signs`, `plane_offsets`), so each
+        // unaligned load reads 8 floats inside the node; the store writes exactly the 8 floats
+        // of `dist`.
+        unsafe {
+            // t = plane · rdir − org · rdir in one rounding (Embree's `madd` form).
+            let plane = |off: usize, a: usize, org: &[__m256; 3]| {
+                _mm256_fmsub_ps(_mm256_loadu_ps(base.add(off)), r.rdir[a], org[a])
+            };
+            let (on, of) = (&r.org_near, &r.org_far);
+            let t_near = _mm256_max_ps(
+                _mm256_max_ps(plane(near[0], 0, on), plane(near[1], 1, on)),
+                _mm256_max_ps(plane(near[2], 2, on), _mm256_set1_ps(tmin)),
+            );
+            let t_far = _mm256_min_ps(
+                _mm256_min_ps(plane(far[0], 0, of), plane(far[1], 1, of)),
+                _mm256_min_ps(plane(far[2], 2, of), _mm256_set1_ps(tmax)),
+            );
+            _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32
         }
     }
 }

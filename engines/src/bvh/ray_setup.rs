@@ -17,12 +17,37 @@ use crate::ray::Ray;
 /// a finite `x` and NaN for ±∞ or NaN, so the sum of the six is 0 exactly when origin and
 /// direction are finite; `tmin` and `tmax` must only not be NaN (`tmax` may be +∞).
 #[inline(always)]
-#[allow(clippy::eq_op)] // `x - x` is the finiteness test, not a mistake.
 pub fn traceable(ray: &Ray) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        x86::traceable(ray)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        traceable_scalar(ray)
+    }
+}
+
+/// [`traceable`] one component at a time (targets without SSE).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x - x` is the finiteness test, not a mistake.
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+fn traceable_scalar(ray: &Ray) -> bool {
     let (o, d) = (ray.origin, ray.dir);
     let z = ((o.x - o.x) + (o.y - o.y)) + ((o.z - o.z) + (d.x - d.x)) + ((d.y - d.y) + (d.z - d.z));
     let ordered = (ray.tmin == ray.tmin) & (ray.tmax == ray.tmax);
     (z == 0.0) & ordered
+}
+
+/// The ray's octant: bit `a` set when the direction is negative on axis `a`, as the sign
+/// bits of `slab_lanes` (`1 / safe(d)` keeps the sign bit of `d`, −0 included) and
+/// `SlabRay::negative`.
+#[inline(always)]
+pub fn octant(ray: &Ray) -> u32 {
+    let d = ray.dir;
+    (d.x.is_sign_negative() as u32)
+        | (d.y.is_sign_negative() as u32) << 1
+        | (d.z.is_sign_negative() as u32) << 2
 }
 
 /// [`WatertightRay::new`] without the branches of the axis choice: `kz` is the axis of the
@@ -68,6 +93,25 @@ mod x86 {
     use crate::geometry::aabb::SlabRay;
     use crate::ray::Ray;
     use std::arch::x86_64::*;
+
+    /// [`super::traceable`] in two SSE2 registers (issue 20, session 10): the ray is
+    /// `repr(C)` (origin, tmin, dir, tmax), so lanes 0–2 of `x − x` summed over the two loads
+    /// are 0 exactly when origin and direction are finite; lane 3 (`tmin`, `tmax`) is masked
+    /// out of that sum and only tested for NaN (`cmpord`).
+    #[inline(always)]
+    pub fn traceable(ray: &Ray) -> bool {
+        // SAFETY: SSE2 is part of the x86-64 baseline. `Ray` is `repr(C)` (8 floats), so each
+        // unaligned load reads 4 floats inside the ray.
+        unsafe {
+            let p = ray as *const Ray as *const f32;
+            let lo = _mm_loadu_ps(p);
+            let hi = _mm_loadu_ps(p.add(4));
+            let xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+            let diff = _mm_add_ps(_mm_sub_ps(lo, lo), _mm_sub_ps(hi, hi));
+            let finite = _mm_cmpeq_ps(_mm_and_ps(diff, xyz), _mm_setzero_ps());
+            _mm_movemask_ps(_mm_and_ps(finite, _mm_cmpord_ps(lo, hi))) == 0xf
+        }
+    }
 
     /// [`SlabRay::new`] in SSE2 registers: (rdir, org·rdir + pad, org·rdir − pad) in lanes
     /// 0–2 (lane 3 is junk), and the signs of `rdir` as bits 0–2.
@@ -167,6 +211,7 @@ mod tests {
     fn traceable_as_is_traceable() {
         for r in rays() {
             assert_eq!(traceable(&r), r.is_traceable(), "{r:?}");
+            assert_eq!(traceable_scalar(&r), r.is_traceable(), "{r:?}");
         }
     }
 
@@ -200,6 +245,7 @@ mod tests {
                 assert_eq!(lanes(far), bits(want.org_rdir_far), "{r:?}");
                 let n = want.negative;
                 assert_eq!(neg, n[0] as u32 | (n[1] as u32) << 1 | (n[2] as u32) << 2);
+                assert_eq!(octant(r), neg, "{r:?}");
             }
         }
     }

@@ -76,6 +76,14 @@ struct Entry {
     dist: f32,
 }
 
+/// The packet tests' output lanes: written by a test before they are read, so made once a
+/// batch (setting them for every ray cost 8 stores a ray; issue 20, session 10).
+#[derive(Default)]
+struct Lanes {
+    one: LaneHits<4>,
+    pair: LaneHits<8>,
+}
+
 /// Counts kept in registers during a batch and added to `Counters` once.
 #[derive(Default)]
 struct Tally {
@@ -95,20 +103,22 @@ impl Tally {
     }
 }
 
-/// The per-ray set-up of the triangle test, made only for the watertight one.
+/// The per-ray set-up of the triangle test (the packet kernel's lanes, and the watertight
+/// set-up for scalar primitives), made only for the watertight test.
 #[inline(always)]
-fn triangle_setup<const W: bool>(dir: glam::Vec3) -> WatertightRay {
+fn triangle_setup<P: PairKernel, const W: bool>(ray: &Ray) -> (P::Ray, WatertightRay) {
     if W {
-        ray_setup::watertight(dir)
+        P::prepare_watertight(ray, ray_setup::watertight)
     } else {
-        WatertightRay {
+        let wt = WatertightRay {
             kx: 0,
             ky: 1,
             kz: 2,
             sx: 0.0,
             sy: 0.0,
             sz: 0.0,
-        }
+        };
+        (P::prepare(ray.origin, ray.dir, &wt), wt)
     }
 }
 
@@ -131,6 +141,16 @@ fn pair_hits(lanes: &LaneHits<8>, mask: u32) -> u64 {
     (a.count_ones() + b.count_ones()) as u64
 }
 
+/// One exchange of a sorting network over pending entries, `lower` below `upper` on the
+/// stack: swapped only when `lower` is strictly nearer, so entries of equal distance keep
+/// their order and a network of adjacent exchanges sorts stably, as the insertion sort does.
+#[inline(always)]
+fn order(lower: &mut Entry, upper: &mut Entry) {
+    if lower.dist < upper.dist {
+        std::mem::swap(lower, upper);
+    }
+}
+
 #[inline(always)]
 fn triangle_test<const W: bool>() -> TriangleTest {
     if W {
@@ -138,6 +158,43 @@ fn triangle_test<const W: bool>() -> TriangleTest {
     } else {
         TriangleTest::Moller
     }
+}
+
+/// `OCT` of a traversal whose box test takes the plane rows from the ray at run time.
+const ANY_OCTANT: u32 = 8;
+
+/// The ray's node test: with the plane rows of octant `OCT` as constants, or
+/// ([`ANY_OCTANT`]) from the ray.
+#[inline(always)]
+fn node_test<const N: usize, T: ChildTest<N>, const OCT: u32>(
+    node: &WideNode<N>,
+    tr: &T::Ray,
+    tmin: f32,
+    tmax: f32,
+    dist: &mut [f32; N],
+) -> u32 {
+    if OCT < ANY_OCTANT {
+        T::test_octant::<OCT>(node, tr, tmin, tmax, dist)
+    } else {
+        T::test(node, tr, tmin, tmax, dist)
+    }
+}
+
+/// `f::<generics…, OCT>(args…)` with `OCT` the octant `oct` (0–7) as a constant: one loop
+/// per octant (issue 20, session 10), as the SIMD box tests want ([`ChildTest::OCTANTS`]).
+macro_rules! by_octant {
+    ($oct:expr, $f:ident::<$($g:tt),*>($($arg:expr),*)) => {
+        match $oct {
+            0 => $f::<$($g),*, 0>($($arg),*),
+            1 => $f::<$($g),*, 1>($($arg),*),
+            2 => $f::<$($g),*, 2>($($arg),*),
+            3 => $f::<$($g),*, 3>($($arg),*),
+            4 => $f::<$($g),*, 4>($($arg),*),
+            5 => $f::<$($g),*, 5>($($arg),*),
+            6 => $f::<$($g),*, 6>($($arg),*),
+            _ => $f::<$($g),*, 7>($($arg),*),
+        }
+    };
 }
 
 /// Closest hits of a batch of rays.
@@ -151,10 +208,16 @@ pub fn closest_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
 ) {
     let mut stack = [Entry::default(); STACK_SIZE];
     let mut tally = Tally::default();
+    let mut lanes = Lanes::default();
     for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+        let (s, l, t) = (&mut stack, &mut lanes, &mut tally);
         *hit = match test {
-            TriangleTest::Watertight => closest::<N, T, P, true>(bvh, ray, &mut stack, &mut tally),
-            TriangleTest::Moller => closest::<N, T, P, false>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Watertight if T::OCTANTS => by_octant!(
+                ray_setup::octant(ray),
+                closest::<N, T, P, true>(bvh, ray, s, l, t)
+            ),
+            TriangleTest::Watertight => closest::<N, T, P, true, ANY_OCTANT>(bvh, ray, s, l, t),
+            TriangleTest::Moller => closest::<N, T, P, false, ANY_OCTANT>(bvh, ray, s, l, t),
         };
     }
     tally.add_to(counters, rays.len());
@@ -171,31 +234,41 @@ pub fn any_batch<const N: usize, T: ChildTest<N>, P: PairKernel>(
 ) {
     let mut stack = [0u32; STACK_SIZE];
     let mut tally = Tally::default();
+    let mut lanes = Lanes::default();
     for (ray, o) in rays.iter().zip(out.iter_mut()) {
+        let (s, l, t) = (&mut stack, &mut lanes, &mut tally);
         *o = match test {
-            TriangleTest::Watertight => any::<N, T, P, true>(bvh, ray, &mut stack, &mut tally),
-            TriangleTest::Moller => any::<N, T, P, false>(bvh, ray, &mut stack, &mut tally),
+            TriangleTest::Watertight if T::OCTANTS => {
+                by_octant!(
+                    ray_setup::octant(ray),
+                    any::<N, T, P, true>(bvh, ray, s, l, t)
+                )
+            }
+            TriangleTest::Watertight => any::<N, T, P, true, ANY_OCTANT>(bvh, ray, s, l, t),
+            TriangleTest::Moller => any::<N, T, P, false, ANY_OCTANT>(bvh, ray, s, l, t),
         };
     }
     tally.add_to(counters, rays.len());
 }
 
 #[inline(always)]
-fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
+fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT: u32>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [Entry; STACK_SIZE],
+    lanes: &mut Lanes,
     tally: &mut Tally,
 ) -> Hit {
     if !ray_setup::traceable(ray) {
         return Hit::MISS;
     }
     let tr = T::prepare_ray(ray, bvh.extent);
-    let wt = triangle_setup::<W>(ray.dir);
-    let pr = P::prepare(ray.origin, ray.dir, &wt);
-    let mut lanes = LaneHits::default();
-    let mut pair_lanes = LaneHits::default();
-    let mut r = *ray;
+    let (pr, wt) = triangle_setup::<P, W>(ray);
+    let Lanes {
+        one: lanes,
+        pair: pair_lanes,
+    } = lanes;
+    let (tmin, mut tmax) = (ray.tmin, ray.tmax);
     let mut best = Hit::MISS;
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
@@ -205,7 +278,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let node = &bvh.nodes[cur as usize];
             tally.nodes += 1;
             tally.boxes += node.len as u64;
-            let mut mask = T::test(node, &tr, r.tmin, r.tmax, &mut dist);
+            let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -228,24 +301,58 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
                     cur = node.child[near];
                     continue;
                 }
-                // Three or more: push all, then insertion-sort the new entries farthest first.
-                let base = sp;
-                for k in [i, j] {
+                // Three or more: sorted farthest first (bottom) to nearest (top), equal
+                // distances in child order (a stable sort of the children in slot order).
+                let entry = |k: usize| {
                     T::prefetch(child_addr(bvh, node.child[k]));
-                    stack[sp] = Entry {
+                    Entry {
                         node: node.child[k],
                         dist: dist[k],
-                    };
+                    }
+                };
+                let k = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let (mut a, mut b, mut c) = (entry(i), entry(j), entry(k));
+                if mask == 0 {
+                    // Three: sorted in registers by adjacent exchanges (Embree's `sort` of
+                    // three stack items; issue 20, session 10).
+                    order(&mut a, &mut b);
+                    order(&mut b, &mut c);
+                    order(&mut a, &mut b);
+                    stack[sp] = a;
+                    stack[sp + 1] = b;
+                    sp += 2;
+                    cur = c.node;
+                    continue;
+                }
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let mut d = entry(l);
+                if mask == 0 {
+                    // Four: odd-even transposition (four rounds of adjacent exchanges).
+                    order(&mut a, &mut b);
+                    order(&mut c, &mut d);
+                    order(&mut b, &mut c);
+                    order(&mut a, &mut b);
+                    order(&mut c, &mut d);
+                    order(&mut b, &mut c);
+                    stack[sp] = a;
+                    stack[sp + 1] = b;
+                    stack[sp + 2] = c;
+                    sp += 3;
+                    cur = d.node;
+                    continue;
+                }
+                // Five or more: push all, then insertion-sort the new entries.
+                let base = sp;
+                for e in [a, b, c, d] {
+                    stack[sp] = e;
                     sp += 1;
                 }
                 while mask != 0 {
                     let k = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    T::prefetch(child_addr(bvh, node.child[k]));
-                    stack[sp] = Entry {
-                        node: node.child[k],
-                        dist: dist[k],
-                    };
+                    stack[sp] = entry(k);
                     sp += 1;
                 }
                 for a in base + 1..sp {
@@ -272,11 +379,11 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let mut pairs = packets.chunks_exact(2);
             for pair in &mut pairs {
                 let (a, b) = (&pair[0], &pair[1]);
-                let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, r.tmin, r.tmax, &mut pair_lanes);
+                let mask = P::test_pair::<W>(&a.tri, &b.tri, &pr, tmin, tmax, pair_lanes);
                 if mask != 0 {
                     let i = pair_lanes.nearest(mask);
-                    tally.prim_hits += pair_hits(&pair_lanes, mask);
-                    r.tmax = pair_lanes.t[i];
+                    tally.prim_hits += pair_hits(pair_lanes, mask);
+                    tmax = pair_lanes.t[i];
                     best = Hit {
                         t: pair_lanes.t[i],
                         object: pair[i / PACKET].object[i % PACKET],
@@ -286,11 +393,11 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
                 }
             }
             for p in pairs.remainder() {
-                let mask = P::test::<W>(&p.tri, &pr, r.tmin, r.tmax, &mut lanes);
+                let mask = P::test::<W>(&p.tri, &pr, tmin, tmax, lanes);
                 if mask != 0 {
                     tally.prim_hits += mask.count_ones() as u64;
                     let i = lanes.nearest(mask);
-                    r.tmax = lanes.t[i];
+                    tmax = lanes.t[i];
                     best = Hit {
                         t: lanes.t[i],
                         object: p.object[i],
@@ -303,9 +410,10 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let (first, count) = leaf_range(cur);
             for k in first..first + count {
                 tally.prims += 1;
+                let r = Ray { tmax, ..*ray };
                 if let Some((t, u, v)) = bvh.prims[k].intersect(&r, triangle_test::<W>(), &wt) {
                     tally.prim_hits += 1;
-                    r.tmax = t;
+                    tmax = t;
                     best = Hit {
                         t,
                         object: bvh.objects[k],
@@ -322,7 +430,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             }
             sp -= 1;
             let e = stack[sp];
-            if e.dist <= r.tmax {
+            if e.dist <= tmax {
                 cur = e.node;
                 break;
             }
@@ -331,20 +439,23 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
 }
 
 #[inline(always)]
-fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
+fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT: u32>(
     bvh: &Bvh<N>,
     ray: &Ray,
     stack: &mut [u32; STACK_SIZE],
+    lanes: &mut Lanes,
     tally: &mut Tally,
 ) -> bool {
     if !ray_setup::traceable(ray) {
         return false;
     }
     let tr = T::prepare_ray(ray, bvh.extent);
-    let wt = triangle_setup::<W>(ray.dir);
-    let pr = P::prepare(ray.origin, ray.dir, &wt);
-    let mut lanes = LaneHits::default();
-    let mut pair_lanes = LaneHits::default();
+    let (pr, wt) = triangle_setup::<P, W>(ray);
+    let Lanes {
+        one: lanes,
+        pair: pair_lanes,
+    } = lanes;
+    let (tmin, tmax) = (ray.tmin, ray.tmax);
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
@@ -353,7 +464,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let node = &bvh.nodes[cur as usize];
             tally.nodes += 1;
             tally.boxes += node.len as u64;
-            let mut mask = T::test(node, &tr, ray.tmin, ray.tmax, &mut dist);
+            let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -373,7 +484,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             let mut pairs = packets.chunks_exact(2);
             for (n, pair) in (&mut pairs).enumerate() {
                 let (a, b) = (&pair[0].tri, &pair[1].tri);
-                let mask = P::test_pair::<W>(a, b, &pr, ray.tmin, ray.tmax, &mut pair_lanes);
+                let mask = P::test_pair::<W>(a, b, &pr, tmin, tmax, pair_lanes);
                 if mask != 0 {
                     // The leaf stops at the first packet with a hit: its triangles and those
                     // before it.
@@ -389,7 +500,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool>(
             }
             let done = packets.len() - pairs.remainder().len();
             for (n, p) in pairs.remainder().iter().enumerate() {
-                let mask = P::test::<W>(&p.tri, &pr, ray.tmin, ray.tmax, &mut lanes);
+                let mask = P::test::<W>(&p.tri, &pr, tmin, tmax, lanes);
                 if mask != 0 {
                     // The leaf stops at this packet: its triangles and those before it.
                     tally.prims += count.min((done + n + 1) * PACKET) as u64;

@@ -23,6 +23,7 @@ use super::kernels::f32::{self as k, WatertightRay};
 use super::lanes::Sse4;
 use super::lanes::{Avx8, Scalar};
 use crate::geometry::TriangleTest;
+use crate::ray::Ray;
 use glam::Vec3;
 
 /// K triangles, structure-of-arrays: `v[i][a][lane]` is coordinate `a` (x, y, z) of vertex `i`
@@ -102,6 +103,18 @@ pub trait PacketKernel<const K: usize> {
     /// once per ray. `wt` is the ray's watertight set-up (any value for Möller).
     type Ray: Copy;
     fn prepare(origin: Vec3, dir: Vec3, wt: &WatertightRay) -> Self::Ray;
+    /// [`Self::prepare`] of the ray with its watertight set-up, and that set-up (for scalar
+    /// primitives), from the ray as it lies in memory. `setup` makes the set-up the scalar way
+    /// (what the default does); the AVX2 form makes both in SSE lanes instead, bit for bit the
+    /// same values (issue 20, session 10: ~70 instructions a ray through the stack before).
+    #[inline(always)]
+    fn prepare_watertight(
+        ray: &Ray,
+        setup: impl FnOnce(Vec3) -> WatertightRay,
+    ) -> (Self::Ray, WatertightRay) {
+        let wt = setup(ray.dir);
+        (Self::prepare(ray.origin, ray.dir, &wt), wt)
+    }
     /// Bit `lane` set when that triangle is hit in `(tmin, tmax)`; `hits` then holds its
     /// `(t, u, v)`. `W`: the watertight test, else Möller–Trumbore.
     fn test<const W: bool>(
@@ -268,6 +281,7 @@ mod x86 {
     use crate::geometry::kernels::f32::WatertightRay;
     use crate::geometry::lanes::{Avx8, Sse4};
     use crate::geometry::TriangleTest;
+    use crate::ray::Ray;
     use glam::Vec3;
     use std::arch::x86_64::*;
 
@@ -494,6 +508,110 @@ mod x86 {
         }
     }
 
+    /// The row of [`AXES`] and [`PERM`], `2 kz + (d[kz] < 0)`, by a key of six bits: bits
+    /// 0–2 (a.x > a.y, a.y > a.z, a.z ≥ a.x) of the direction's magnitudes `a`, bits 3–5 the
+    /// signs `d < 0`. `kz` is `WatertightRay::new`'s choice: `a.x > a.y ? (a.x > a.z ? 0 : 2)
+    /// : (a.y > a.z ? 1 : 2)`, with `a.x > a.z` the negation of bit 2.
+    const ROW: [u8; 64] = {
+        let mut t = [0u8; 64];
+        let mut key = 0;
+        while key < 64 {
+            let (x_y, y_z, x_z) = (key & 1 != 0, key & 2 != 0, key & 4 == 0);
+            let kz = if x_y {
+                if x_z {
+                    0
+                } else {
+                    2
+                }
+            } else if y_z {
+                1
+            } else {
+                2
+            };
+            t[key] = (2 * kz + ((key >> (3 + kz)) & 1)) as u8;
+            key += 1;
+        }
+        t
+    };
+    /// (kx, ky) by `2 kz + (d[kz] < 0)` (swapped when negative), as `WatertightRay::new`;
+    /// rows 6 and 7 only pad the table to a power of two. Every entry is < 3.
+    const AXES: [[usize; 2]; 8] = [
+        [1, 2],
+        [2, 1],
+        [2, 0],
+        [0, 2],
+        [0, 1],
+        [1, 0],
+        [0, 1],
+        [0, 1],
+    ];
+    /// The lanes (kx, ky, kz, kz) of the same rows, for `vpermilps`.
+    const PERM: [[i32; 4]; 8] = [
+        [1, 2, 0, 0],
+        [2, 1, 0, 0],
+        [2, 0, 1, 1],
+        [0, 2, 1, 1],
+        [0, 1, 2, 2],
+        [1, 0, 2, 2],
+        [0, 1, 2, 2],
+        [0, 1, 2, 2],
+    ];
+
+    /// `WatertightRay::new(dir)` and the ray's lanes (`prepare`) in SSE registers (issue 20,
+    /// session 10): the axis choice from two comparisons of the magnitudes, the direction and
+    /// origin put on the set-up's axes by one `vpermilps` each, and `(d[kx], d[ky], 1) / d[kz]`
+    /// as one division. Each lane runs the scalar code's IEEE operation (a division stays a
+    /// division), so the values are the same bits (test `watertight_lanes_as_the_kernels`).
+    ///
+    /// Safety: AVX (and so SSE4.1) present.
+    #[inline(always)]
+    unsafe fn watertight_lanes(ray: &Ray) -> (TriangleRayLanes<__m256>, WatertightRay) {
+        // `Ray` is `repr(C)` (origin, tmin, dir, tmax): each load reads 4 floats of the ray.
+        let p = ray as *const Ray as *const f32;
+        let o = _mm_loadu_ps(p);
+        let d = _mm_loadu_ps(p.add(4));
+        let a = _mm_andnot_ps(_mm_set1_ps(-0.0), d);
+        // a against (a.y, a.z, a.x): lanes 0, 1 by `>`, lane 2 by `≥` (the key of `ROW`).
+        let next = _mm_shuffle_ps::<0b00_00_10_01>(a, a);
+        let axes = _mm_blend_ps::<0b0100>(_mm_cmpgt_ps(a, next), _mm_cmpge_ps(a, next));
+        let neg = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) & 7;
+        let key = (_mm_movemask_ps(axes) & 7) | (neg << 3);
+        let row = ROW[key as usize] as usize & 7;
+        let kz = row >> 1;
+        let [kx, ky] = AXES[row];
+        let perm = _mm_loadu_si128(PERM[row].as_ptr() as *const __m128i);
+        let dk = _mm_permutevar_ps(d, perm);
+        let ok = _mm_permutevar_ps(o, perm);
+        // (d[kx], d[ky], 1, d[kz]) / d[kz]: sx, sy, sz.
+        let s = _mm_div_ps(
+            _mm_blend_ps::<0b0100>(dk, _mm_set1_ps(1.0)),
+            _mm_permute_ps::<0b10_10_10_10>(dk),
+        );
+        let wt = WatertightRay {
+            kx,
+            ky,
+            kz,
+            sx: _mm_cvtss_f32(s),
+            sy: _mm_cvtss_f32(_mm_movehdup_ps(s)),
+            sz: _mm_cvtss_f32(_mm_movehl_ps(s, s)),
+        };
+        let splat = |v: __m128| {
+            [
+                _mm256_broadcastss_ps(v),
+                _mm256_broadcastss_ps(_mm_movehdup_ps(v)),
+                _mm256_broadcastss_ps(_mm_movehl_ps(v, v)),
+            ]
+        };
+        let lanes = TriangleRayLanes {
+            o: splat(o),
+            d: splat(d),
+            s: splat(s),
+            ok: splat(ok),
+            k: [kx, ky, kz],
+        };
+        (lanes, wt)
+    }
+
     /// Row `a` (an axis, < 3) of vertex `i` (< 3) of a packet of `L::K` lanes.
     ///
     /// Safety: `i < 3`, `a < 3`, `K == L::K`, and the lanes' instruction set present.
@@ -692,6 +810,16 @@ mod x86 {
         }
 
         #[inline(always)]
+        fn prepare_watertight(
+            ray: &Ray,
+            _: impl FnOnce(Vec3) -> WatertightRay,
+        ) -> (Self::Ray, WatertightRay) {
+            // SAFETY: only reached from code run after `Avx8::available()` (this form's
+            // contract), all `watertight_lanes` needs.
+            unsafe { watertight_lanes(ray) }
+        }
+
+        #[inline(always)]
         fn test<const W: bool>(
             p: &TrianglePacket<4>,
             r: &Self::Ray,
@@ -772,6 +900,16 @@ mod x86 {
         }
 
         #[inline(always)]
+        fn prepare_watertight(
+            ray: &Ray,
+            _: impl FnOnce(Vec3) -> WatertightRay,
+        ) -> (Self::Ray, WatertightRay) {
+            // SAFETY: only reached from code run after `Avx8::available()` (this form's
+            // contract), all `watertight_lanes` needs.
+            unsafe { watertight_lanes(ray) }
+        }
+
+        #[inline(always)]
         fn test<const W: bool>(
             p: &TrianglePacket<8>,
             r: &Self::Ray,
@@ -807,6 +945,74 @@ mod x86 {
         tmax: f32,
     ) -> Option<(usize, f32, f32, f32)> {
         super::closest_with::<8, Avx8>(p, origin, dir, test, tmin, tmax)
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+
+        /// The AVX2 form's set-up in lanes gives the bits of `WatertightRay::new` and of
+        /// `prepare` from it, on random directions and every combination of ±0, ±1e-20, ±0.5,
+        /// ±1 components (ties of the axis choice, zero and negative-zero signs).
+        #[test]
+        fn watertight_lanes_as_the_kernels() {
+            if !Avx8::available() {
+                return;
+            }
+            let specials = [0.0, -0.0, 1e-20, -1e-20, 0.5, -0.5, 1.0, -1.0];
+            let mut dirs = Vec::new();
+            for &x in &specials {
+                for &y in &specials {
+                    for &z in &specials {
+                        dirs.push(Vec3::new(x, y, z));
+                    }
+                }
+            }
+            let mut s = 99u64;
+            for _ in 0..2000 {
+                let mut c = [0.0f32; 3];
+                for x in &mut c {
+                    s = s
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    *x = (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0;
+                }
+                dirs.push(Vec3::from_array(c));
+            }
+            let bits = |v: &[__m256; 3]| {
+                v.map(|x| {
+                    let mut a = [0.0f32; 8];
+                    // SAFETY: AVX present (checked above); stores 8 floats into `a`.
+                    unsafe { _mm256_storeu_ps(a.as_mut_ptr(), x) };
+                    a.map(f32::to_bits)
+                })
+            };
+            for (i, d) in dirs.into_iter().enumerate() {
+                let o = Vec3::new(1.5, -2.25, 3.0 + i as f32);
+                let ray = Ray::new(o, d, 0.0, f32::INFINITY);
+                let want = WatertightRay::new(d);
+                // SAFETY: AVX2 present (checked above).
+                let (lanes, wt) = unsafe { watertight_lanes(&ray) };
+                let want_lanes: TriangleRayLanes<__m256> =
+                    <Avx8 as PacketKernel<8>>::prepare(o, d, &want);
+                let w = |w: &WatertightRay| {
+                    (
+                        [w.kx, w.ky, w.kz],
+                        [w.sx.to_bits(), w.sy.to_bits(), w.sz.to_bits()],
+                    )
+                };
+                assert_eq!(w(&wt), w(&want), "{d:?}");
+                assert_eq!(lanes.k, want_lanes.k, "{d:?}");
+                for (a, b) in [
+                    (&lanes.s, &want_lanes.s),
+                    (&lanes.ok, &want_lanes.ok),
+                    (&lanes.o, &want_lanes.o),
+                    (&lanes.d, &want_lanes.d),
+                ] {
+                    assert_eq!(bits(a), bits(b), "{d:?}");
+                }
+            }
+        }
     }
 }
 
