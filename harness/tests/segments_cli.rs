@@ -7,6 +7,7 @@ mod common;
 
 use common::{expect_input_error, json, render_breadth_first, rtbench, Dir};
 use serde_json::Value;
+use sha2::Digest;
 use std::path::Path;
 
 const VIEW: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/views/rings368m.json");
@@ -213,4 +214,14 @@ fn nakamaru_4_3_runs_a_scenes_basic_rows_before_its_split_store() {
         passes,
         "{err}"
     );
+    // Each row's S+G+B image, kept across invocations in the checkpoint and written beside the
+    // report: the pixels whose sha256 the row states.
+    for (i, row) in ["rings2", "rings2m"].iter().enumerate() {
+        let png = Path::new(&out).join(format!("images/nakamaru-4.3-{row}.png"));
+        let img = image::open(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
+        assert_eq!((img.width(), img.height()), (16, 16));
+        let sha = sha2::Sha256::digest(img.to_rgb8().as_raw());
+        let hex: String = sha.iter().map(|b| format!("{b:02x}")).collect();
+        assert_eq!(m[i]["sgb"]["sha256"].as_str().unwrap(), hex, "{row}");
+    }
 }

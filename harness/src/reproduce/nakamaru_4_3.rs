@@ -303,12 +303,15 @@ fn write_store(
     }
 }
 
+/// One method's run on the store at `dir`; a whole image (not capped, no tile) is also written
+/// to `image` when given, so that a row's picture outlives the process that traced it.
 fn trace(
     dir: &Path,
     s: &Setup,
     view: Option<&View>,
     tile: Option<ShardSpec>,
     extra: &[(&str, &str)],
+    image: Option<&Path>,
 ) -> Result<Run> {
     workload::reset_peak_rss();
     let load_average = super::grid_runs::load_average();
@@ -338,6 +341,12 @@ fn trace(
     };
     // A run the pass cap stopped has no image and no scale until S+G's passes are known.
     let capped = crate::commands::render::pass_capped(&r.counters);
+    if let (Some(path), false, None) = (image, capped, tile) {
+        if let Some(d) = path.parent() {
+            std::fs::create_dir_all(d).map_err(|e| input(format!("{}: {e}", d.display())))?;
+        }
+        crate::output::write_png(path, r.pixels(), s.size)?;
+    }
     Ok(Run {
         preprocess_s,
         trace_s: r.trace_s,
@@ -387,6 +396,11 @@ fn store_dir(m: &Measured, s: &Setup, kind: &str) -> PathBuf {
     s.stores.join(format!("{}{}-{kind}", m.scene, m.sf))
 }
 
+/// Where a row's S+G+B image is kept between invocations (`.partial/nakamaru-4.3/images/`).
+fn image_path(ctx: &Ctx, m: &Measured) -> PathBuf {
+    ctx.checkpoint.dir().join("images").join(format!("{}.png", m.row))
+}
+
 /// The basic method's steps of one row: its store (gzip, in segments) and its run (whole, a
 /// tile set or the first N passes). Returns whether they are done. The store is removed after
 /// the last row that needs it (`keep_basic` false), before any split store of the scene is
@@ -424,18 +438,18 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
     if ctx.quick {
         // The model's test: the part beside the whole.
         m.basic_tile = Some(match &capped_sets {
-            Some(sets) => trace(&dir, s, view, None, sets)?,
-            None => trace(&dir, s, view, Some(ShardSpec { k: 1, n: 4 }), &basic_sets)?,
+            Some(sets) => trace(&dir, s, view, None, sets, None)?,
+            None => trace(&dir, s, view, Some(ShardSpec { k: 1, n: 4 }), &basic_sets, None)?,
         });
-        m.basic = Some(trace(&dir, s, view, None, &basic_sets)?);
+        m.basic = Some(trace(&dir, s, view, None, &basic_sets, None)?);
     } else if let Some(sets) = &capped_sets {
-        m.basic = Some(trace(&dir, s, view, None, sets)?);
+        m.basic = Some(trace(&dir, s, view, None, sets, None)?);
     } else {
         let tile = (s.fraction > 1).then_some(ShardSpec {
             k: 1,
             n: s.fraction,
         });
-        m.basic = Some(trace(&dir, s, view, tile, &basic_sets)?);
+        m.basic = Some(trace(&dir, s, view, tile, &basic_sets, None)?);
     }
     save(m)?;
     if !keep_basic {
@@ -478,7 +492,9 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
             save(m)?;
         }
         eprintln!("nakamaru-4.3: {}: {name} …", m.row);
-        let r = trace(&dir, s, view, None, sets)?;
+        // The row's image (docs/images): S+G+B's, the same as S+G's when the images agree.
+        let png = image_path(ctx, m);
+        let r = trace(&dir, s, view, None, sets, (name == "S+G+B").then_some(png.as_path()))?;
         if name == "S+G" {
             // The pass model's total: S+G's passes (the same grid, rays and memory budget).
             for b in [m.basic.as_mut(), m.basic_tile.as_mut()].into_iter().flatten() {
@@ -645,6 +661,21 @@ fn run(ctx: &Ctx) -> Result<Output> {
     rows.extend(growth_rows(&points, size));
     let mut doc = document(&p, &measured, &s, ctx.quick, finished);
     per_ray::table(&mut doc, &points, size);
+    let mut images = Vec::new();
+    for m in &measured {
+        let png = image_path(ctx, m);
+        if m.sgb.is_none() || !png.exists() {
+            continue;
+        }
+        let img = image::open(&png)
+            .map_err(|e| input(format!("{}: {e}", png.display())))?
+            .to_rgb8();
+        images.push(super::Image {
+            path: format!("images/{}-{}.png", ctx.id, m.row),
+            size: img.width(),
+            pixels: img.into_raw(),
+        });
+    }
     let mut out = Output::new(
         Result_ {
             id: ctx.id,
@@ -660,6 +691,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         doc,
     );
     out.charts = per_ray::charts(ctx.id, &points, size);
+    out.images = images;
     Ok(out)
 }
 
