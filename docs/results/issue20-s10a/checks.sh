@@ -1,7 +1,7 @@
 #!/bin/bash
 # checks.sh BIN OUT: rtbench check summary, 4 scenes x bvh4/bvh8, 256², one thread
 BIN=$1; OUT=$2; : > $OUT
-cd /work/wt/s10-20a
+cd "$(git rev-parse --show-toplevel)"
 for S in gears tetra balls teapot; do for E in bvh4 bvh8; do
   taskset -c 1 $BIN check --scene $S --engine $E --threads 1 --size 256 --json 2>/dev/null | python3 -c "
 import json,sys; j=json.load(sys.stdin)
