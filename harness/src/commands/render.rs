@@ -5,7 +5,7 @@ use crate::error::{input, Result};
 use crate::output::{print_json, write_png};
 use crate::runs::shard::{Manifest, ShardSpec};
 use crate::source::Source;
-use crate::workload::{self, trace};
+use crate::workload::{self, memory, trace};
 use serde_json::json;
 use sha2::{Digest, Sha256};
 
@@ -26,11 +26,26 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     workload::check_scene_fits(&src, a.scene.opts.force)?;
     let pool = workload::pool(a.threads)?;
+    memory::phase("start");
     let prepared = workload::prepare(&src)?;
+    memory::phase("scene");
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
+    memory::phase("build");
+    // What the output reports of the geometry, read before it is let go: the trace shades from
+    // the scene (materials, lights, view) and asks the engine; engines that answer from the
+    // prepared primitives keep their own reference to them.
+    let (generate_s, prepare_s) = (prepared.generate_s, prepared.prepare_s);
+    let (primitives, geometry_bytes) = (
+        prepared.input.geometry.prims.len(),
+        prepared.input.geometry.bytes(),
+    );
+    let scene = prepared.input.scene;
+    drop(prepared.input.geometry);
+    memory::release_free_heap();
+    memory::phase("release");
     let r = pool.install(|| {
         trace::render_chunked(
-            &prepared.input.scene,
+            &scene,
             engine.as_ref(),
             a.size,
             a.chunk,
@@ -38,6 +53,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             None,
         )
     });
+    memory::phase("trace");
     if let Some(f) = engine.failure() {
         return Err(input(f));
     }
@@ -50,8 +66,6 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     } else if let Some(png) = &a.png {
         write_png(png, pixels, a.size)?;
     }
-    let scene = &prepared.input.scene;
-    let g = &prepared.input.geometry;
     let v = json!({
         "engine": a.engine,
         "scene": {
@@ -59,21 +73,21 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "program": src.program().map(|p| p.name()),
             "sf": src.size_factor(),
             "objects": scene.objects.len(),
-            "primitives": g.prims.len(),
+            "primitives": primitives,
             "lights": scene.lights.len(),
         },
         "threads": pool.current_num_threads(),
         "chunk": a.chunk,
         "rays": r.stats,
         "time_s": {
-            "generate": prepared.generate_s,
-            "preprocess": prepared.prepare_s + build_s,
+            "generate": generate_s,
+            "preprocess": prepare_s + build_s,
             "build": build_s,
             "trace": r.trace_s,
             "intersect": r.intersect_s,
             "shade": r.shade_s,
         },
-        "memory": {"structure_bytes": engine.structure_bytes(), "geometry_bytes": g.bytes(), "peak_rss_bytes": workload::peak_rss_bytes()},
+        "memory": {"structure_bytes": engine.structure_bytes(), "geometry_bytes": geometry_bytes, "peak_rss_bytes": workload::peak_rss_bytes()},
         "counters": r.counters,
         "build_stats": engine.build_stats(),
         "image": {"width": a.size, "height": a.size, "sha256": sha, "incomplete": capped},

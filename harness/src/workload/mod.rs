@@ -3,6 +3,7 @@
 pub mod camera;
 pub mod crosscheck;
 pub mod frustum;
+pub mod memory;
 pub mod out_of_core;
 pub mod paging;
 pub mod pass_003;
