@@ -50,4 +50,7 @@ fn main() {
     println!("cargo:rustc-link-search=native={dir}");
     println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
     println!("cargo:lib_dir={dir}");
+    // The file `embree::api` opens at run time (the engine calls Embree through pointers it
+    // looks up there, so the binaries no longer need the library to start).
+    println!("cargo:rustc-env=RTBENCH_EMBREE_LIB={dir}/libembree4.so");
 }

@@ -1,13 +1,13 @@
 //! The built `embree` engine: set-up with a few raw calls, tracing with raw `rtcIntersect1` /
 //! `rtcOccluded1` (no error check per ray).
 
+use super::api as sys;
 use super::config::{Api, EmbreeConfig, Quality};
 use super::raw::{self, Device, Geometry, RayHit, Scene};
 use super::user::{self, UserPrims};
 use crate::engine::{BuildInput, Counters, Engine, EngineError};
 use crate::geometry::Prim;
 use crate::ray::{Hit, Ray};
-use embree4_sys as sys;
 use std::collections::BTreeMap;
 use std::ffi::c_void;
 use std::ptr::null_mut;

@@ -36,6 +36,8 @@
 
 use crate::engine::{BuildInput, Engine, EngineError, EngineInfo, Settings};
 
+#[cfg(feature = "embree")]
+mod api;
 mod config;
 #[cfg(feature = "embree")]
 mod engine;

@@ -7,7 +7,7 @@
 //! grew the same way, so we never allocate one (null arguments: Embree uses its own), and the
 //! callbacks read only its first field (`instID[0]`, where it always was).
 
-use embree4_sys as sys;
+use super::api as sys;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::ptr::null_mut;
 use std::sync::atomic::{AtomicI64, Ordering};
@@ -64,6 +64,8 @@ impl Device {
     pub fn new(config: &str) -> Result<Device, String> {
         let c = CString::new(config)
             .map_err(|_| "the Embree configuration contains a NUL byte".to_string())?;
+        // Embree is opened when the first device is made, not when the process starts.
+        sys::load()?;
         // SAFETY: `c` is a valid NUL-terminated string that outlives the call; Embree copies
         // what it needs from it.
         let handle = unsafe { sys::rtcNewDevice(c.as_ptr()) };

@@ -5,9 +5,9 @@
 //! float k·N + i, the hit's fields after the ray's 12). `rtcIntersect1` calls them with N = 1.
 //! They must not unwind (they are `extern "C"`): they use no panicking indexing.
 
+use super::api as sys;
 use crate::geometry::kernels::f32 as k;
 use crate::geometry::Prim;
-use embree4_sys as sys;
 use glam::Vec3;
 use std::cell::Cell;
 

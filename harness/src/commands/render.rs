@@ -43,16 +43,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     drop(prepared.input.geometry);
     memory::release_free_heap();
     memory::phase("release");
-    let r = pool.install(|| {
-        trace::render_chunked(
-            &scene,
-            engine.as_ref(),
-            a.size,
-            a.chunk,
-            false,
-            None,
-        )
-    });
+    let r = pool
+        .install(|| trace::render_chunked(&scene, engine.as_ref(), a.size, a.chunk, false, None));
     memory::phase("trace");
     if let Some(f) = engine.failure() {
         return Err(input(f));

@@ -30,7 +30,10 @@ pub struct Prepared {
 
 pub fn prepare(src: &Source) -> Result<Prepared> {
     let t = Instant::now();
-    let scene = src.load()?;
+    let mut scene = src.load()?;
+    // The objects were collected one by one into a growing vector; its spare capacity (up to
+    // half of it: 0.6 MiB of gears4's 1.3 MiB) would stay resident through build and trace.
+    scene.objects.shrink_to_fit();
     if scene.objects.is_empty() {
         return Err(input(format!("{}: the scene has no objects", src.label())));
     }

@@ -153,7 +153,8 @@ pub fn pixels_of(size: u32, corners: &[Vec3]) -> Vec<u8> {
 }
 
 /// One row of pixels from the corner rows above (`top`) and below it: each pixel the average
-/// of its four corners.
+/// of its four corners. Never inlined, like [`trace_chunk`] (once per row).
+#[inline(never)]
 fn pixel_row(top: &[Vec3], bottom: &[Vec3], out: &mut [u8]) {
     for (i, px) in out.chunks_exact_mut(3).enumerate() {
         let c = (top[i] + top[i + 1] + bottom[i] + bottom[i + 1]) * 0.25;
@@ -326,6 +327,11 @@ pub fn render(
     render_chunked(scene, engine, size, DEFAULT_CHUNK, false, record)
 }
 
+/// Environment variable that makes [`render_chunked`] print one line per band on stderr (its
+/// rows, thread, rays, engine counters and the thread's CPU seconds): how the trace's work is
+/// spread over bands and threads (issue 20, acceptance 3).
+pub const BANDS_VAR: &str = "RTBENCH_BANDS";
+
 /// The buffers of one chunk's generations, reused from chunk to chunk on a thread.
 #[derive(Default)]
 struct Wavefront {
@@ -462,12 +468,27 @@ pub fn render_chunked(
     }
     let seams = std::sync::Mutex::new(seams);
     let recording = record.is_some();
+    let bands = std::env::var_os(BANDS_VAR).is_some();
     let t = Instant::now();
     let parts: Vec<Part> = slices
         .into_par_iter()
         .map_init(Wavefront::default, |wf, (k, j0, out)| {
             let rows = band_rows.min(w - j0);
+            let cpu = bands.then(super::thread_cpu_seconds);
             let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
+            if let Some(cpu) = cpu {
+                let c = &part.counters;
+                eprintln!(
+                    "band {k} rows {j0}+{rows} thread {} rays {} nodes {} boxes {} prims {} cells {} cpu_s {:.6}",
+                    rayon::current_thread_index().unwrap_or(usize::MAX),
+                    part.stats.total,
+                    c.nodes_visited,
+                    c.box_tests,
+                    c.primitive_tests,
+                    c.cells_visited,
+                    super::thread_cpu_seconds() - cpu
+                );
+            }
             for (j, row) in out.chunks_exact_mut(n * 3).take(rows - 1).enumerate() {
                 pixel_row(
                     &wf.corners[j * w..(j + 1) * w],
@@ -550,7 +571,9 @@ fn pool_cpu_seconds() -> f64 {
 }
 
 /// Traces the ray trees of the corners `first..first + count` to the end, their colours into
-/// `wf.corners`.
+/// `wf.corners`. Never inlined (once per band, so no cost): a profile then shows the bands'
+/// work apart from the serial rest of [`render_chunked`] (issue 20, acceptance 3).
+#[inline(never)]
 fn trace_chunk(s: &Setup, first: u32, count: usize, wf: &mut Wavefront, recording: bool) -> Part {
     let t_chunk = Instant::now();
     let w = s.size + 1;
