@@ -132,6 +132,8 @@ pub struct Config {
     pub sah_block: usize,
     /// Rays traced together (`packet.rs`).
     pub packet: PacketSize,
+    /// Packets test a node's boxes against their interval ray first (`packet.rs`).
+    pub packet_cull: bool,
     /// Threads of the build (`build_sah::binary_blocks_threads`).
     pub build_threads: usize,
 }
@@ -179,6 +181,7 @@ impl Config {
         )?;
         let sah_block = settings.get("sah_block", if wide_packets { 4usize } else { 1 })?;
         let packet = settings.get("packet", PacketSize::Off)?;
+        let packet_cull = settings.get("packet_cull", OnOff(true))?.0;
         let build_threads = settings.get("build_threads", 1usize)?;
         settings.finish()?;
         if !(1..=64).contains(&build_threads) {
@@ -248,6 +251,7 @@ impl Config {
             max_leaf,
             sah_block,
             packet,
+            packet_cull,
             build_threads,
         })
     }
