@@ -1,30 +1,42 @@
 //! Packet traversal (`packet=8|16`): 8 or 16 coherent rays (eye rays of neighbouring pixels,
 //! shadow rays of neighbouring points to one light) walk the wide tree together, as Embree's
 //! `rtcIntersect8/16` packets do (Wald, Slusallek, Benthin and Wagner 2001, "Interactive
-//! rendering with coherent ray tracing"; Embree's `BVHNIntersectorKHybrid` in packet mode).
+//! rendering with coherent ray tracing"; Embree's `BVHNIntersectorKHybrid`).
 //!
-//! The rays are held in AVX2 lanes (one or two `__m256` per quantity) and each child box of a
-//! node is tested against all of them at once: one node fetch and one set of stack operations
-//! serve the whole packet. A child is visited when at least one ray of the packet that is still
-//! active there hits its box; the rays that hit it ride along as a mask. In a leaf every ray of
-//! the mask is tested against the leaf's triangle packets with the single-ray kernel
-//! (4 triangles per SSE test, the one [`super::traverse`] uses), so each ray's hits are exactly
-//! the single-ray traversal's.
+//! Issue 20, session 11 rebuilt it so that a packet costs less than its rays one by one:
+//! - **Set-up once a packet, in lanes**: the rays are transposed into AVX2 lanes (one 8×8
+//!   transpose per 8 rays) and the slab test's and the watertight test's per-ray values are
+//!   computed for all lanes at once, by the same IEEE operations as `SlabRay::new` and
+//!   `WatertightRay::new` (so the same bits).
+//! - **Groups**: the rays of a packet that share the slab test's octant and the watertight
+//!   set-up's axes (kx, ky, kz) are traced together (almost always the whole packet), so a
+//!   node's plane rows and a triangle's rows are the same for every lane.
+//! - **Interval cull** (`packet_cull=on`, 8-wide trees): each node's 8 boxes are first tested
+//!   in one AVX test against the group's interval ray (least/greatest `rdir`, greatest
+//!   `org_near`, least `org_far`), which is conservative for every lane (see
+//!   [`x86`]'s `candidates`); only the children it passes are tested lane by lane.
+//! - **Triangle × rays in lanes**: a leaf's triangles are tested one at a time against all
+//!   lanes (Embree's `TriangleMIntersectorKMoeller`, but with rtbench's watertight test:
+//!   [`crate::geometry::triangle_simd::rays_against_triangle`], the same bits as the single-ray
+//!   test), each lane within its own segment.
+//! - **Lone lanes** (Embree's hybrid switch, at the leaves and nodes only): a leaf reached by at
+//!   most 2 live lanes is tested ray by ray with the single-ray kernel (two packets of 4
+//!   triangles per AVX test), and an 8-wide node reached by one lane is tested with that ray's
+//!   own interval, which is exactly its single-ray box test.
 //!
-//! Why the answers are the single-ray answers: the lane slab test is the single-ray AVX2 test
-//! per lane (the same `fmsub` of the same operands, the near plane picked by the direction's
-//! sign), so a ray visits at least every leaf its own traversal would (it may visit more: a
-//! child is entered for the packet, and a ray's lane there is only tested when its own box test
-//! said so, so no more leaves in fact). Any hit is order-free. Closest hit takes the nearest
-//! `t` over every leaf the ray's box test admits; only two triangles at exactly the same `t`
-//! could be reported differently (the first found wins), since the packet visits children in
-//! the order of the packet's nearest entry, not the ray's own.
+//! Why the answers are the single-ray answers: a lane's box test is the single-ray AVX2 test's
+//! arithmetic (the same `fmsub` of the same operands), so a ray visits at least every leaf its
+//! own traversal would, and each triangle test gives the single-ray test's bits. Any hit is
+//! order-free. Closest hit keeps the nearest `t` over those leaves, the first in leaf order on a
+//! tie inside a leaf; only two triangles of different leaves at exactly the same `t` could be
+//! reported differently, since the packet visits children in the order of the packet's nearest
+//! entry, not the ray's own.
 //!
-//! Counters count per ray, as single rays do: a node visit and its `len` box tests for every
-//! ray active at the node, and the primitive tests of each ray in each leaf.
+//! Counters count per ray: a node visit and its `len` box tests for every lane active at the
+//! node, and the triangles each lane tests.
 //!
-//! One file of ~680 lines: the closest-hit and any-hit loops share the lane set-up and the
-//! lane box test, which exist only for them.
+//! One file of ~1,250 lines: the closest-hit and any-hit loops share the lane set-up, the
+//! groups, the interval and lane box tests and the lone-lane tests, which exist only for them.
 
 use super::leaf::{LeafPacket, PACKET};
 use super::node::{is_leaf, is_packet_leaf, leaf_range, packet_range};
@@ -351,7 +363,11 @@ mod x86 {
         Interval {
             rdir_lo: rdir,
             rdir_hi: rdir,
-            near_hi: [b(g.org_near[h][0]), b(g.org_near[h][1]), b(g.org_near[h][2])],
+            near_hi: [
+                b(g.org_near[h][0]),
+                b(g.org_near[h][1]),
+                b(g.org_near[h][2]),
+            ],
             far_lo: [b(g.org_far[h][0]), b(g.org_far[h][1]), b(g.org_far[h][2])],
             tmin_lo: b(g.tmin[h]),
             tmax_hi: b(g.tmax[h]),
@@ -521,7 +537,10 @@ mod x86 {
             _mm256_min_ps(far(0), far(1)),
             _mm256_min_ps(far(2), span.tmax_hi),
         );
-        (bits(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) & all, t_near)
+        (
+            bits(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) & all,
+            t_near,
+        )
     }
 
     /// Child `i`'s box against the group's lanes in `active`: the lanes that hit it (within
@@ -550,6 +569,7 @@ mod x86 {
         let inf = _mm256_set1_ps(f32::INFINITY);
         let mut mask = 0u32;
         let mut dist = [inf; H];
+        #[allow(clippy::needless_range_loop)] // `h` indexes the group's lanes as well.
         for h in 0..H {
             if (active >> (8 * h)) & 0xff == 0 {
                 continue;
@@ -665,6 +685,9 @@ mod x86 {
         TriangleRayLanes::rays(splat(ray.origin), splat(ray.dir), s, g.k)
     }
 
+    /// A lone ray's nearest hit in a leaf: (packet, lane in it, t, u, v).
+    type LoneHit = (usize, usize, f32, f32, f32);
+
     /// The nearest hit of one ray among a leaf's packets in `(tmin, tmax)`, as the single-ray
     /// traversal tests a leaf (`traverse.rs`: pairs, then the odd packet; the first triangle in
     /// leaf order on a tie of t): (packet, lane in it, t, u, v) and the hits counted there.
@@ -674,7 +697,7 @@ mod x86 {
         r: &TriangleRayLanes<__m256>,
         tmin: f32,
         mut tmax: f32,
-    ) -> (Option<(usize, usize, f32, f32, f32)>, u64) {
+    ) -> (Option<LoneHit>, u64) {
         let mut pair_lanes = LaneHits::<8>::default();
         let mut lanes = LaneHits::<4>::default();
         let mut best = None;
@@ -777,7 +800,11 @@ mod x86 {
                 let lone = CULL && N == 8 && cur_mask.count_ones() == 1;
                 let mut cand = if lone {
                     // One lane: its own box test of all 8 children (the single-ray test).
-                    let (m, t_near) = candidates(node, &g, &lone_interval(&g, cur_mask.trailing_zeros() as usize));
+                    let (m, t_near) = candidates(
+                        node,
+                        &g,
+                        &lone_interval(&g, cur_mask.trailing_zeros() as usize),
+                    );
                     let t = store8(t_near);
                     let mut m = m;
                     while m != 0 {
@@ -909,8 +936,8 @@ mod x86 {
                 let (first, count) = leaf_range(cur);
                 let mut m = cur_mask;
                 let mut tmax_s = [[0.0f32; 8]; H];
-                for h in 0..H {
-                    tmax_s[h] = store8(g.tmax[h]);
+                for (s, t) in tmax_s.iter_mut().zip(&g.tmax) {
+                    *s = store8(*t);
                 }
                 while m != 0 {
                     let l = m.trailing_zeros() as usize;
@@ -932,8 +959,8 @@ mod x86 {
                     }
                     tmax_s[l / 8][l % 8] = rr.tmax;
                 }
-                for h in 0..H {
-                    g.tmax[h] = _mm256_loadu_ps(tmax_s[h].as_ptr());
+                for (t, s) in g.tmax.iter_mut().zip(&tmax_s) {
+                    *t = _mm256_loadu_ps(s.as_ptr());
                 }
                 if CULL {
                     g.span.tmax_hi = hmax_all(&g.tmax);
