@@ -1,8 +1,9 @@
 //! Packets against Embree's packets on coherent generations (issue 20, acceptance 2):
 //! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]
-//! [--engines LABEL,...] [--tessellate RES]` (`--engines`: only the engines whose label starts with
-//! one of these, e.g. `"embree single,bvh4 single"`; bvh8 single is always built, it makes the
-//! shadow rays; `--tessellate`: the scenes as triangles, SPD `-t RES`).
+//! [--engines LABEL,...] [--tessellate RES] [--set KEY=VALUE ...]` (`--engines`: only the engines
+//! whose label starts with one of these, e.g. `"embree single,bvh4 single"`; bvh8 single is always
+//! built, it makes the shadow rays; `--tessellate`: the scenes as triangles, SPD `-t RES`;
+//! `--set`: a setting of bvh8's packet engines, e.g. `packet_cull=off`).
 //!
 //! Two generations of each scene, as the SPD workload makes them but grouped so that a batch is
 //! coherent: the eye rays through the (size+1)² pixel corners, row by row, and the shadow rays
@@ -139,6 +140,8 @@ fn main() {
     // `--engines L1,L2`: only the engines whose label starts with one of these (bvh8 single,
     // which makes the shadow rays and the reference answers, is always built).
     let mut only: Option<Vec<String>> = None;
+    // `--set KEY=VALUE`: added to the settings of bvh8's packet engines.
+    let mut extra: Vec<(String, String)> = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -152,6 +155,11 @@ fn main() {
                         .and_then(|s| s.parse().ok())
                         .expect("--tessellate RES"),
                 )
+            }
+            "--set" => {
+                let kv = args.next().expect("--set KEY=VALUE");
+                let (k, v) = kv.split_once('=').expect("--set KEY=VALUE");
+                extra.push((k.to_string(), v.to_string()));
             }
             "--engines" => {
                 let l = args.next().expect("--engines LABEL,LABEL");
@@ -191,10 +199,16 @@ fn main() {
         let engines: Vec<Option<Box<dyn Engine>>> = ENGINES
             .iter()
             .enumerate()
-            .map(|(k, (_, name, set))| {
+            .map(|(k, (label, name, set))| {
                 wanted(k).then(|| {
-                    let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
-                    build_engine(name, &input, s.collect()).expect("engine")
+                    let mut s: Vec<(String, String)> = set
+                        .iter()
+                        .map(|(k, v)| (k.to_string(), v.to_string()))
+                        .collect();
+                    if *name == "bvh8" && label.contains("packet") {
+                        s.extend(extra.iter().cloned());
+                    }
+                    build_engine(name, &input, s).expect("engine")
                 })
             })
             .collect();

@@ -13,6 +13,7 @@
 //! | `max_leaf` | largest leaf the binned or sweep SAH may choose, `leaf`–16 (with packets: scenes of triangles only; spheres and cones keep one leaf each and the tree below): a range of more than `leaf` primitives becomes a leaf when the SAH says testing it costs no more than splitting it (Embree's `BVHBuilderBinnedSAH` rule; `build_sah::binary_blocks`) | 16 for bvh4/bvh8 with packets and `simd=on` when `leaf` is not given, else `leaf` |
 //! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets and `simd=on`, else 1 |
 //! | `packet` | `off`: one ray at a time; `8`, `16`: packets of 8 or 16 consecutive rays of a batch traverse together, their boxes tested in AVX2 lanes (`packet.rs`; needs `simd=on` and a CPU with AVX2 + FMA, else rays go one at a time and `build_stats.packet_rays` says 1) | `off` |
+//! | `packet_cull` | `on`: packets test an 8-wide node's boxes against their interval ray first and only the children it passes lane by lane (`packet.rs`); `off`: every child lane by lane | `on` |
 //! | `build_threads` | threads of the binned SAH build with Embree's leaf rule (the default tree of triangle scenes; `build_sah::binary_blocks_threads`): the subtrees of the top splits are built on threads of their own; the tree is the same whatever the count | 1 |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
@@ -132,6 +133,8 @@ pub struct Config {
     pub sah_block: usize,
     /// Rays traced together (`packet.rs`).
     pub packet: PacketSize,
+    /// Packets test a node's boxes against their interval ray first (`packet.rs`).
+    pub packet_cull: bool,
     /// Threads of the build (`build_sah::binary_blocks_threads`).
     pub build_threads: usize,
 }
@@ -179,6 +182,7 @@ impl Config {
         )?;
         let sah_block = settings.get("sah_block", if wide_packets { 4usize } else { 1 })?;
         let packet = settings.get("packet", PacketSize::Off)?;
+        let packet_cull = settings.get("packet_cull", OnOff(true))?.0;
         let build_threads = settings.get("build_threads", 1usize)?;
         settings.finish()?;
         if !(1..=64).contains(&build_threads) {
@@ -248,6 +252,7 @@ impl Config {
             max_leaf,
             sah_block,
             packet,
+            packet_cull,
             build_threads,
         })
     }

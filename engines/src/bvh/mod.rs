@@ -270,7 +270,7 @@ fn build_engine<const N: usize>(
     // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
     let kernels = if config.simd {
         let single = simd_kernels().unwrap_or_else(dispatch::scalar::<N>);
-        packet::kernels::<N>(config.packet).unwrap_or(single)
+        packet::kernels::<N>(config.packet, config.packet_cull).unwrap_or(single)
     } else if !config.precompute {
         dispatch::scalar_per_box::<N>()
     } else {

@@ -275,6 +275,10 @@ pub fn closest_with<const K: usize, P: PacketKernel<K>>(
     })
 }
 
+/// Rays in lanes against one triangle (the packet traversal's leaves, `bvh/packet.rs`).
+#[cfg(target_arch = "x86_64")]
+pub use x86::{rays_against_triangle, TriangleRayLanes};
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{LaneHits, PacketKernel, PairKernel, TrianglePacket};
@@ -479,6 +483,33 @@ mod x86 {
         }
     }
 
+    /// The segment `(tmin, tmax)` of each lane, made only when a lane passes the edge tests:
+    /// one ray's bounds splatted (`Splat`; splatting them before the call cost the
+    /// single-ray kernels 1.4 % more instructions on gears4), or each lane's own (a pair of
+    /// lane vectors: rays in the lanes).
+    trait Segment<L> {
+        /// # Safety
+        /// The lanes' instruction set present.
+        unsafe fn bounds(self) -> (L, L);
+    }
+
+    /// One ray's `(tmin, tmax)`, splatted into every lane.
+    struct Splat(f32, f32);
+
+    impl<L: Lanes> Segment<L> for Splat {
+        #[inline(always)]
+        unsafe fn bounds(self) -> (L, L) {
+            (L::splat(self.0), L::splat(self.1))
+        }
+    }
+
+    impl<L: Lanes> Segment<L> for (L, L) {
+        #[inline(always)]
+        unsafe fn bounds(self) -> (L, L) {
+            self
+        }
+    }
+
     /// A ray splatted into lanes: origin, direction, and the watertight shear with its axes.
     #[derive(Clone, Copy)]
     pub struct TriangleRayLanes<L> {
@@ -624,13 +655,13 @@ mod x86 {
     }
 
     /// The watertight test (`kernels.rs`, `triangle_watertight`) on every lane; `row(i, a)`
-    /// loads coordinate `a` of vertex `i` of every lane (one packet, or two side by side).
+    /// loads coordinate `a` of vertex `i` of every lane (one packet, or two side by side, or
+    /// one triangle splatted for rays in the lanes), `tmin`, `tmax` each lane's segment.
     #[inline(always)]
     unsafe fn watertight<L: Lanes, const K: usize>(
         row: impl Fn(usize, usize) -> L,
         r: &TriangleRayLanes<L>,
-        tmin: f32,
-        tmax: f32,
+        segment: impl Segment<L>,
         hits: &mut LaneHits<K>,
     ) -> u32 {
         // The vertices relative to the origin, on the three axes of the ray's set-up.
@@ -662,15 +693,13 @@ mod x86 {
         if ok.mask() == 0 {
             return 0;
         }
+        let (tmin, tmax) = segment.bounds();
         let az = sz.mul(a_z);
         let bz = sz.mul(b_z);
         let cz = sz.mul(c_z);
         let inv = L::splat(1.0).div(det);
         let t = u.mul(az).add(v.mul(bz)).add(w.mul(cz)).mul(inv);
-        let hit = ok
-            .and(t.gt(L::splat(tmin)))
-            .and(t.lt(L::splat(tmax)))
-            .mask();
+        let hit = ok.and(t.gt(tmin)).and(t.lt(tmax)).mask();
         if hit != 0 {
             t.store(hits.t.as_mut_ptr());
             v.mul(inv).store(hits.u.as_mut_ptr());
@@ -715,8 +744,7 @@ mod x86 {
     unsafe fn moller<L: Lanes, const K: usize>(
         row: impl Fn(usize, usize) -> L,
         r: &TriangleRayLanes<L>,
-        tmin: f32,
-        tmax: f32,
+        segment: impl Segment<L>,
         hits: &mut LaneHits<K>,
     ) -> u32 {
         let v0 = [0, 1, 2].map(|a| row(0, a));
@@ -749,11 +777,9 @@ mod x86 {
         if inside.mask() == 0 {
             return 0;
         }
+        let (tmin, tmax) = segment.bounds();
         let t = dot(e2, q).mul(inv);
-        let hit = inside
-            .and(t.gt(L::splat(tmin)))
-            .and(t.lt(L::splat(tmax)))
-            .mask();
+        let hit = inside.and(t.gt(tmin)).and(t.lt(tmax)).mask();
         if hit != 0 {
             t.store(hits.t.as_mut_ptr());
             u.store(hits.u.as_mut_ptr());
@@ -786,9 +812,9 @@ mod x86 {
             unsafe {
                 let row = |i, a| row::<_, 4>(p, i, a);
                 if W {
-                    watertight(row, r, tmin, tmax, hits)
+                    watertight(row, r, Splat(tmin, tmax), hits)
                 } else {
-                    moller(row, r, tmin, tmax, hits)
+                    moller(row, r, Splat(tmin, tmax), hits)
                 }
             }
         }
@@ -847,9 +873,9 @@ mod x86 {
                 };
                 let row = |i, a| row::<__m128, 4>(p, i, a);
                 if W {
-                    watertight(row, &r4, tmin, tmax, hits)
+                    watertight(row, &r4, Splat(tmin, tmax), hits)
                 } else {
-                    moller(row, &r4, tmin, tmax, hits)
+                    moller(row, &r4, Splat(tmin, tmax), hits)
                 }
             }
         }
@@ -879,9 +905,9 @@ mod x86 {
                     )
                 };
                 if W {
-                    watertight(row, r, tmin, tmax, hits)
+                    watertight(row, r, Splat(tmin, tmax), hits)
                 } else {
-                    moller(row, r, tmin, tmax, hits)
+                    moller(row, r, Splat(tmin, tmax), hits)
                 }
             }
         }
@@ -923,9 +949,9 @@ mod x86 {
             unsafe {
                 let row = |i, a| row::<_, 8>(p, i, a);
                 if W {
-                    watertight(row, r, tmin, tmax, hits)
+                    watertight(row, r, Splat(tmin, tmax), hits)
                 } else {
-                    moller(row, r, tmin, tmax, hits)
+                    moller(row, r, Splat(tmin, tmax), hits)
                 }
             }
         }
@@ -945,6 +971,54 @@ mod x86 {
         tmax: f32,
     ) -> Option<(usize, f32, f32, f32)> {
         super::closest_with::<8, Avx8>(p, origin, dir, test, tmin, tmax)
+    }
+
+    impl TriangleRayLanes<__m256> {
+        /// Eight rays in the lanes (issue 20, session 11: the packet traversal's leaves):
+        /// origins `o`, directions `d` and each ray's watertight shear `s` (its own
+        /// `WatertightRay`'s sx, sy, sz), all rays sharing the set-up's axes `k` (kx, ky, kz).
+        pub fn rays(o: [__m256; 3], d: [__m256; 3], s: [__m256; 3], k: [usize; 3]) -> Self {
+            // Clamped as in `prepare`: a row load never leaves the packet.
+            let k = [k[0].min(2), k[1].min(2), k[2].min(2)];
+            TriangleRayLanes {
+                o,
+                d,
+                s,
+                ok: [o[k[0]], o[k[1]], o[k[2]]],
+                k,
+            }
+        }
+    }
+
+    /// Triangle `j` of a packet against the rays in the lanes of `r` ([`TriangleRayLanes::rays`]),
+    /// each within its own `(tmin, tmax)`: one triangle and 8 rays per instruction, as
+    /// Embree's `TriangleMIntersectorKMoeller` tests a leaf against a ray packet (issue 20,
+    /// session 11). The lanes run the same operations as [`PacketKernel::test`] (the triangle's
+    /// coordinates splatted instead of the ray's), so each lane's mask bit and `(t, u, v)` are
+    /// the bits the single-ray test gives that ray.
+    ///
+    /// # Safety
+    /// The CPU must have AVX (the packet traversal's AVX2 + FMA entry points check it), and
+    /// `j < 4`.
+    #[inline(always)]
+    pub unsafe fn rays_against_triangle<const W: bool>(
+        p: &TrianglePacket<4>,
+        j: usize,
+        r: &TriangleRayLanes<__m256>,
+        tmin: __m256,
+        tmax: __m256,
+        hits: &mut LaneHits<8>,
+    ) -> u32 {
+        debug_assert!(j < 4);
+        // Row `(3 i + a)` of the packet holds coordinate `a` of vertex `i` of its 4 triangles;
+        // `i`, `a` < 3 (`rays` clamps the axes), so every load is inside `p.v`.
+        let base = (p.v.as_ptr() as *const f32).add(j.min(3));
+        let row = |i: usize, a: usize| _mm256_broadcast_ss(&*base.add((3 * i + a) * 4));
+        if W {
+            watertight(row, r, (tmin, tmax), hits)
+        } else {
+            moller(row, r, (tmin, tmax), hits)
+        }
     }
 
     #[cfg(test)]
@@ -1013,6 +1087,104 @@ mod x86 {
                 }
             }
         }
+
+        /// Rays in the lanes against one triangle (`rays_against_triangle`) give, lane by lane,
+        /// the single-ray packet test's mask bit and (t, u, v) bits for that triangle, with
+        /// each lane's own segment; rays grouped by their watertight axes, 8 to a test.
+        #[test]
+        fn rays_in_lanes_as_the_single_test() {
+            if !Avx8::available() {
+                return;
+            }
+            let (tris, rays) = super::super::tests::cases();
+            let packets: Vec<TrianglePacket<4>> = tris.chunks(4).map(TrianglePacket::new).collect();
+            let mut by_axes: std::collections::BTreeMap<[usize; 3], Vec<(Vec3, Vec3)>> =
+                Default::default();
+            for &(o, d) in &rays {
+                let w = WatertightRay::new(d);
+                by_axes.entry([w.kx, w.ky, w.kz]).or_default().push((o, d));
+            }
+            let mut hits = 0;
+            for (k, group) in by_axes {
+                for (n, eight) in group.chunks(8).enumerate() {
+                    let lane = |f: &dyn Fn(usize) -> f32| {
+                        let a: [f32; 8] = std::array::from_fn(|l| f(l.min(eight.len() - 1)));
+                        // SAFETY: AVX present (checked above); loads the 8 floats of `a`.
+                        unsafe { _mm256_loadu_ps(a.as_ptr()) }
+                    };
+                    let wts: Vec<WatertightRay> =
+                        eight.iter().map(|&(_, d)| WatertightRay::new(d)).collect();
+                    let o = [0, 1, 2].map(|a| lane(&|l| eight[l].0[a]));
+                    let d = [0, 1, 2].map(|a| lane(&|l| eight[l].1[a]));
+                    let s = [
+                        lane(&|l| wts[l].sx),
+                        lane(&|l| wts[l].sy),
+                        lane(&|l| wts[l].sz),
+                    ];
+                    let r = TriangleRayLanes::rays(o, d, s, k);
+                    // Every other lane's segment ends at 2 (alternating by chunk).
+                    let tmax_of = |l: usize| {
+                        if (l + n).is_multiple_of(2) {
+                            f32::INFINITY
+                        } else {
+                            2.0
+                        }
+                    };
+                    let tmin = lane(&|_| 0.0);
+                    let tmax = lane(&|l| tmax_of(l));
+                    for p in &packets {
+                        for j in 0..4 {
+                            let mut got = LaneHits::<8>::default();
+                            // SAFETY: AVX present (checked above), j < 4.
+                            let (mw, mm) = unsafe {
+                                (
+                                    rays_against_triangle::<true>(p, j, &r, tmin, tmax, &mut got),
+                                    rays_against_triangle::<false>(
+                                        p,
+                                        j,
+                                        &r,
+                                        tmin,
+                                        tmax,
+                                        &mut LaneHits::default(),
+                                    ),
+                                )
+                            };
+                            for (l, &(o, d)) in eight.iter().enumerate() {
+                                let one = <Sse4 as PacketKernel<4>>::prepare(o, d, &wts[l]);
+                                let mut want = LaneHits::<4>::default();
+                                let w = <Sse4 as PacketKernel<4>>::test::<true>(
+                                    p,
+                                    &one,
+                                    0.0,
+                                    tmax_of(l),
+                                    &mut want,
+                                );
+                                let m = <Sse4 as PacketKernel<4>>::test::<false>(
+                                    p,
+                                    &one,
+                                    0.0,
+                                    tmax_of(l),
+                                    &mut LaneHits::default(),
+                                );
+                                assert_eq!((mw >> l) & 1, (w >> j) & 1, "{o} {d} lane {l}");
+                                assert_eq!((mm >> l) & 1, (m >> j) & 1, "Möller {o} {d}");
+                                if (w >> j) & 1 != 0 {
+                                    hits += 1;
+                                    let b = |x: f32| x.to_bits();
+                                    assert_eq!(
+                                        (b(got.t[l]), b(got.u[l]), b(got.v[l])),
+                                        (b(want.t[j]), b(want.u[j]), b(want.v[j])),
+                                        "{o} {d} lane {l}"
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            // 160 watertight hits of these rays (each ray's lane against each triangle).
+            assert!(hits > 100, "only {hits} hits");
+        }
     }
 }
 
@@ -1065,7 +1237,7 @@ mod tests {
     /// sharing edges with their neighbours), some random triangles, and rays of three kinds:
     /// through the grid's vertices and edges exactly (the watertight test's hard case),
     /// random, and parallel to the plane.
-    fn cases() -> (Vec<[Vec3; 3]>, Vec<(Vec3, Vec3)>) {
+    pub(super) fn cases() -> (Vec<[Vec3; 3]>, Vec<(Vec3, Vec3)>) {
         let mut rng = Lcg(7);
         let mut tris = Vec::new();
         for j in 0..3 {
