@@ -48,6 +48,12 @@ pub trait ChildTest<const N: usize> {
     ) -> u32 {
         Self::test(node, r, tmin, tmax, dist)
     }
+    /// [`Self::prepare_ray`] for a ray of octant `NEG` (`ray_setup::octant`), for the loops of
+    /// [`Self::test_octant`]: a form may use the octant to lay the ray out (the same answers).
+    #[inline(always)]
+    fn prepare_ray_octant<const NEG: u32>(ray: &Ray, extent: f32) -> Self::Ray {
+        Self::prepare_ray(ray, extent)
+    }
     /// Asks for the node-sized block of memory at `p` to be brought into the cache (a hint;
     /// nothing for the scalar form).
     #[inline(always)]
@@ -161,6 +167,9 @@ impl<const N: usize> ChildTest<N> for ScalarPerBox {
         mask
     }
 }
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::Avx4;
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -338,6 +347,222 @@ mod x86 {
         }
     }
 
+    // ------------------------------------------ AVX2 + FMA, 4 boxes with near and far side by side
+
+    /// bvh4's slab test in the AVX2 + FMA entry points (issue 20, session 11): a node's lower
+    /// and upper plane rows of an axis are 8 contiguous floats, so one 256-bit FMA gives all four
+    /// children's distances to both planes of that axis, where [`Sse4`] needs two 128-bit ones.
+    /// The far half is computed with `−rdir` and `−org·rdir` (the negated IEEE result, bit for
+    /// bit: rounding to nearest is symmetric), so the near maximum and the far minimum are one
+    /// `max` over 8 lanes; `−max(−a, −b)` is `minps(a, b)` exactly (NaN and signed zeros
+    /// included), and the maxima are taken in [`Sse4`]'s order, so `dist` and the mask are
+    /// [`Sse4<true>`]'s. Six ray registers instead of nine: the profile of session 11 showed the
+    /// SSE form reloading `rdir` and `org·rdir` from the stack at every node.
+    pub struct Avx4;
+
+    /// The ray for [`Avx4`]: for each axis, the factors of its (lower, upper) plane rows:
+    /// `rdir` and `org·rdir` (near pad) on the near row, their negations (far pad) on the far
+    /// row; `neg` has bit `a` set when the direction is negative on axis `a` (lower row far).
+    #[derive(Clone, Copy)]
+    pub struct SlabRayRows {
+        rdir: [__m256; 3],
+        org: [__m256; 3],
+        neg: u32,
+    }
+
+    /// The two 128-bit halves of `v` exchanged.
+    #[inline(always)]
+    fn swap_halves(v: __m256) -> __m256 {
+        // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`); the permute
+        // only moves lanes.
+        unsafe { _mm256_permute2f128_ps::<1>(v, v) }
+    }
+
+    impl Avx4 {
+        /// [`SlabRayRows`] from the slab ray's lanes (`slab_lanes`: x, y, z in lanes 0–2).
+        #[inline(always)]
+        fn rows(rdir: __m128, on: __m128, of: __m128, neg: u32) -> SlabRayRows {
+            // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`), which run
+            // only on CPUs with both; shuffles, broadcasts and sign flips only move or negate
+            // lanes.
+            unsafe {
+                let sign = _mm_set1_ps(-0.0);
+                let lane = |v: __m128, a: usize| match a {
+                    0 => _mm_shuffle_ps::<0x00>(v, v),
+                    1 => _mm_shuffle_ps::<0x55>(v, v),
+                    _ => _mm_shuffle_ps::<0xaa>(v, v),
+                };
+                let axis = |a: usize| {
+                    let (r, n, f) = (lane(rdir, a), lane(on, a), lane(of, a));
+                    let (nr, nf) = (_mm_xor_ps(r, sign), _mm_xor_ps(f, sign));
+                    if (neg >> a) & 1 == 0 {
+                        // Lower row near, upper row far.
+                        (_mm256_set_m128(nr, r), _mm256_set_m128(nf, n))
+                    } else {
+                        (_mm256_set_m128(r, nr), _mm256_set_m128(n, nf))
+                    }
+                };
+                let (x, y, z) = (axis(0), axis(1), axis(2));
+                SlabRayRows {
+                    rdir: [x.0, y.0, z.0],
+                    org: [x.1, y.1, z.1],
+                    neg: neg & 7,
+                }
+            }
+        }
+    }
+
+    impl ChildTest<4> for Avx4 {
+        type Ray = SlabRayRows;
+
+        #[inline(always)]
+        fn prefetch(p: *const u8) {
+            prefetch_lines(p, 2)
+        }
+
+        #[inline(always)]
+        fn prepare_ray(ray: &Ray, extent: f32) -> SlabRayRows {
+            let (rdir, on, of, neg) = slab_lanes(ray, extent);
+            Self::rows(rdir, on, of, neg)
+        }
+
+        /// [`Avx4::rows`] with the octant known: `[rdir | −rdir]` and `[on | −of]` made once
+        /// (and their halves exchanged once, for the negative axes), then one in-lane
+        /// broadcast per axis and vector, where the run-time form needs ~3 instructions more
+        /// per axis.
+        #[inline(always)]
+        fn prepare_ray_octant<const NEG: u32>(ray: &Ray, extent: f32) -> SlabRayRows {
+            let (rdir, on, of, _) = slab_lanes(ray, extent);
+            // SAFETY: only reached from the AVX2 + FMA entry points (`avx2_entry!`); the
+            // inserts, permutes and sign flips only move or negate lanes.
+            unsafe {
+                let sign = _mm_set1_ps(-0.0);
+                let r = _mm256_set_m128(_mm_xor_ps(rdir, sign), rdir);
+                let o = _mm256_set_m128(_mm_xor_ps(of, sign), on);
+                let (rs, os) = if NEG & 7 != 0 {
+                    (swap_halves(r), swap_halves(o))
+                } else {
+                    (r, o)
+                };
+                let pick = |a: u32| {
+                    if (NEG >> a) & 1 != 0 {
+                        (rs, os)
+                    } else {
+                        (r, o)
+                    }
+                };
+                let ((rx, ox), (ry, oy), (rz, oz)) = (pick(0), pick(1), pick(2));
+                SlabRayRows {
+                    rdir: [
+                        _mm256_permute_ps::<0x00>(rx),
+                        _mm256_permute_ps::<0x55>(ry),
+                        _mm256_permute_ps::<0xaa>(rz),
+                    ],
+                    org: [
+                        _mm256_permute_ps::<0x00>(ox),
+                        _mm256_permute_ps::<0x55>(oy),
+                        _mm256_permute_ps::<0xaa>(oz),
+                    ],
+                    neg: NEG & 7,
+                }
+            }
+        }
+
+        #[inline(always)]
+        fn prepare(r: &SlabRay) -> SlabRayRows {
+            let v = |v: glam::Vec3| {
+                let lanes = [v.x, v.y, v.z, 0.0];
+                // SAFETY: SSE is part of the x86-64 baseline; the load reads the 4 floats of
+                // the local `lanes`.
+                unsafe { _mm_loadu_ps(lanes.as_ptr()) }
+            };
+            let neg = (0..3).fold(0, |m, a| m | ((r.near_plane(a) & 1) as u32) << a);
+            Self::rows(v(r.rdir), v(r.org_rdir_near), v(r.org_rdir_far), neg)
+        }
+
+        const OCTANTS: bool = true;
+
+        #[inline(always)]
+        fn test(
+            node: &WideNode<4>,
+            r: &SlabRayRows,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 4],
+        ) -> u32 {
+            match r.neg {
+                0 => rows4::<0>(node, r, tmin, tmax, dist),
+                1 => rows4::<1>(node, r, tmin, tmax, dist),
+                2 => rows4::<2>(node, r, tmin, tmax, dist),
+                3 => rows4::<3>(node, r, tmin, tmax, dist),
+                4 => rows4::<4>(node, r, tmin, tmax, dist),
+                5 => rows4::<5>(node, r, tmin, tmax, dist),
+                6 => rows4::<6>(node, r, tmin, tmax, dist),
+                _ => rows4::<7>(node, r, tmin, tmax, dist),
+            }
+        }
+
+        #[inline(always)]
+        fn test_octant<const NEG: u32>(
+            node: &WideNode<4>,
+            r: &SlabRayRows,
+            tmin: f32,
+            tmax: f32,
+            dist: &mut [f32; 4],
+        ) -> u32 {
+            rows4::<NEG>(node, r, tmin, tmax, dist)
+        }
+    }
+
+    /// [`Avx4`]'s test for a ray of octant `NEG` (bit `a`: negative on axis `a`). Each axis's
+    /// result is `[near | −far]` when positive and `[−far | near]` when negative; the halves are
+    /// exchanged where needed so that the maxima run as [`slab4`]'s do:
+    /// `near = max(max(x, y), max(z, tmin))` and `−far = max(max(−x, −y), max(−z, −tmax))`.
+    #[inline(always)]
+    fn rows4<const NEG: u32>(
+        node: &WideNode<4>,
+        r: &SlabRayRows,
+        tmin: f32,
+        tmax: f32,
+        dist: &mut [f32; 4],
+    ) -> u32 {
+        let base = node.planes.as_ptr() as *const f32;
+        let neg = |a: u32| (NEG >> a) & 1 != 0;
+        // SAFETY: AVX2 and FMA are present (only reached through the feature-checked entry
+        // points of `avx2_entry!`). `planes` is 6 rows of 4 contiguous floats (repr(C)), so the
+        // unaligned 8-float load at row 2a (a < 3) reads rows 2a and 2a + 1 inside the node; the
+        // store writes exactly the 4 floats of `dist`.
+        unsafe {
+            let t =
+                |a: usize| _mm256_fmsub_ps(_mm256_loadu_ps(base.add(8 * a)), r.rdir[a], r.org[a]);
+            let (x, y, z) = (t(0), t(1), t(2));
+            // max(x, y) in x's orientation (`xs`: halves exchanged when x is negative).
+            let (xy, xs) = if neg(0) == neg(1) {
+                (_mm256_max_ps(x, y), neg(0))
+            } else {
+                (_mm256_max_ps(x, swap_halves(y)), neg(0))
+            };
+            // max(z, [tmin | −tmax]) in z's orientation.
+            let lim = if neg(2) {
+                _mm256_set_m128(_mm_set1_ps(tmin), _mm_set1_ps(-tmax))
+            } else {
+                _mm256_set_m128(_mm_set1_ps(-tmax), _mm_set1_ps(tmin))
+            };
+            let zl = _mm256_max_ps(z, lim);
+            // max(xy, zl) as [near | −far]: the halves exchanged once where both are.
+            let m = match (xs, neg(2)) {
+                (false, false) => _mm256_max_ps(xy, zl),
+                (true, true) => swap_halves(_mm256_max_ps(xy, zl)),
+                (true, false) => _mm256_max_ps(swap_halves(xy), zl),
+                (false, true) => _mm256_max_ps(xy, swap_halves(zl)),
+            };
+            let t_near = _mm256_castps256_ps128(m);
+            let t_far = _mm_xor_ps(_mm256_extractf128_ps::<1>(m), _mm_set1_ps(-0.0));
+            _mm_storeu_ps(dist.as_mut_ptr(), t_near);
+            _mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32
+        }
+    }
+
     // ------------------------------------------------------------ AVX2 + FMA, 8 boxes at once
 
     /// 8 boxes at once in 256-bit registers, with FMA.
@@ -463,5 +688,127 @@ mod x86 {
             _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32
         }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::super::node::WideNode;
+    use super::{Avx4, ChildTest};
+    use crate::geometry::aabb::SlabRay;
+    use crate::geometry::lanes::{Avx8, Sse4};
+    use crate::ray::Ray;
+    use glam::Vec3;
+
+    /// bvh4's AVX form ([`Avx4`]) gives [`Sse4<true>`]'s mask and entry distances, bit for bit,
+    /// for rays of all eight octants (zero and tiny components included) against random,
+    /// flat, point-like and empty child boxes, with and without a segment's ends.
+    #[test]
+    fn avx4_as_sse4_fma() {
+        if !Avx8::available() {
+            return;
+        }
+        let mut s = 99u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        };
+        let mut nodes = Vec::new();
+        for k in 0..400 {
+            let mut planes = [[0.0f32; 4]; 6];
+            for i in 0..4 {
+                for a in 0..3 {
+                    let c = next() * 40.0;
+                    // Every fourth node has flat boxes (lower = upper on one axis).
+                    let h = if k % 4 == 1 && a == i % 3 {
+                        0.0
+                    } else {
+                        next().abs() * 15.0
+                    };
+                    planes[2 * a][i] = c - h;
+                    planes[2 * a + 1][i] = c + h;
+                }
+            }
+            // Empty slots hold the empty box (+∞ lower, −∞ upper planes).
+            let len = 1 + k % 4;
+            for (row, p) in planes.iter_mut().enumerate() {
+                let empty = if row % 2 == 0 {
+                    f32::INFINITY
+                } else {
+                    f32::NEG_INFINITY
+                };
+                p[len..].fill(empty);
+            }
+            nodes.push(WideNode::<4> {
+                planes,
+                child: [0; 4],
+                len: len as u32,
+            });
+        }
+        let mut rays = Vec::new();
+        for _ in 0..300 {
+            let o = Vec3::new(next(), next(), next()) * 50.0;
+            let d = Vec3::new(next(), next(), next());
+            rays.push(Ray::new(o, d, 0.0, f32::INFINITY));
+            rays.push(Ray::new(o, d, 0.5, 20.0));
+        }
+        let specials = [0.0, -0.0, 1e-20, -1e-20, 0.5, -0.5, 1.0, -1.0];
+        for &x in &specials {
+            for &y in &specials {
+                for &z in &specials {
+                    rays.push(Ray::new(
+                        Vec3::new(1.0, -2.0, 3.0),
+                        Vec3::new(x, y, z),
+                        0.1,
+                        70.0,
+                    ));
+                }
+            }
+        }
+        let (mut octants, mut hits, mut misses) = ([0usize; 8], 0u32, 0u32);
+        for r in rays.iter().filter(|r| r.is_traceable()) {
+            for extent in [0.0, 60.0] {
+                let slab = SlabRay::new(r, extent);
+                let want_ray = <Sse4<true> as ChildTest<4>>::prepare_ray(r, extent);
+                let got_ray = <Avx4 as ChildTest<4>>::prepare_ray(r, extent);
+                let from_slab = <Avx4 as ChildTest<4>>::prepare(&slab);
+                let by_octant = match super::super::ray_setup::octant(r) {
+                    0 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<0>(r, extent),
+                    1 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<1>(r, extent),
+                    2 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<2>(r, extent),
+                    3 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<3>(r, extent),
+                    4 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<4>(r, extent),
+                    5 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<5>(r, extent),
+                    6 => <Avx4 as ChildTest<4>>::prepare_ray_octant::<6>(r, extent),
+                    _ => <Avx4 as ChildTest<4>>::prepare_ray_octant::<7>(r, extent),
+                };
+                octants[super::super::ray_setup::octant(r) as usize] += 1;
+                for node in &nodes {
+                    let (mut dw, mut dg, mut ds, mut d8) =
+                        ([0.0f32; 4], [0.0; 4], [0.0; 4], [0.0; 4]);
+                    let octant =
+                        <Avx4 as ChildTest<4>>::test(node, &by_octant, r.tmin, r.tmax, &mut d8);
+                    let want = <Sse4<true> as ChildTest<4>>::test(
+                        node, &want_ray, r.tmin, r.tmax, &mut dw,
+                    );
+                    let got = <Avx4 as ChildTest<4>>::test(node, &got_ray, r.tmin, r.tmax, &mut dg);
+                    let slabbed =
+                        <Avx4 as ChildTest<4>>::test(node, &from_slab, r.tmin, r.tmax, &mut ds);
+                    hits += want.count_ones();
+                    misses += node.len - want.count_ones();
+                    assert_eq!(got, want, "{r:?}");
+                    assert_eq!(slabbed, want, "{r:?}");
+                    assert_eq!(octant, want, "{r:?}");
+                    assert_eq!(d8.map(f32::to_bits), dw.map(f32::to_bits), "{r:?}");
+                    assert_eq!(dg.map(f32::to_bits), dw.map(f32::to_bits), "{r:?}");
+                    assert_eq!(ds.map(f32::to_bits), dw.map(f32::to_bits), "{r:?}");
+                }
+            }
+        }
+        // The test must reach every octant's form, and hit and miss boxes.
+        assert!(octants.iter().all(|&n| n > 0), "{octants:?}");
+        assert!(hits > 1000 && misses > 1000, "{hits} hits, {misses} misses");
     }
 }
