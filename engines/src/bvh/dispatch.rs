@@ -93,10 +93,9 @@ pub fn avx8() -> Option<Kernels<8>> {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::super::box_test::Avx4;
     use super::super::traverse::{self, Bvh};
     use crate::engine::Counters;
-    use crate::geometry::lanes::Avx8;
+    use crate::geometry::lanes::{Avx8, Sse4};
     use crate::geometry::TriangleTest;
     use crate::ray::{Hit, Ray};
 
@@ -166,7 +165,7 @@ mod x86 {
         fma4_any,
         fma4_any_impl,
         4,
-        Avx4
+        Sse4<true>
     );
 }
 

@@ -180,16 +180,6 @@ fn node_test<const N: usize, T: ChildTest<N>, const OCT: u32>(
     }
 }
 
-/// The ray as the node test wants it: laid out for octant `OCT`, or ([`ANY_OCTANT`]) for any.
-#[inline(always)]
-fn ray_test<const N: usize, T: ChildTest<N>, const OCT: u32>(ray: &Ray, extent: f32) -> T::Ray {
-    if OCT < ANY_OCTANT {
-        T::prepare_ray_octant::<OCT>(ray, extent)
-    } else {
-        T::prepare_ray(ray, extent)
-    }
-}
-
 /// `f::<generics…, OCT>(args…)` with `OCT` the octant `oct` (0–7) as a constant: one loop
 /// per octant (issue 20, session 10), as the SIMD box tests want ([`ChildTest::OCTANTS`]).
 macro_rules! by_octant {
@@ -272,7 +262,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const 
     if !ray_setup::traceable(ray) {
         return Hit::MISS;
     }
-    let tr = ray_test::<N, T, OCT>(ray, bvh.extent);
+    let tr = T::prepare_ray(ray, bvh.extent);
     let (pr, wt) = triangle_setup::<P, W>(ray);
     let Lanes {
         one: lanes,
@@ -459,7 +449,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
     if !ray_setup::traceable(ray) {
         return false;
     }
-    let tr = ray_test::<N, T, OCT>(ray, bvh.extent);
+    let tr = T::prepare_ray(ray, bvh.extent);
     let (pr, wt) = triangle_setup::<P, W>(ray);
     let Lanes {
         one: lanes,
