@@ -144,3 +144,106 @@ fn a_truncated_or_foreign_grid_is_refused_and_a_failed_build_leaves_nothing() {
     assert!(!path.exists());
     std::fs::remove_dir(&tmp).unwrap();
 }
+
+/// `hrgrid=resume`: a build killed after `k` subspaces goes on from subspace `k + 1` (the first
+/// `k` are not swept or written again: their bytes, zeroed here, stay as they are), counts
+/// the recorded seconds, and a finished build is taken whole; a record of another grid is not.
+#[test]
+fn a_resumed_grid_build_sweeps_only_the_subspaces_not_yet_on_disk() {
+    use super::hires::disk_grid::PROGRESS_FILE;
+    let input = spd(Program::Tetra, 4);
+    let dir = TempDir::new("hr-resume");
+    StoreWriter::create(&dir.0, "tetra4")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let open = |mode: &str, side: &str| {
+        let s = Settings::new(
+            "breadth-first",
+            kv(&[
+                ("grid", "two-level"),
+                ("upper", "4"),
+                ("subspace", side),
+                ("hrgrid", mode),
+            ]),
+        );
+        BreadthFirst::open(&dir.0, BreadthFirstConfig::from_settings(s).unwrap()).unwrap()
+    };
+    let path = dir.0.join(FILE_NAME);
+    let tmp = dir.0.join(format!("{FILE_NAME}.tmp"));
+    let progress = dir.0.join(PROGRESS_FILE);
+    // A plain build keeps no record; a resumable one keeps the finished build's.
+    let e = open("build", "5");
+    let plain = e.build_stats().clone();
+    drop(e);
+    let good = std::fs::read(&path).unwrap();
+    assert!(!progress.exists());
+    let e = open("resume", "5");
+    let s = e.build_stats().clone();
+    drop(e);
+    assert_eq!(std::fs::read(&path).unwrap(), good);
+    assert_eq!(s["hr_build_resumed_subspaces"], 0.0);
+    assert_eq!(s["hr_build_boxes_read"], plain["hr_build_boxes_read"]);
+    let total = s["hr_subspaces"];
+    assert!(total >= 8.0, "{total} subspaces");
+    let side = s["hr_subspace_side"] as usize;
+    let res = [s["res_x"], s["res_y"], s["res_z"]].map(|r| r as usize);
+    let count = res.map(|r| r.div_ceil(side));
+    // Killed after 3 subspaces: the grid still a temporary, the record at 3, and (to see what
+    // is written again) the flags of every voxel zeroed.
+    let mut rec: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&progress).unwrap()).unwrap();
+    rec["done"] = 3.into();
+    rec["seconds"] = 1000.0.into();
+    std::fs::write(&progress, serde_json::to_vec(&rec).unwrap()).unwrap();
+    let mut zeroed = good.clone();
+    zeroed[64..].fill(0);
+    std::fs::write(&tmp, &zeroed).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let e = open("resume", "5");
+    let s = e.build_stats().clone();
+    drop(e);
+    assert_eq!(s["hr_build_resumed_subspaces"], 3.0);
+    assert!(s["hr_build_prior_s"] == 1000.0 && s["hr_build_s"] >= 1000.0);
+    assert!(s["preprocess_s"] >= 1000.0);
+    assert_eq!(s["hr_subspaces"], total);
+    assert!(!tmp.exists());
+    let resumed = std::fs::read(&path).unwrap();
+    let mut kept = 0;
+    for x in 0..res[0] {
+        for y in 0..res[1] {
+            for z in 0..res[2] {
+                let sub = ((x / side) * count[1] + y / side) * count[2] + z / side;
+                let at = 64 + (x * res[1] + y) * res[2] + z;
+                if sub < 3 {
+                    assert_eq!(resumed[at], 0, "subspace {sub} was written again");
+                    kept += usize::from(good[at] != 0);
+                } else {
+                    assert_eq!(resumed[at], good[at], "subspace {sub} not rebuilt");
+                }
+            }
+        }
+    }
+    assert!(
+        kept > 0,
+        "the first 3 subspaces held no flag: the test shows nothing"
+    );
+    // Finished: taken whole, nothing swept, the recorded seconds counted.
+    std::fs::write(&path, &good).unwrap();
+    let e = open("resume", "5");
+    let s = e.build_stats().clone();
+    drop(e);
+    assert_eq!(s["hr_build_resumed_subspaces"], total);
+    assert!(s["hr_build_prior_s"] >= 1000.0);
+    assert_eq!(std::fs::read(&path).unwrap(), good);
+    // Another subspace side: another build, the record replaced.
+    let e = open("resume", "6");
+    let s = e.build_stats().clone();
+    drop(e);
+    assert_eq!(s["hr_build_resumed_subspaces"], 0.0);
+    assert!(s["hr_build_prior_s"] == 0.0 && s["hr_build_s"] < 1000.0);
+    assert_eq!(std::fs::read(&path).unwrap(), good);
+    // A plain build drops the record.
+    drop(open("build", "5"));
+    assert!(!progress.exists());
+}

@@ -45,7 +45,7 @@
 //! | `pool` | a count | what 1/16 of `memory` holds | lower grids in the pool (`two-level`) |
 //! | `block` | bytes | 1/8 of `memory` | one X-slab block of the on-disk grid (`two-level`) |
 //! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
-//! | `hrgrid` | `build`, `reuse` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there |
+//! | `hrgrid` | `build`, `reuse`, `resume` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there; `resume`: make it keeping `hrgrid.progress.json` after each subspace, and take up an interrupted or finished build of the same grid (its subspaces and seconds from the record: `hr_build_resumed_subspaces`, `hr_build_prior_s`, both counted in `hr_build_s` and `preprocess_s`) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -285,6 +285,7 @@ impl BreadthFirst {
         };
         let mut plan = None;
         let mut hr_stats = BTreeMap::new();
+        let mut prior_s = 0.0;
         // The grid takes about one voxel per primitive (5 bytes each: flags and where its rays
         // begin in the registrations grouped by voxel).
         // Where that would pass half the memory budget, it is made coarser to fit in half, so
@@ -367,8 +368,12 @@ impl BreadthFirst {
                         &mut scene,
                         tree.as_mut(),
                         &floor_ids,
+                        tl.resume,
                     )
                     .map_err(|e| err(e.to_string()))?;
+                    prior_s = st.prior_s;
+                    hr_stats.insert("hr_build_resumed_subspaces".into(), st.resumed as f64);
+                    hr_stats.insert("hr_build_prior_s".into(), st.prior_s);
                     hr_stats.insert("hr_subspace_side".into(), st.side as f64);
                     hr_stats.insert("hr_subspaces".into(), st.subspaces as f64);
                     hr_stats.insert("hr_build_boxes_read".into(), st.boxes_read as f64);
@@ -378,7 +383,7 @@ impl BreadthFirst {
                     hr_stats.insert("hr_build_write_calls".into(), st.io.write_calls as f64);
                     hr_stats.insert("marked_voxels".into(), st.marked as f64);
                 }
-                hr_stats.insert("hr_build_s".into(), tb.elapsed().as_secs_f64());
+                hr_stats.insert("hr_build_s".into(), prior_s + tb.elapsed().as_secs_f64());
                 let grid = hires::disk_grid::DiskGrid::open(dir, &voxels, floor.len() as u64)
                     .map_err(|e| err(e.to_string()))?;
                 hr_stats.insert(
@@ -422,7 +427,8 @@ impl BreadthFirst {
                 t.drop_cache();
             }
         }
-        let preprocess_s = t.elapsed().as_secs_f64();
+        // With `hrgrid=resume`, the grid's subspaces an earlier invocation built count here too.
+        let preprocess_s = prior_s + t.elapsed().as_secs_f64();
 
         let mut stats = bh_stats;
         stats.extend(hr_stats);

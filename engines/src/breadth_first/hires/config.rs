@@ -35,6 +35,10 @@ pub struct TwoLevelConfig {
     /// Rebuild the on-disk grid at preprocessing (`hrgrid=build`, the default, counted in
     /// preprocessing) or open the one a previous run left in the store (`hrgrid=reuse`).
     pub reuse: bool,
+    /// `hrgrid=resume`: build as `build` does, keeping a record after each subspace, and take
+    /// up an interrupted or finished build of the same grid with its recorded seconds
+    /// ([`super::disk_grid::DiskGrid::build`]).
+    pub resume: bool,
 }
 
 fn bad(key: &str, value: &str, reason: &str) -> EngineError {
@@ -65,10 +69,11 @@ impl GridKind {
         let block = s.get("block", super::super::config::Bytes(1))?.0;
         let subspace: u32 = s.get("subspace", 0u32)?;
         let hrgrid: String = s.get("hrgrid", "build".to_string())?;
-        let reuse = match hrgrid.as_str() {
-            "build" => false,
-            "reuse" => true,
-            v => return Err(bad("hrgrid", v, "build or reuse")),
+        let (reuse, resume) = match hrgrid.as_str() {
+            "build" => (false, false),
+            "reuse" => (true, false),
+            "resume" => (false, true),
+            v => return Err(bad("hrgrid", v, "build, reuse or resume")),
         };
         if upper > 4096 || lower > 64 {
             return Err(bad(
@@ -90,6 +95,7 @@ impl GridKind {
                 block: (block > 1).then_some(block),
                 subspace: (subspace > 0).then_some(subspace),
                 reuse,
+                resume,
             }),
             v => return Err(bad("grid", v, "cuberoot, single or two-level")),
         })
@@ -142,6 +148,7 @@ mod tests {
             block: None,
             subspace: None,
             reuse: false,
+            resume: false,
         }
     }
 

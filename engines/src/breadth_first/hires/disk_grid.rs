@@ -38,6 +38,59 @@ pub struct BuildStats {
     pub objects_culled: u64,
     pub marked: u64,
     pub io: IoCounters,
+    /// `hrgrid=resume`: subspaces an earlier, interrupted invocation had finished (all of them
+    /// when it had finished the grid), and the build seconds it had spent on them.
+    pub resumed: u64,
+    pub prior_s: f64,
+}
+
+/// `hrgrid=resume`'s record, `hrgrid.progress.json` beside the grid: written after each
+/// subspace is on disk, so that a build of hours (rings368's 27 subspaces each read the
+/// 35 GB store: ~4 h) goes on where a killed invocation stopped, and kept when the grid is
+/// whole, so that an invocation killed in its passes does not make the grid again. It binds
+/// to one grid: the header's checksum (resolution, bounds, floor group, store), the subspace
+/// side and whether the hierarchy culled.
+#[derive(serde::Serialize, serde::Deserialize, Clone, Copy, Debug, PartialEq)]
+struct Progress {
+    header_crc: u32,
+    side: u32,
+    hierarchy: bool,
+    total: u64,
+    done: u64,
+    seconds: f64,
+    boxes_read: u64,
+    nodes_culled: u64,
+    objects_culled: u64,
+    marked: u64,
+    bytes_written: u64,
+    write_calls: u64,
+}
+
+pub const PROGRESS_FILE: &str = "hrgrid.progress.json";
+
+impl Progress {
+    fn read(path: &Path) -> Option<Progress> {
+        serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+    }
+
+    /// Written whole or not at all (a temporary renamed), after the grid's bytes are synced.
+    fn write(&self, path: &Path) -> io::Result<()> {
+        let tmp = path.with_extension("json.tmp");
+        std::fs::write(&tmp, serde_json::to_vec(self).map_err(io::Error::other)?)?;
+        std::fs::rename(&tmp, path)
+    }
+
+    fn restore(&self, st: &mut BuildStats) {
+        st.subspaces = self.done;
+        st.boxes_read = self.boxes_read;
+        st.nodes_culled = self.nodes_culled;
+        st.objects_culled = self.objects_culled;
+        st.marked = self.marked;
+        st.io.bytes_written = self.bytes_written;
+        st.io.write_calls = self.write_calls;
+        st.resumed = self.done;
+        st.prior_s = self.seconds;
+    }
 }
 
 pub struct DiskGrid {
@@ -186,7 +239,10 @@ fn store_crc(dir: &Path) -> io::Result<u32> {
 
 impl DiskGrid {
     /// Builds the grid of `g` (its lattice and pad; flags not held) in `dir`, subspace by
-    /// subspace of `side`³ voxels. On any failure the temporary file is removed.
+    /// subspace of `side`³ voxels. On any failure the temporary file is removed. With `resume`
+    /// (`hrgrid=resume`) the build keeps [`Progress`] and takes up an interrupted or finished
+    /// build of the same grid: the subspaces already on disk are not swept again, and their
+    /// counts and seconds come from the record (`resumed`, `prior_s`).
     #[allow(clippy::too_many_arguments)]
     pub fn build(
         dir: &Path,
@@ -195,31 +251,74 @@ impl DiskGrid {
         scene: &mut SceneReader,
         mut tree: Option<&mut Tree>,
         floor: &[u32],
+        resume: bool,
     ) -> io::Result<BuildStats> {
         let res = g.lattice.res;
         let path = dir.join(FILE_NAME);
         let tmp = dir.join(format!("{FILE_NAME}.tmp"));
+        let progress = dir.join(PROGRESS_FILE);
         let mut st = BuildStats {
             side,
             ..Default::default()
         };
+        let head = header_bytes(
+            res,
+            [g.lattice.lo, g.lattice.hi],
+            floor.len() as u64,
+            store_crc(dir)?,
+        );
+        let count = res.map(|r| r.div_ceil(side));
+        let total = count.iter().map(|&c| c as u64).product::<u64>();
+        let mut record = Progress {
+            header_crc: u32::from_le_bytes([head[56], head[57], head[58], head[59]]),
+            side,
+            hierarchy: tree.is_some(),
+            total,
+            done: 0,
+            seconds: 0.0,
+            boxes_read: 0,
+            nodes_culled: 0,
+            objects_culled: 0,
+            marked: 0,
+            bytes_written: 0,
+            write_calls: 0,
+        };
+        let earlier = Progress::read(&progress).filter(|p| {
+            resume
+                && (p.header_crc, p.side, p.hierarchy, p.total)
+                    == (record.header_crc, side, record.hierarchy, total)
+        });
+        match earlier {
+            Some(p) if p.done == total && path.exists() => {
+                p.restore(&mut st);
+                return Ok(st);
+            }
+            Some(p) if p.done < total && tmp.exists() => p.restore(&mut st),
+            _ => {
+                let _ = std::fs::remove_file(&progress);
+            }
+        }
+        let t0 = std::time::Instant::now();
         let r = (|| -> io::Result<()> {
-            let f = File::create(&tmp)?;
-            let head = header_bytes(
-                res,
-                [g.lattice.lo, g.lattice.hi],
-                floor.len() as u64,
-                store_crc(dir)?,
-            );
-            f.write_all_at(&head, 0)?;
-            st.io.write_calls += 1;
-            st.io.bytes_written += HEADER;
+            let f = if st.resumed > 0 {
+                std::fs::OpenOptions::new().write(true).open(&tmp)?
+            } else {
+                let f = File::create(&tmp)?;
+                f.write_all_at(&head, 0)?;
+                st.io.write_calls += 1;
+                st.io.bytes_written += HEADER;
+                f
+            };
             let mut rec = ObjectRecord::default();
             let mut buf = Vec::new();
-            let count = res.map(|r| r.div_ceil(side));
+            let mut index = 0u64;
             for bx in 0..count[0] {
                 for by in 0..count[1] {
                     for bz in 0..count[2] {
+                        index += 1;
+                        if index <= st.resumed {
+                            continue;
+                        }
                         let s0 = [bx, by, bz].map(|b| b * side);
                         let s1 = [0, 1, 2].map(|i| ((s0[i] + side).min(res[i])) - 1);
                         let n = [0, 1, 2].map(|i| (s1[i] - s0[i] + 1) as usize);
@@ -253,15 +352,38 @@ impl DiskGrid {
                                 st.io.bytes_written += n[2] as u64;
                             }
                         }
+                        if resume {
+                            // The record never runs ahead of the bytes on disk.
+                            f.sync_data()?;
+                            record = Progress {
+                                done: index,
+                                seconds: st.prior_s + t0.elapsed().as_secs_f64(),
+                                boxes_read: st.boxes_read,
+                                nodes_culled: st.nodes_culled,
+                                objects_culled: st.objects_culled,
+                                marked: st.marked,
+                                bytes_written: st.io.bytes_written,
+                                write_calls: st.io.write_calls,
+                                ..record
+                            };
+                            if index < total {
+                                record.write(&progress)?;
+                            }
+                        }
                     }
                 }
             }
             f.sync_all()?;
             std::fs::rename(&tmp, &path)?;
+            if resume {
+                // Written after the rename: a record of `total` always has its whole grid.
+                record.write(&progress)?;
+            }
             Ok(())
         })();
         if let Err(e) = r {
             let _ = std::fs::remove_file(&tmp);
+            let _ = std::fs::remove_file(&progress);
             return Err(io::Error::new(
                 e.kind(),
                 format!("{}: building the on-disk grid: {e}", tmp.display()),
