@@ -51,6 +51,59 @@ fn a_store_renders_out_of_core_as_embree_renders_in_memory() {
     assert_eq!(left.len(), 1, "{left:?}");
 }
 
+/// Shading groups are as many rays as the engine holds in memory (at least 16,384): at 160²
+/// (25,921 eye rays) a 1 MiB budget shades the eye rays in 2 groups, a 64 MiB one in 1, and
+/// the image is the in-memory tracer's either way.
+#[test]
+fn shading_groups_follow_the_memory_budget_and_leave_the_image_unchanged() {
+    let d = Dir::new("store-cli", "groups");
+    let store = d.join("rings2");
+    json(&[
+        "scene", "store", "rings", "--sf", "2", "-o", &store, "--json",
+    ]);
+    let ooc = |memory: &str| {
+        json(&[
+            "render",
+            "--scene",
+            &store,
+            "--engine",
+            "breadth-first",
+            "--size",
+            "160",
+            "--set",
+            memory,
+            "--json",
+        ])
+    };
+    let (small, large) = (ooc("memory=1MiB"), ooc("memory=64MiB"));
+    let mem = json(&[
+        "render",
+        "--scene",
+        "rings",
+        "--sf",
+        "2",
+        "--engine",
+        "breadth-first",
+        "--size",
+        "160",
+        "--json",
+    ]);
+    let group = |v: &Value| v["shading"]["group_rays"].as_u64().unwrap();
+    let in_memory = |v: &Value| v["build_stats"]["rays_in_memory"].as_f64().unwrap() as u64;
+    assert_eq!(group(&small), 16_384, "{}", small["shading"]);
+    assert!(in_memory(&small) < 16_384);
+    assert_eq!(group(&large), in_memory(&large));
+    assert!(group(&large) > 161 * 161, "{}", large["shading"]);
+    // Generation 1 alone takes 2 sweeps in the small budget's groups, 1 in the large one's.
+    let gens = small["rays"]["generations"].as_array().unwrap().len() as u64;
+    assert!(small["shading"]["store_sweeps"].as_u64().unwrap() > gens);
+    assert!(large["shading"]["store_sweeps"].as_u64().unwrap() <= gens);
+    for v in [&small, &large] {
+        assert_eq!(v["image"]["sha256"], mem["image"]["sha256"]);
+        assert_eq!(v["rays"], mem["rays"]);
+    }
+}
+
 #[test]
 fn bad_stores_engines_and_spill_directories_exit_2() {
     let d = Dir::new("store-cli", "errors");

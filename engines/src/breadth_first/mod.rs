@@ -512,6 +512,13 @@ impl BreadthFirst {
         &self.config
     }
 
+    /// The rays the engine holds in memory at once within its budget (`rays_in_memory`): the
+    /// out-of-core workload shades that many rays per sweep of the store (Algorithm 3.6, "while
+    /// memory not full of rays").
+    pub fn ray_capacity(&self) -> usize {
+        self.work.lock().unwrap_or_else(|p| p.into_inner()).capacity
+    }
+
     /// Answers `rays` (ids are their positions) through `out`; the shared body of `intersect`
     /// and `occluded`, and the entry of the out-of-core workload.
     pub fn trace_stream(

@@ -17,9 +17,11 @@
 //! `render --tile 1/N` makes it) and extrapolates its tracing time by the rows not traced: that
 //! row is labelled `model`, with the extrapolation written out. Or `basic-passes=N` runs the
 //! basic method for its first N passes (the engine's `max_passes`) and extrapolates its tracing
-//! time by S+G's pass count: S+G uses the same high-resolution grid, the same rays and the same
-//! memory budget, so it makes the passes the basic method would (measured on `--quick`: the
-//! report's basic-model row gives both counts). `--quick` runs small stand-ins (mount6, rings6,
+//! part by part: the passes by S+G's pass count (S+G uses the same high-resolution grid, the same
+//! rays and the same memory budget, so it makes the passes the basic method would; measured on
+//! `--quick`: the report's basic-model row gives both counts), the shading by the whole run's
+//! forward reads of the store (one per group of rays in memory per generation, from S+G's
+//! generations; rows saved before this split was kept scale all of the tracing by the passes). `--quick` runs small stand-ins (mount6, rings6,
 //! rings6m at 64×64) with the basic method both whole and as the model (a quarter of the rows,
 //! or the first N passes), which tests the model against a measurement.
 //!
@@ -83,7 +85,7 @@ const MAX_SECONDS: Param = Param {
 };
 const PASSES: Param = Param {
     key: "basic-passes",
-    help: "trace the basic method for its first N passes only (max_passes=N) and extrapolate by S+G's pass count (a model; --quick: against the whole basic run)",
+    help: "trace the basic method for its first N passes only (max_passes=N) and extrapolate its passes by S+G's pass count and its shading by the whole run's store sweeps (a model; --quick: against the whole basic run)",
 };
 const SPLIT_COMPRESS: Param = Param {
     key: "split-compress",
@@ -130,7 +132,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "basic-model",
             fidelity: Fidelity::Model,
-            why: "basic tracing time extrapolated from a tile set of the image rows (basic-fraction) or from its first N passes by S+G's pass count (basic-passes); --quick: against the whole run, measured",
+            why: "basic tracing time extrapolated from a tile set of the image rows (basic-fraction) or from its first N passes: passes by S+G's pass count, shading by the whole run's store sweeps (basic-passes); --quick: against the whole run, measured",
         },
         Claim {
             key: "per-ray-growth",
@@ -208,13 +210,64 @@ struct Run {
     /// more than a session), counted in `preprocess_s` but not in `cpu_s`.
     #[serde(default)]
     earlier_s: f64,
+    /// The tracing split: the engine's passes (`intersect_s`) and shading (`shade_s`, whose
+    /// `shade_sweeps` groups of `shade_group` rays each read the store forward), and each
+    /// generation's rays. 0 / empty in rows saved before they were kept.
+    #[serde(default)]
+    intersect_s: f64,
+    #[serde(default)]
+    shade_s: f64,
+    #[serde(default)]
+    shade_group: u64,
+    #[serde(default)]
+    shade_sweeps: u64,
+    #[serde(default)]
+    generation_rays: Vec<u64>,
+    /// A capped run's shading sweeps in the whole run, once S+G's generations are known: one per
+    /// group of `shade_group` rays of each generation (an upper bound: a group without a hit
+    /// reads nothing).
+    #[serde(default)]
+    sweeps_total: u64,
 }
 
 impl Run {
-    /// Preprocessing + tracing, the tracing extrapolated when only a tile set was traced.
+    /// Preprocessing + tracing, the tracing extrapolated when only a tile set or the first
+    /// passes were traced ([`Run::split_model`] when the run kept its split).
     fn total_s(&self) -> f64 {
-        self.preprocess_s + self.trace_s * self.scale
+        match self.split_model() {
+            Some((passes_s, shade_s, other_s)) => self.preprocess_s + passes_s + shade_s + other_s,
+            None => self.preprocess_s + self.trace_s * self.scale,
+        }
     }
+
+    /// A capped basic run's tracing, extrapolated part by part: its passes by S+G's pass count,
+    /// its shading by the whole run's sweeps of the store, the rest (writing the eye rays) as
+    /// measured. Scaling all of `trace_s` by the passes, as rows saved without the split do,
+    /// scales the shading sweeps by the pass count too (seed 000 §3.4: shading is one forward
+    /// read of the store per group of rays in memory, not per pass).
+    fn split_model(&self) -> Option<(f64, f64, f64)> {
+        let ok = self.capped
+            && self.passes > 0
+            && self.passes_total > 0
+            && self.shade_sweeps > 0
+            && self.sweeps_total > 0
+            && self.intersect_s > 0.0;
+        ok.then(|| {
+            let passes_s = self.intersect_s * self.passes_total as f64 / self.passes as f64;
+            let shade_s = self.shade_s * self.sweeps_total as f64 / self.shade_sweeps as f64;
+            let other_s = (self.trace_s - self.intersect_s - self.shade_s).max(0.0);
+            (passes_s, shade_s, other_s)
+        })
+    }
+}
+
+/// Shading groups of `group` rays over a run's generations: the forward reads of the store the
+/// basic layout makes.
+fn sweeps(generation_rays: &[u64], group: u64) -> u64 {
+    generation_rays
+        .iter()
+        .map(|&n| n.div_ceil(group.max(1)))
+        .sum()
 }
 
 /// A store written in segments: its seconds summed over sessions, its size.
@@ -381,6 +434,12 @@ fn trace(
         passes_total: 0,
         cpu_s: workload::process_cpu_seconds() - cpu0,
         earlier_s,
+        intersect_s: r.intersect_s,
+        shade_s: r.shade_s,
+        shade_group: ooc.shade_group as u64,
+        shade_sweeps: ooc.shade_sweeps,
+        generation_rays: r.stats.generations.iter().map(|g| g.rays).collect(),
+        sweeps_total: 0,
     })
 }
 
@@ -514,6 +573,7 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
                 if b.capped && b.passes > 0 {
                     b.passes_total = r.passes;
                     b.scale = r.passes as f64 / b.passes as f64;
+                    b.sweeps_total = sweeps(&r.generation_rays, b.shade_group);
                 }
             }
             m.sg = Some(r);
@@ -777,6 +837,24 @@ fn model_text(r: &Run) -> String {
             format!(
                 "pre {:.1} s + trace {:.1} s (first {} passes) × (S+G's passes, not yet measured)",
                 r.preprocess_s, r.trace_s, r.passes
+            )
+        } else if let Some((passes_s, shade_s, other_s)) = r.split_model() {
+            format!(
+                "pre {:.1} s + passes {:.1} s (first {}) × {} / {} (S+G's passes) + shading {:.1} s ({} sweeps of the store) × {} / {} (the whole run's groups of {} rays) + other {:.1} s = {:.1} s (passes {:.1} s, shading {:.1} s)",
+                r.preprocess_s,
+                r.intersect_s,
+                r.passes,
+                r.passes_total,
+                r.passes,
+                r.shade_s,
+                r.shade_sweeps,
+                r.sweeps_total,
+                r.shade_sweeps,
+                r.shade_group,
+                other_s,
+                r.total_s(),
+                passes_s,
+                shade_s,
             )
         } else {
             format!(
@@ -1097,5 +1175,41 @@ mod tests {
         assert!(rows[0].measured.contains("2.50×"), "{}", rows[0].measured);
         assert_eq!(v[1], ("rings".into(), Verdict::Holds));
         assert_eq!(v[2], ("tetra".into(), Verdict::Shown));
+    }
+    /// A capped basic run is extrapolated part by part: passes by S+G's pass count, shading by
+    /// the whole run's sweeps (one per group of each S+G generation), the rest as measured; a
+    /// row saved without the split keeps the old model (all of the trace by the passes).
+    #[test]
+    fn a_capped_basic_run_scales_its_passes_by_passes_and_its_shading_by_sweeps() {
+        let mut b = Run {
+            preprocess_s: 100.0,
+            trace_s: 70.0,
+            passes: 2,
+            capped: true,
+            passes_total: 10,
+            scale: 5.0,
+            intersect_s: 40.0,
+            shade_s: 20.0,
+            shade_group: 100,
+            shade_sweeps: 2,
+            ..Default::default()
+        };
+        // 250 rays in generation 1 (3 groups), 100 in 2 (1), 1 in 3 (1): 5 sweeps.
+        b.sweeps_total = sweeps(&[250, 100, 1], b.shade_group);
+        assert_eq!(b.sweeps_total, 5);
+        let (passes_s, shade_s, other_s) = b.split_model().unwrap();
+        assert_eq!((passes_s, shade_s, other_s), (200.0, 50.0, 10.0));
+        assert_eq!(b.total_s(), 360.0);
+        assert!(model_text(&b).contains("× 5 / 2 (the whole run's groups of 100 rays)"), "{}", model_text(&b));
+        // Saved before the split was kept: the trace by the passes, 100 + 70 × 5.
+        let old = Run {
+            intersect_s: 0.0,
+            shade_s: 0.0,
+            shade_sweeps: 0,
+            sweeps_total: 0,
+            ..b.clone()
+        };
+        assert!(old.split_model().is_none());
+        assert_eq!(old.total_s(), 450.0);
     }
 }
