@@ -3,7 +3,8 @@
 //! [--engines LABEL,...] [--tessellate RES] [--set KEY=VALUE ...]` (`--engines`: only the engines
 //! whose label starts with one of these, e.g. `"embree single,bvh4 single"`; bvh8 single is always
 //! built, it makes the shadow rays; `--tessellate`: the scenes as triangles, SPD `-t RES`;
-//! `--set`: a setting of bvh8's packet engines, e.g. `packet_cull=off`).
+//! `--set`: a setting of bvh8's packet engines, e.g. `packet_cull=off`; `--set-single`: a
+//! setting of bvh4 single and bvh8 single, e.g. `sah_block=8`).
 //!
 //! Two generations of each scene, as the SPD workload makes them but grouped so that a batch is
 //! coherent: the eye rays through the (size+1)² pixel corners, row by row, and the shadow rays
@@ -142,6 +143,9 @@ fn main() {
     let mut only: Option<Vec<String>> = None;
     // `--set KEY=VALUE`: added to the settings of bvh8's packet engines.
     let mut extra: Vec<(String, String)> = Vec::new();
+    // `--set-single KEY=VALUE`: added to the settings of bvh4 single and bvh8 single (a tree
+    // setting tried on both widths, issue 20 session 12).
+    let mut single: Vec<(String, String)> = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -160,6 +164,11 @@ fn main() {
                 let kv = args.next().expect("--set KEY=VALUE");
                 let (k, v) = kv.split_once('=').expect("--set KEY=VALUE");
                 extra.push((k.to_string(), v.to_string()));
+            }
+            "--set-single" => {
+                let kv = args.next().expect("--set-single KEY=VALUE");
+                let (k, v) = kv.split_once('=').expect("--set-single KEY=VALUE");
+                single.push((k.to_string(), v.to_string()));
             }
             "--engines" => {
                 let l = args.next().expect("--engines LABEL,LABEL");
@@ -208,6 +217,9 @@ fn main() {
                     if *name == "bvh8" && label.contains("packet") {
                         s.extend(extra.iter().cloned());
                     }
+                    if name.starts_with("bvh") && label.contains("single") {
+                        s.extend(single.iter().cloned());
+                    }
                     build_engine(name, &input, s).expect("engine")
                 })
             })
@@ -238,13 +250,15 @@ fn main() {
             }
             continue;
         }
-        // Answers: every engine against bvh8's single-ray traversal.
+        // Answers: every engine against bvh8's single-ray traversal (bvh8 single itself too:
+        // its line gives its counters).
         let shadow_want = any(first, &shadow, &mut Counters::default());
-        for (k, (label, _, _)) in ENGINES.iter().enumerate().skip(1) {
+        for (k, (label, _, _)) in ENGINES.iter().enumerate() {
             let Some(e) = engines[k].as_deref() else {
                 continue;
             };
-            let h = closest(e, &eye, &mut Counters::default());
+            let mut ce = Counters::default();
+            let h = closest(e, &eye, &mut ce);
             let same_object = h
                 .iter()
                 .zip(&eye_hits)
@@ -255,12 +269,29 @@ fn main() {
                 .zip(&eye_hits)
                 .filter(|(a, b)| a.object == b.object && a.t.to_bits() == b.t.to_bits())
                 .count();
-            let o = any(e, &shadow, &mut Counters::default());
+            let mut cs = Counters::default();
+            let o = any(e, &shadow, &mut cs);
             let same_occ = o.iter().zip(&shadow_want).filter(|(a, b)| a == b).count();
             println!(
                 "  {label:<16} eye: same object {same_object}/{n}, same object and t bits {same_t}/{n}; shadow: same answer {same_occ}/{m}",
                 n = eye.len(),
                 m = shadow.len()
+            );
+            // Exact counters per ray (nodes visited, box tests, primitive tests), the
+            // noise-free side of a tree or traversal change.
+            let per = |c: &Counters| {
+                let r = c.rays.max(1) as f64;
+                format!(
+                    "nodes {:.4}, boxes {:.4}, prims {:.4}",
+                    c.nodes_visited as f64 / r,
+                    c.box_tests as f64 / r,
+                    c.primitive_tests as f64 / r
+                )
+            };
+            println!(
+                "  {label:<16} per eye ray: {}; per shadow ray: {}",
+                per(&ce),
+                per(&cs)
             );
         }
         for (gen, is_eye) in [("eye", true), ("shadow", false)] {
