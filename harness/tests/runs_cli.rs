@@ -401,7 +401,10 @@ fn paired_threads_record_each_pairs_speedup() {
     assert_eq!((t1.len(), tn.len(), up.len()), (3, 3, 3));
     for i in 0..3 {
         assert!(t1[i] > 0.0 && tn[i] > 0.0);
-        assert!((up[i] - t1[i] / tn[i]).abs() <= 1e-9 * up[i], "pair {i}: {s}");
+        assert!(
+            (up[i] - t1[i] / tn[i]).abs() <= 1e-9 * up[i],
+            "pair {i}: {s}"
+        );
     }
     let report = rtbench()
         .args(["report", "--format", "md"])

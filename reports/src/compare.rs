@@ -7,7 +7,10 @@
 //!   max(threshold, 2 × the runs' own noise) is a regression, where a ratio's noise combines the
 //!   engine's and Embree's (σ ≈ 1.4826 × median absolute deviation of the repeats, relative), the
 //!   larger of set A's and set B's. Embree's own times are the yardstick (ratio 1)
-//!   and are not compared; its counters are.
+//!   and are not compared; its counters are;
+//! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), a
+//!   median speed-up that fell by more than max(threshold, 2 × the pairs' noise) is a regression
+//!   (Embree's too: it measures how the harness splits the trace as much as Embree).
 
 use crate::anchor::{Anchors, EMBREE};
 use crate::number;

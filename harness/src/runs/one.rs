@@ -5,9 +5,7 @@
 use crate::error::Result;
 use crate::source::Source;
 use crate::workload::{self, crosscheck, trace};
-use rtbench_reports::{
-    run_key, CheckResult, RunRecord, SceneInfo, Spread, ThreadScaling, Timings,
-};
+use rtbench_reports::{run_key, CheckResult, RunRecord, SceneInfo, Spread, ThreadScaling, Timings};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -216,8 +214,13 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         _ => None,
     };
     let thread_scaling = if spec.paired_threads > 0 && pool.current_num_threads() > 1 {
-        let pairs =
-            paired_thread_times(&pool, scene, engine.as_ref(), spec.size, spec.paired_threads)?;
+        let pairs = paired_thread_times(
+            &pool,
+            scene,
+            engine.as_ref(),
+            spec.size,
+            spec.paired_threads,
+        )?;
         Some(ThreadScaling::of(pool.current_num_threads(), &pairs))
     } else {
         None

@@ -456,7 +456,6 @@ impl Binned {
             cost: split_cost(c, r.bounds.half_area()),
         }
     }
-
 }
 
 impl Splitter for Binned {
