@@ -172,6 +172,12 @@ pub struct PlanArgs {
     /// on a shared machine moves far less than the ratio of two separate runs.
     #[arg(long, default_value_t = 0)]
     pub paired: u32,
+    /// In every run at more than one thread, also time N back-to-back pairs of the same trace at
+    /// one thread and at the run's threads in one process (alternating which goes first), and
+    /// record the speed-up over one thread per pair (`thread_scaling`: median and range);
+    /// `report` shows it. Runs at one thread ignore it.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub paired_threads: u32,
     /// A run still going after this many seconds is stopped and recorded as failed.
     #[arg(long)]
     pub max_seconds: Option<f64>,
@@ -255,6 +261,10 @@ pub struct RunOneArgs {
     /// which goes first) and record their trace-CPU-time ratios: the low-noise yardstick.
     #[arg(long, default_value_t = 0)]
     pub paired: u32,
+    /// With `--threads` above 1, also time N back-to-back pairs of the trace at one thread and
+    /// at `--threads` (alternating which goes first) and record the speed-up of each pair.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub paired_threads: u32,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -343,3 +343,103 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
         std::fs::remove_dir_all(&d).unwrap();
     }
 }
+
+/// `--paired-threads N` (issue 20, acceptance 3): a two-thread run records N pairs of one- and
+/// two-thread traces, each pair's speed-up its own two wall times' ratio; the one-thread run of
+/// the same plan records none; `report` shows the speed-up table. `RTBENCH_MAX_THREADS=2` lets
+/// the two-thread run start on a machine (or a `taskset`) with one core: only the record's
+/// shape is checked here, no figure.
+#[test]
+fn paired_threads_record_each_pairs_speedup() {
+    let _one_at_a_time = serial();
+    let dir = tmp("paired-threads");
+    let out = rtbench()
+        .env("RTBENCH_MAX_THREADS", "2")
+        .args([
+            "run",
+            "--engines",
+            "bvh8",
+            "--scenes",
+            "tetra",
+            "--sf",
+            "1",
+            "--threads",
+            "1,2",
+            "--repeat",
+            "1",
+            "--paired-threads",
+            "3",
+            "--size",
+            "64",
+            "--no-check",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ok(&out), "{}", String::from_utf8_lossy(&out.stderr));
+    let recs = records(&dir);
+    assert_eq!(recs.len(), 2);
+    let one = recs.iter().find(|r| r["threads"] == 1).unwrap();
+    assert!(one.get("thread_scaling").is_none(), "{one}");
+    let two = recs.iter().find(|r| r["threads"] == 2).unwrap();
+    let s = &two["thread_scaling"];
+    assert_eq!(s["threads"], 2);
+    let nums = |v: &Value| -> Vec<f64> {
+        v["samples"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let (t1, tn, up) = (
+        nums(&s["one_thread_s"]),
+        nums(&s["threads_s"]),
+        nums(&s["speedup"]),
+    );
+    assert_eq!((t1.len(), tn.len(), up.len()), (3, 3, 3));
+    for i in 0..3 {
+        assert!(t1[i] > 0.0 && tn[i] > 0.0);
+        assert!(
+            (up[i] - t1[i] / tn[i]).abs() <= 1e-9 * up[i],
+            "pair {i}: {s}"
+        );
+    }
+    let report = rtbench()
+        .args(["report", "--format", "md"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ok(&report));
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(
+        md.contains("Speed-up over one thread (pairs in one process)"),
+        "{md}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn paired_threads_above_the_limit_is_refused() {
+    let out = rtbench()
+        .args([
+            "run-one",
+            "--scene",
+            "tetra",
+            "--sf",
+            "1",
+            "--engine",
+            "bvh8",
+            "--paired-threads",
+            "1001",
+            "--size",
+            "8",
+            "--no-check",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--paired-threads 1001"), "{err}");
+}

@@ -46,6 +46,7 @@ fn comparable(dir: &Path) -> Vec<(String, Value)> {
                 "finished_at",
                 "peak_rss_bytes",
                 "paired_ratio",
+                "thread_scaling",
                 "machine",
             ] {
                 o.remove(k);

@@ -7,7 +7,10 @@
 //!   max(threshold, 2 × the runs' own noise) is a regression, where a ratio's noise combines the
 //!   engine's and Embree's (σ ≈ 1.4826 × median absolute deviation of the repeats, relative), the
 //!   larger of set A's and set B's. Embree's own times are the yardstick (ratio 1)
-//!   and are not compared; its counters are.
+//!   and are not compared; its counters are;
+//! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), a
+//!   median speed-up that fell by more than max(threshold, 2 × the pairs' noise) is a regression
+//!   (Embree's too: it measures how the harness splits the trace as much as Embree).
 
 use crate::anchor::{Anchors, EMBREE};
 use crate::number;
@@ -40,6 +43,9 @@ pub enum FindingKind {
     OnlyInB,
     /// Times not compared: no Embree run beside this one in A or B.
     NoYardstick,
+    /// The speed-up over one thread (`run --paired-threads N`, in both sets) moved past the
+    /// tolerance: a fall is a regression, a rise an improvement.
+    ThreadSpeedup,
 }
 
 /// One difference between the two sets, about one run.
@@ -291,6 +297,7 @@ fn compare_records(runs_a: &[RunRecord], runs_b: &[RunRecord], c: &mut Compariso
         if ra.engine != EMBREE {
             compare_times(ra, rb, &anchors_a, &anchors_b, c);
         }
+        compare_scaling(ra, rb, c);
     }
     for rb in runs_b.iter().filter(|r| !keys_a.contains(r.key.as_str())) {
         c.notes.push(finding(
@@ -413,6 +420,46 @@ fn compare_times(
     let spread_pct =
         2.0 * noise(ra, anchors_a.anchor(ra)).max(noise(rb, anchors_b.anchor(rb))) * 100.0;
     time_finding(ra, q_a, q_b, change_pct, spread_pct, c);
+}
+
+/// The speed-up over one thread in A against B's, when both timed it in pairs: each set's
+/// median of its pairs' ratios; the tolerance is max(threshold, 2 × the pairs' own noise), as
+/// for the ratios to Embree. Embree's own speed-up is compared too: it is a figure of the
+/// harness (how it splits the trace), not only of Embree.
+fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
+    let (Some(sa), Some(sb)) = (&ra.thread_scaling, &rb.thread_scaling) else {
+        return;
+    };
+    let (pa, pb) = (&sa.speedup, &sb.speedup);
+    let change_pct = (pb.median / pa.median.max(1e-12) - 1.0) * 100.0;
+    let tolerance_pct = c
+        .threshold_pct
+        .max(2.0 * pa.rel_noise().max(pb.rel_noise()) * 100.0);
+    if change_pct.abs() <= tolerance_pct {
+        return;
+    }
+    let (list, word) = if change_pct < 0.0 {
+        (&mut c.regressions, "fell")
+    } else {
+        (&mut c.improvements, "rose")
+    };
+    list.push(Finding {
+        key: ra.key.clone(),
+        kind: FindingKind::ThreadSpeedup,
+        what: "speed-up over 1 thread".to_string(),
+        old: Value::from(pa.median),
+        new: Value::from(pb.median),
+        change_pct: Some(change_pct),
+        tolerance_pct: Some(tolerance_pct),
+        message: format!(
+            "{}: speed-up over 1 thread {} → {} ({}% {word}; tolerance {}%)",
+            ra.key,
+            number::ratio(pa.median),
+            number::ratio(pb.median),
+            number::short(change_pct.abs(), 3),
+            number::short(tolerance_pct, 3)
+        ),
+    });
 }
 
 /// A run's paired ratios to Embree, when it has some.

@@ -34,6 +34,14 @@ pub fn report(summary: &Summary, svgs: &[(String, String)]) -> String {
     if !summary.rows.is_empty() {
         let _ = writeln!(s, "<p class=\"notes\">{}</p>", inline_html(table::NOTES));
     }
+    if let Some(t) = table::scaling_table(summary) {
+        write_table(&mut s, &t);
+        let _ = writeln!(
+            s,
+            "<p class=\"notes\">{}</p>",
+            inline_html(table::SCALING_NOTES)
+        );
+    }
     let failures = table::failure_lines(summary);
     if !failures.is_empty() {
         s.push_str("<h2>Failed runs</h2>\n<ul>\n");

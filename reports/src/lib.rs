@@ -30,6 +30,7 @@ pub mod number;
 pub mod plot;
 mod report;
 pub mod results;
+mod scaling;
 mod summary;
 mod table;
 
@@ -42,4 +43,5 @@ pub use results::{
     read_environment, read_results, run_key, CheckResult, Environment, ReadError, RunRecord,
     SceneInfo, Spread, Timings,
 };
+pub use scaling::ThreadScaling;
 pub use summary::{engine_label, Failure, Row, Summary};

@@ -31,6 +31,10 @@ pub fn report(summary: &Summary, plots: &[String]) -> String {
     if !summary.rows.is_empty() {
         let _ = writeln!(s, "{}\n", table::NOTES);
     }
+    if let Some(t) = table::scaling_table(summary) {
+        write_table(&mut s, &t);
+        let _ = writeln!(s, "{}\n", table::SCALING_NOTES);
+    }
 
     let failures = table::failure_lines(summary);
     if !failures.is_empty() {

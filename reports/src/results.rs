@@ -167,6 +167,11 @@ pub struct RunRecord {
     /// pair. `None` when not asked for (and for Embree itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub paired_ratio: Option<Spread>,
+    /// Speed-up over one thread, timed in pairs in the same process (`--paired-threads N`): the
+    /// same trace at one thread and at `threads`, back to back, alternating which goes first.
+    /// `None` when not asked for, and for one-thread runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thread_scaling: Option<crate::scaling::ThreadScaling>,
     pub image_sha256: Option<String>,
     /// Wall seconds of the whole child process.
     pub wall_s: f64,

@@ -3,6 +3,7 @@
 
 use crate::anchor::{Anchors, EMBREE};
 use crate::results::{CheckResult, Environment, RunRecord, SceneInfo, Spread};
+use crate::scaling::ThreadScaling;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -46,6 +47,9 @@ pub struct Row {
     pub structure_bytes: u64,
     pub peak_rss_bytes: u64,
     pub check: Option<CheckResult>,
+    /// Speed-up over one thread timed in pairs in the run's process (`run --paired-threads N`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thread_scaling: Option<ThreadScaling>,
     /// The machine the run (and so its ratio to Embree) was measured on, in merged shard results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
@@ -140,6 +144,7 @@ impl Summary {
                 structure_bytes: r.structure_bytes,
                 peak_rss_bytes: r.peak_rss_bytes,
                 check: r.check.clone(),
+                thread_scaling: r.thread_scaling.clone(),
                 machine: r.machine.clone(),
             })
             .collect();

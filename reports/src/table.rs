@@ -98,6 +98,72 @@ fn bytes_per_primitive(r: &Row) -> String {
     format!("{:.1}", r.structure_bytes as f64 / r.primitives as f64)
 }
 
+/// The speed-up over one thread of the runs timed in pairs (`run --paired-threads N`), when any
+/// was: per run, the median and range of the pairs' own ratios, the pairs' median times, how
+/// much CPU time the split trace took over the one-thread trace, and beside it the speed-up from
+/// two separate runs of this set (its one-thread run's median trace time over this run's), which
+/// outside load moves far more.
+pub fn scaling_table(summary: &Summary) -> Option<Table> {
+    let rows: Vec<Vec<String>> = summary
+        .rows
+        .iter()
+        .filter_map(|r| r.thread_scaling.as_ref().map(|s| (r, s)))
+        .map(|(r, s)| {
+            let separate = summary
+                .rows
+                .iter()
+                .find(|o| o.threads == 1 && o.label == r.label && o.scene == r.scene)
+                .map(|o| number::ratio(o.trace_s.median / r.trace_s.median.max(1e-12)))
+                .unwrap_or_else(|| "–".to_string());
+            let p = &s.speedup;
+            vec![
+                r.scene.clone(),
+                r.label.clone(),
+                s.threads.to_string(),
+                format!(
+                    "{} ({}–{})",
+                    number::ratio(p.median),
+                    number::ratio(p.min),
+                    number::ratio(p.max)
+                ),
+                p.samples.len().to_string(),
+                number::seconds(s.one_thread_s.median),
+                number::seconds(s.threads_s.median),
+                number::ratio(s.cpu_growth()),
+                separate,
+            ]
+        })
+        .collect();
+    if rows.is_empty() {
+        return None;
+    }
+    let header = [
+        ("scene", false),
+        ("engine", false),
+        ("threads", true),
+        ("speed-up, paired (min–max)", true),
+        ("pairs", true),
+        ("1 thread s", true),
+        ("N threads s", true),
+        ("CPU s × 1 thread", true),
+        ("speed-up, separate runs", true),
+    ];
+    Some(Table {
+        caption: "Speed-up over one thread (pairs in one process)".to_string(),
+        header: header.iter().map(|h| h.0.to_string()).collect(),
+        numeric: header.iter().map(|h| h.1).collect(),
+        rows,
+    })
+}
+
+/// What the scaling table's columns mean.
+pub const SCALING_NOTES: &str = "Each pair traces the same built structure at one thread and at N threads back to \
+back in one process, alternating which goes first (`rtbench run --paired-threads`); the speed-up is each pair's \
+one-thread wall time over its N-thread wall time, median and range over the pairs, and both traces must give the \
+same image. 1 thread s and N threads s are the pairs' median wall times; CPU s × 1 thread is the CPU time of the \
+pool's threads at N threads over that at one (1.00: splitting cost no extra CPU time). Speed-up, separate runs: \
+this set's one-thread run's median trace time over this run's, for comparison.";
+
 /// The failed runs: key, then why.
 pub fn failure_lines(summary: &Summary) -> Vec<(String, String)> {
     summary

@@ -295,3 +295,40 @@ fn paired_ratios_are_compared_when_both_runs_have_them() {
         .expect("the paired slowdown is found");
     assert!((f.change_pct.unwrap() - 20.0).abs() < 0.5, "{f:?}");
 }
+
+/// A speed-up over one thread timed in pairs (`run --paired-threads`), 1% spread around `s`.
+fn scaling(r: &mut RunRecord, s: f64) {
+    let one: Vec<f64> = samples(1.0, 0.01).samples;
+    let pairs: Vec<(f64, f64, f64, f64)> = one.iter().map(|&t| (t * s, t, t * s, t * s)).collect();
+    r.thread_scaling = Some(rtbench_reports::ThreadScaling::of(2, &pairs));
+}
+
+#[test]
+fn a_fallen_thread_speedup_is_a_regression() {
+    let (mut a, mut b) = (base(), base());
+    scaling(find(&mut a, "grid/balls3@1"), 1.9);
+    scaling(find(&mut b, "grid/balls3@1"), 1.9);
+    scaling(find(&mut a, "embree/balls3@1"), 1.8);
+    scaling(find(&mut b, "embree/balls3@1"), 1.4);
+    let c = compare_sets(&a, &b, 5.0);
+    let found: Vec<&str> = c
+        .regressions
+        .iter()
+        .filter(|f| f.kind == FindingKind::ThreadSpeedup)
+        .map(|f| f.key.as_str())
+        .collect();
+    assert_eq!(found, ["embree/balls3@1"], "{}", c.to_markdown());
+    let f = c
+        .regressions
+        .iter()
+        .find(|f| f.kind == FindingKind::ThreadSpeedup)
+        .unwrap();
+    assert!((f.change_pct.unwrap() + 22.2).abs() < 0.5, "{f:?}");
+    // A risen speed-up is an improvement, not a regression.
+    scaling(find(&mut b, "grid/balls3@1"), 2.0);
+    let c = compare_sets(&a, &b, 1.0);
+    assert!(c
+        .improvements
+        .iter()
+        .any(|f| f.kind == FindingKind::ThreadSpeedup && f.key == "grid/balls3@1"));
+}

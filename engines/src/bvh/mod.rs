@@ -80,7 +80,7 @@ pub struct BvhEngine<const N: usize> {
 /// Builds the tree of `config` over `geometry`: a build tree with at most `config.width`
 /// children per node.
 pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
-    let prims = BuildPrims::new(geometry);
+    let prims = BuildPrims::new_threads(geometry, config.build_threads);
     let (width, leaf) = (config.width, config.leaf);
     if width > 2 && config.wide == WideMethod::Direct {
         return match config.builder {
@@ -127,7 +127,8 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
             build_sah::binary_blocks(build_sah::Sweep::new(&prims).with_block(block), &rule)
         }
         Builder::SahBinned if block_leaves => build_sah::binary_blocks_threads(
-            build_sah::Binned::new(&prims, config.bins).with_block(block),
+            build_sah::Binned::new_threads(&prims, config.bins, config.build_threads)
+                .with_block(block),
             &rule,
             config.build_threads,
         ),
@@ -229,21 +230,47 @@ pub fn build_bvh<const N: usize>(
         Ok(()),
         "builder broke an invariant"
     );
-    let mut flat = flatten::<N>(&tree);
-    let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
+    let mut flat = if config.build_threads > 1 {
+        node::flatten_threads::<N>(&tree, config.build_threads)
+    } else {
+        flatten::<N>(&tree)
+    };
     let extent = flat
         .root_bounds
         .lo
         .abs()
         .max(flat.root_bounds.hi.abs())
         .max_element();
-    let leaves = leaf::lay_out(
-        &mut flat.nodes,
-        &mut flat.root,
-        &tree.order,
-        geometry,
-        config.packets,
-    );
+    let (s, leaves) = if config.build_threads > 1 {
+        // The statistics read the nodes as flattened, the leaf layout rewrites their leaf
+        // references: the statistics get a copy and run beside it (the two were 42 M and 80 M
+        // of the 403 M instructions the first thread ran alone on balls4 tessellated at two
+        // threads; callgrind, issue 20, session 12). The same figures and leaves either way.
+        let copy = flat.nodes.clone();
+        let (root, bounds) = (flat.root, flat.root_bounds);
+        std::thread::scope(|scope| {
+            let s = scope.spawn(move || stats::tree_stats(&copy, root, &bounds));
+            let leaves = leaf::lay_out_threads(
+                &mut flat.nodes,
+                &mut flat.root,
+                &tree.order,
+                geometry,
+                config.packets,
+                config.build_threads,
+            );
+            (s.join().expect("the statistics thread panicked"), leaves)
+        })
+    } else {
+        let s = stats::tree_stats(&flat.nodes, flat.root, &flat.root_bounds);
+        let leaves = leaf::lay_out(
+            &mut flat.nodes,
+            &mut flat.root,
+            &tree.order,
+            geometry,
+            config.packets,
+        );
+        (s, leaves)
+    };
     Ok((
         Bvh {
             nodes: flat.nodes,

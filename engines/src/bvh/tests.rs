@@ -564,3 +564,35 @@ fn threads_build_the_same_tree() {
         assert_eq!(t.nodes, base.nodes, "{threads} threads");
     }
 }
+
+/// The two-thread engine build (primitive boxes, the top split's binning, statistics beside the
+/// leaf layout on threads) makes the one-thread build's engine: the same wide nodes, leaf
+/// packets, scalar primitives and statistics.
+#[test]
+fn threads_build_the_same_engine() {
+    // gears4: 36,610 triangles, above every threshold of the threaded parts (8,192).
+    let inp = input(Program::Gears, 4, None);
+    let one = Config::parse(8, Settings::new("bvh8", vec![])).unwrap();
+    let (base, base_stats) = build_bvh::<8>(&inp.geometry, &one).unwrap();
+    assert!(base.packets.len() > 1000);
+    for threads in ["2", "3"] {
+        let more = Config::parse(
+            8,
+            Settings::new("bvh8", vec![("build_threads".into(), threads.into())]),
+        )
+        .unwrap();
+        let (b, s) = build_bvh::<8>(&inp.geometry, &more).unwrap();
+        assert_eq!(b.root, base.root, "{threads} threads");
+        assert_eq!(b.nodes, base.nodes, "{threads} threads");
+        assert_eq!(b.prims, base.prims, "{threads} threads");
+        assert_eq!(b.objects, base.objects, "{threads} threads");
+        assert_eq!(b.extent.to_bits(), base.extent.to_bits());
+        // Debug prints every float of a packet exactly (shortest round trip, signs of zero).
+        assert_eq!(
+            format!("{:?}", b.packets),
+            format!("{:?}", base.packets),
+            "{threads} threads"
+        );
+        assert_eq!(s, base_stats, "{threads} threads");
+    }
+}

@@ -111,8 +111,13 @@ fn shard_of(p: &PlanArgs) -> Result<Option<ShardSpec>> {
 
 /// What identifies a plan across its shards: the command, the shared settings, every job key.
 pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
+    // `paired_threads` only when asked for, so plans written before it keep their text.
+    let threads = match c.paired_threads {
+        0 => String::new(),
+        n => format!(" paired_threads={n}"),
+    };
     format!(
-        "{kind} repeats={} size={} check={} paired={} max_seconds={:?} max_memory={:?}\n{}",
+        "{kind} repeats={} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
         c.repeats,
         c.size,
         c.check,
@@ -143,9 +148,9 @@ fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
                     "--threads '{}': expected counts ≥ 1 or 'all'",
                     p.threads
                 ))),
-                Ok(n) if n > workload::available_threads() => Err(input(format!(
+                Ok(n) if n > workload::thread_limit() => Err(input(format!(
                     "--threads {n}: more than the {} this machine runs at once",
-                    workload::available_threads()
+                    workload::thread_limit()
                 ))),
                 Ok(n) => Ok(Some(n)),
             },
@@ -168,6 +173,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         size: p.size,
         check: !p.no_check,
         paired: p.paired,
+        paired_threads: p.paired_threads,
         max_seconds: p.max_seconds,
         max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
     })
@@ -365,6 +371,7 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
         size: a.size,
         check: !a.no_check,
         paired: a.paired,
+        paired_threads: a.paired_threads,
     };
     let rec = run_one(&spec)?;
     println!(

@@ -514,6 +514,7 @@ fn measure(
         size: suite.size,
         check: false,
         paired: suite.paired,
+        paired_threads: 0,
         max_seconds: suite.max_seconds,
         max_memory: None,
     };

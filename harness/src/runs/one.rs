@@ -5,7 +5,7 @@
 use crate::error::Result;
 use crate::source::Source;
 use crate::workload::{self, crosscheck, trace};
-use rtbench_reports::{run_key, CheckResult, RunRecord, SceneInfo, Spread, Timings};
+use rtbench_reports::{run_key, CheckResult, RunRecord, SceneInfo, Spread, ThreadScaling, Timings};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -23,6 +23,9 @@ pub struct OneSpec {
     pub check: bool,
     /// Pairs of this engine's and Embree's traces to time back to back (0: none).
     pub paired: u32,
+    /// Pairs of this engine's traces at one thread and at `threads` to time back to back, for
+    /// the speed-up over one thread (0: none; ignored at one thread).
+    pub paired_threads: u32,
 }
 
 /// The most pairs `--paired` takes: each pair traces the whole workload twice.
@@ -62,6 +65,51 @@ fn paired_ratios(
                 (time(engine), b)
             };
             a / b.max(1e-12)
+        })
+        .collect()
+}
+
+/// The same trace at one thread and on `pool`, `pairs` times, back to back in this process:
+/// (one-thread wall s, wall s on `pool`, one-thread pool CPU s, pool CPU s) per pair. Pair i
+/// traces one thread first when i is even and `pool` first when it is odd, as
+/// [`paired_ratios`] alternates. Every trace must give the image of the first: a speed-up of a
+/// different answer would mean nothing.
+fn paired_thread_times(
+    pool: &rayon::ThreadPool,
+    scene: &rtbench_scenes::Scene,
+    engine: &dyn rtbench_engines::Engine,
+    size: u32,
+    pairs: u32,
+) -> Result<Vec<(f64, f64, f64, f64)>> {
+    let one = workload::pool(Some(1))?;
+    let mut image: Option<Vec<u8>> = None;
+    let mut time = |p: &rayon::ThreadPool| -> Result<(f64, f64)> {
+        let r = p.install(|| trace::render(scene, engine, size, None));
+        match &image {
+            Some(first) if first.as_slice() != r.pixels() => Err(crate::error::input(format!(
+                "--paired-threads: the image at {} thread(s) differs from the first trace's",
+                p.current_num_threads()
+            ))),
+            Some(_) => Ok((r.trace_s, r.trace_cpu_s)),
+            None => {
+                image = Some(r.pixels().to_vec());
+                Ok((r.trace_s, r.trace_cpu_s))
+            }
+        }
+    };
+    // The one-thread pool's first render is slow (its thread's buffers, first touch), as the
+    // run's own pool was before its untimed render.
+    time(&one)?;
+    (0..pairs)
+        .map(|i| {
+            let ((w1, c1), (wn, cn)) = if i % 2 == 0 {
+                let a = time(&one)?;
+                (a, time(pool)?)
+            } else {
+                let b = time(pool)?;
+                (time(&one)?, b)
+            };
+            Ok((w1, wn, c1, cn))
         })
         .collect()
 }
@@ -111,6 +159,12 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             spec.paired
         )));
     }
+    if spec.paired_threads > MAX_PAIRS {
+        return Err(crate::error::input(format!(
+            "--paired-threads {}: at most {MAX_PAIRS} pairs",
+            spec.paired_threads
+        )));
+    }
     let pool = workload::pool(spec.threads)?;
     let prepared = workload::prepare(&spec.source)?;
     let scene = &prepared.input.scene;
@@ -158,6 +212,18 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             n,
         ))),
         _ => None,
+    };
+    let thread_scaling = if spec.paired_threads > 0 && pool.current_num_threads() > 1 {
+        let pairs = paired_thread_times(
+            &pool,
+            scene,
+            engine.as_ref(),
+            spec.size,
+            spec.paired_threads,
+        )?;
+        Some(ThreadScaling::of(pool.current_num_threads(), &pairs))
+    } else {
+        None
     };
     let check = if let (true, Some(yardstick)) = (spec.check, &yardstick) {
         let c = pool.install(|| {
@@ -222,6 +288,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         build_stats: engine.build_stats(),
         check,
         paired_ratio,
+        thread_scaling,
         image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(pixels))),
         wall_s: start.elapsed().as_secs_f64(),
         finished_at: super::env::now_utc(),

@@ -68,6 +68,8 @@ pub struct Common {
     pub check: bool,
     /// Pairs of engine and Embree traces timed back to back in the child (0: none).
     pub paired: u32,
+    /// Pairs of one-thread and N-thread traces timed back to back in the child (0: none).
+    pub paired_threads: u32,
     pub max_seconds: Option<f64>,
     pub max_memory: Option<u64>,
 }
@@ -198,6 +200,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     }
     if common.paired > 0 {
         cmd.args(["--paired", &common.paired.to_string()]);
+    }
+    if common.paired_threads > 0 {
+        cmd.args(["--paired-threads", &common.paired_threads.to_string()]);
     }
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())

@@ -102,14 +102,30 @@ pub fn available_threads() -> usize {
         .unwrap_or(1)
 }
 
+/// Environment variable that raises the most threads `--threads` takes above the machine's
+/// (`RTBENCH_MAX_THREADS=2`): for instruction counts and tests of a two-thread trace on a
+/// process pinned to one core (`taskset -c 1`, where the machine's count reads 1). Threads
+/// beyond the cores time nothing but the scheduler: not for time figures.
+pub const MAX_THREADS_VAR: &str = "RTBENCH_MAX_THREADS";
+
+/// The most threads `--threads` takes: the machine's ([`available_threads`]), or more with
+/// [`MAX_THREADS_VAR`] (at most 64).
+pub fn thread_limit() -> usize {
+    let most = available_threads();
+    std::env::var(MAX_THREADS_VAR)
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .map_or(most, |n| most.max(n.min(64)))
+}
+
 /// A rayon pool with `threads` threads (all cores when `None`). More threads than the machine
 /// runs at once are refused: they measure nothing but the scheduler (100,000 made a load
-/// average of 800 on two cores before failing).
+/// average of 800 on two cores before failing); [`MAX_THREADS_VAR`] raises the limit.
 pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     if threads == Some(0) {
         return Err(input("--threads must be at least 1"));
     }
-    let most = available_threads();
+    let most = thread_limit();
     if let Some(n) = threads.filter(|&n| n > most) {
         return Err(input(format!(
             "--threads {n}: more than the {most} this machine runs at once"

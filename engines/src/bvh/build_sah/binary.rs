@@ -121,7 +121,7 @@ pub fn binary_blocks_threads(mut s: Binned, rule: &BlockLeaves, threads: usize) 
     };
     // Two subtrees per thread so that an uneven split still keeps both cores busy.
     let forks = threads.next_power_of_two().trailing_zeros() as usize + 1;
-    fork_node(&mut s, &mut tree, &root, 0, rule, forks);
+    fork_node(&mut s, &mut tree, &root, 0, rule, forks, threads);
     tree.order = s.into_order();
     tree
 }
@@ -133,14 +133,18 @@ fn fork_node(
     depth: usize,
     rule: &BlockLeaves,
     forks: usize,
+    threads: usize,
 ) -> u32 {
     let n = r.len();
     if forks == 0 || n < 2 * FORK_MIN {
         return block_node(s, tree, r, depth, rule);
     }
     let packable = n <= rule.max && rule.packable(s.ids(r));
-    // (A range this large is never a leaf: n > max.)
-    let split = s.split(r, None, depth >= SAH_MEDIAN_DEPTH);
+    // (A range this large is never a leaf: n > max.) Only the top split has every thread
+    // free: below it each range has a thread of its own already. Its binning ran alone on
+    // one thread, 71 M instructions of the 403 M the first thread ran alone on balls4
+    // tessellated at two threads (callgrind, issue 20, session 12).
+    let split = s.split_threads(r, None, depth >= SAH_MEDIAN_DEPTH, threads);
     let leaf_cost = super::blocks(n, rule.block) as f32 * T_TRI;
     if packable && leaf_cost <= split.cost - T_AABB {
         return tree.push(r.bounds, leaf_kind(r));
@@ -157,11 +161,12 @@ fn fork_node(
                 depth + 1,
                 rule,
                 forks - 1,
+                1,
             );
             t
         });
         let mut t = BuildTree::default();
-        fork_node(s, &mut t, &split.left, depth + 1, rule, forks - 1);
+        fork_node(s, &mut t, &split.left, depth + 1, rule, forks - 1, 1);
         (t, right.join().expect("a build thread panicked"))
     });
     s.join(right_s);

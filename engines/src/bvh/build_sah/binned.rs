@@ -1,7 +1,7 @@
 //! Wald 2007's binned SAH split search.
 
 use super::{blocks, split_cost, Range, Split, Splitter};
-use crate::bvh::tree::BuildPrims;
+use crate::bvh::tree::{BuildPrims, PARALLEL_MIN};
 use crate::geometry::aabb::Aabb;
 use glam::Vec3A;
 
@@ -161,6 +161,34 @@ impl Binned {
         }
     }
 
+    /// [`Binned::new`] with the boxes converted on `threads` threads (contiguous parts; the
+    /// same boxes and order).
+    pub fn new_threads(prims: &BuildPrims, bins: usize, threads: usize) -> Binned {
+        let n = prims.len();
+        if threads <= 1 || n < 2 * PARALLEL_MIN {
+            return Binned::new(prims, bins);
+        }
+        let mut b = Binned {
+            boxes: vec![Box3A::EMPTY; n],
+            ..Binned::new(&BuildPrims::default(), bins)
+        };
+        b.ids = (0..n as u32).collect();
+        let part = n.div_ceil(threads);
+        std::thread::scope(|scope| {
+            for (from, to) in prims.bounds.chunks(part).zip(b.boxes.chunks_mut(part)) {
+                scope.spawn(move || {
+                    for (f, t) in from.iter().zip(to) {
+                        *t = Box3A {
+                            lo: f.lo.into(),
+                            hi: f.hi.into(),
+                        };
+                    }
+                });
+            }
+        });
+        b
+    }
+
     /// The same search with the SAH counting primitives in blocks of `block` (Embree's
     /// `sahBlockSize`), for leaves whose primitives are tested `block` at a time.
     pub fn with_block(mut self, block: usize) -> Binned {
@@ -235,12 +263,78 @@ impl Binned {
     }
 }
 
-impl Splitter for Binned {
-    fn root(&self) -> Range {
-        self.range(self.off, self.off + self.boxes.len())
+/// Counts and bounds the centres of `boxes` into `bins` on all three axes.
+#[inline(always)]
+fn bin_into(bins: &mut [[Bin; 3]; 256], boxes: &[Box3A], map: &BinMap) {
+    for p in boxes {
+        let k = map.bin_of(p.centre());
+        for a in 0..3 {
+            // k < nb ≤ 256: the u8 is the bin itself, and indexes the 256 bins unchecked.
+            let bin = &mut bins[k[a] as u8 as usize][a];
+            bin.bounds.grow(p);
+            bin.count += 1;
+        }
+    }
+}
+
+/// [`bin_into`] on `threads` threads, each binning a contiguous part of `boxes` into bins of
+/// its own, then merged into `bins` (the first `nb` of each axis). A bin's count is a sum and
+/// its box a union (min and max, exact), whichever thread saw which box, so the bins, and the
+/// split chosen from them, are the one-thread search's (for boxes without NaN: the scenes'
+/// coordinates are finite, `rtbench_scenes::validate`).
+fn bin_threads(
+    bins: &mut [[Bin; 3]; 256],
+    boxes: &[Box3A],
+    map: &BinMap,
+    nb: usize,
+    threads: usize,
+) {
+    let part = boxes.len().div_ceil(threads);
+    let parts: Vec<Box<[[Bin; 3]; 256]>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = boxes
+            .chunks(part)
+            .map(|chunk| {
+                scope.spawn(move || {
+                    let mut own = Box::new([[Bin::EMPTY; 3]; 256]);
+                    bin_into(&mut own, chunk, map);
+                    own
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a binning thread panicked"))
+            .collect()
+    });
+    for own in &parts {
+        for (row, mine) in bins[..nb].iter_mut().zip(&own[..nb]) {
+            for (b, m) in row.iter_mut().zip(mine) {
+                b.bounds.grow(&m.bounds);
+                b.count += m.count;
+            }
+        }
+    }
+}
+
+impl Binned {
+    /// [`Splitter::split`] with the binning pass (48 instructions per primitive, issue 20
+    /// session 10) on `threads` threads when the range is large: for the top split of a
+    /// parallel build, where every other thread would wait (`binary_blocks_threads`). The
+    /// split is the one-thread search's ([`bin_threads`]).
+    pub fn split_threads(
+        &mut self,
+        r: &Range,
+        axis: Option<usize>,
+        median: bool,
+        threads: usize,
+    ) -> Split {
+        self.split_on(r, axis, median, threads)
     }
 
-    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
+    /// The split search; `threads` 1 from [`Splitter::split`], a constant once inlined, so the
+    /// one-thread build's code is as before.
+    #[inline(always)]
+    fn split_on(&mut self, r: &Range, axis: Option<usize>, median: bool, threads: usize) -> Split {
         debug_assert!(r.len() >= 2);
         let cb = r.centroids;
         if median {
@@ -254,16 +348,12 @@ impl Splitter for Binned {
         let (start, end) = (r.start - self.off, r.end - self.off);
         // Every bin is empty between splits (the sweeps below empty the ones they used), so
         // no clearing pass is needed.
-        let bins: &mut [[Bin; 3]; 256] = &mut self.bins;
-        for p in &self.boxes[start..end] {
-            let k = map.bin_of(p.centre());
-            for a in 0..3 {
-                // k < nb ≤ 256: the u8 is the bin itself, and indexes the 256 bins unchecked.
-                let bin = &mut bins[k[a] as u8 as usize][a];
-                bin.bounds.grow(p);
-                bin.count += 1;
-            }
+        if threads > 1 && r.len() >= 2 * PARALLEL_MIN {
+            bin_threads(&mut self.bins, &self.boxes[start..end], &map, nb, threads);
+        } else {
+            bin_into(&mut self.bins, &self.boxes[start..end], &map);
         }
+        let bins: &mut [[Bin; 3]; 256] = &mut self.bins;
         // An empty bin leaves both sides' boxes and counts as they were, so the plane after it
         // costs exactly what the plane before it does and never wins (ties keep the first
         // plane): the sweeps run over the filled bins only, `filled[..m]` in order. Small
@@ -365,6 +455,16 @@ impl Splitter for Binned {
             axis: a,
             cost: split_cost(c, r.bounds.half_area()),
         }
+    }
+}
+
+impl Splitter for Binned {
+    fn root(&self) -> Range {
+        self.range(self.off, self.off + self.boxes.len())
+    }
+
+    fn split(&mut self, r: &Range, axis: Option<usize>, median: bool) -> Split {
+        self.split_on(r, axis, median, 1)
     }
 
     fn ids(&self, r: &Range) -> &[u32] {
