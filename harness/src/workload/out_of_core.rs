@@ -330,14 +330,16 @@ pub fn render_view(
             codec,
         )?;
         let mut file = rays.reader()?;
-        let mut group: Vec<(Ray, Path)> = Vec::with_capacity(group_len);
-        let mut order: Vec<u32> = Vec::with_capacity(group_len);
-        let mut term = vec![Vec3::ZERO; group_len];
+        // A generation smaller than a group holds only its own rays.
+        let held = group_len.min(n as usize);
+        let mut group: Vec<(Ray, Path)> = Vec::with_capacity(held);
+        let mut order: Vec<u32> = Vec::with_capacity(held);
+        let mut term = vec![Vec3::ZERO; held];
         let mut out_next: Vec<(u32, Ray, Path)> = Vec::new();
         let mut out_shadow: Vec<(u32, Ray, u32, Vec3)> = Vec::new();
         let mut buf = [0u8; RAY_RECORD];
         let mut hb = [0u8; HIT_RECORD];
-        let mut hits = vec![Hit::MISS; group_len];
+        let mut hits = vec![Hit::MISS; held];
         let mut first = 0u64;
         for mut bucket in buckets {
             let count = (n - first).min(group_len as u64) as usize;
