@@ -52,11 +52,11 @@ fn packet_of(ids: &[u32], geometry: &Geometry) -> LeafPacket {
 }
 
 /// [`lay_out`] with the triangle packets made on `threads` threads: one pass numbers the
-/// leaves and rewrites the references exactly as [`lay_out`] does (and copies the scalar
-/// leaves' primitives), then each thread fills a contiguous part of the packets. The same
-/// references, packets and primitives. Packet making was 80 M of the 403 M instructions the
-/// first thread ran alone in a two-thread build of balls4 tessellated (callgrind, issue 20,
-/// session 12).
+/// leaves and rewrites the references (and copies the scalar leaves' primitives), then each
+/// thread fills a contiguous part of the packets; one thread fills them all in that pass's
+/// order. The same references, packets and primitives at any thread count. Packet making was
+/// 80 M of the 403 M instructions the first thread ran alone in a two-thread build of balls4
+/// tessellated (callgrind, issue 20, session 12).
 pub fn lay_out_threads<const N: usize>(
     nodes: &mut [WideNode<N>],
     root: &mut u32,
@@ -65,9 +65,6 @@ pub fn lay_out_threads<const N: usize>(
     packets: bool,
     threads: usize,
 ) -> Leaves {
-    if threads <= 1 || !packets {
-        return lay_out(nodes, root, order, geometry, packets);
-    }
     let mut out = Leaves::default();
     // (first of the leaf's range of `order`, its count, its first packet), in packet order.
     let mut jobs: Vec<(u32, u32, u32)> = Vec::new();
@@ -78,9 +75,10 @@ pub fn lay_out_threads<const N: usize>(
         }
         let (first, count) = leaf_range(r);
         let ids = &order[first..first + count];
-        if ids
-            .iter()
-            .all(|&i| matches!(geometry.prims[i as usize], Prim::Triangle(_)))
+        if packets
+            && ids
+                .iter()
+                .all(|&i| matches!(geometry.prims[i as usize], Prim::Triangle(_)))
         {
             let at = next;
             next += count.div_ceil(PACKET) as u32;
@@ -106,6 +104,19 @@ pub fn lay_out_threads<const N: usize>(
         object: [u32::MAX; PACKET],
     };
     out.packets = vec![blank; next as usize];
+    let fill = |slice: &mut [LeafPacket], mine: &[(u32, u32, u32)], from: usize| {
+        for &(first, count, at) in mine {
+            let ids = &order[first as usize..(first + count) as usize];
+            let at = at as usize - from;
+            for (p, o) in slice[at..].iter_mut().zip(ids.chunks(PACKET)) {
+                *p = packet_of(o, geometry);
+            }
+        }
+    };
+    if threads <= 1 {
+        fill(&mut out.packets, &jobs, 0);
+        return out;
+    }
     // Cut the jobs where the packets reach each thread's share; each part fills its own
     // contiguous packets.
     let share = (next as usize).div_ceil(threads).max(1);
@@ -123,15 +134,8 @@ pub fn lay_out_threads<const N: usize>(
             let upto = more_jobs.first().map_or(next as usize, |j| j.2 as usize);
             let (slice, more) = std::mem::take(&mut rest).split_at_mut(upto - base);
             let from = base;
-            scope.spawn(move || {
-                for &(first, count, at) in mine {
-                    let ids = &order[first as usize..(first + count) as usize];
-                    let at = at as usize - from;
-                    for (p, o) in slice[at..].iter_mut().zip(ids.chunks(PACKET)) {
-                        *p = packet_of(o, geometry);
-                    }
-                }
-            });
+            let fill = &fill;
+            scope.spawn(move || fill(slice, mine, from));
             rest = more;
             jobs_left = more_jobs;
             base = upto;
@@ -150,50 +154,5 @@ pub fn lay_out<const N: usize>(
     geometry: &Geometry,
     packets: bool,
 ) -> Leaves {
-    let mut out = Leaves::default();
-    if packets {
-        // Reserved once (exactly, when every leaf is of triangles): growing one by one
-        // reallocated and copied the 160-byte packets.
-        let leaf_refs = std::iter::once(*root).chain(
-            nodes
-                .iter()
-                .flat_map(|n| n.child[..n.len as usize].iter().copied()),
-        );
-        let most: usize = leaf_refs
-            .filter(|&r| is_leaf(r) && r != EMPTY_SLOT)
-            .map(|r| leaf_range(r).1.div_ceil(PACKET))
-            .sum();
-        out.packets.reserve_exact(most);
-    }
-    let mut place = |r: u32| -> u32 {
-        if !is_leaf(r) || r == EMPTY_SLOT {
-            return r;
-        }
-        let (first, count) = leaf_range(r);
-        let ids = &order[first..first + count];
-        let all_triangles = ids
-            .iter()
-            .all(|&i| matches!(geometry.prims[i as usize], Prim::Triangle(_)));
-        if packets && all_triangles {
-            let at = out.packets.len() as u32;
-            for o in ids.chunks(PACKET) {
-                out.packets.push(packet_of(o, geometry));
-            }
-            packet_leaf_ref(at, count as u32)
-        } else {
-            let at = out.prims.len() as u32;
-            for &i in ids {
-                out.prims.push(geometry.prims[i as usize]);
-                out.objects.push(geometry.prim_object[i as usize]);
-            }
-            super::node::leaf_ref(at, count as u32)
-        }
-    };
-    *root = place(*root);
-    for node in nodes.iter_mut() {
-        for slot in 0..node.len as usize {
-            node.child[slot] = place(node.child[slot]);
-        }
-    }
-    out
+    lay_out_threads(nodes, root, order, geometry, packets, 1)
 }
