@@ -225,3 +225,72 @@ fn nakamaru_4_3_runs_a_scenes_basic_rows_before_its_split_store() {
         assert_eq!(m[i]["sgb"]["sha256"].as_str().unwrap(), hex, "{row}");
     }
 }
+
+/// `methods` measures a row one method an invocation (a 10^9-object row takes more than a
+/// session per method): S+G+B first with no basic store written, then the capped basic run,
+/// whose pass model takes its totals from the S+G+B run saved before, then S+G (its split store
+/// written again when the disk no longer holds it), which finishes the rows and removes their
+/// stores.
+#[test]
+fn nakamaru_4_3_measures_one_method_an_invocation() {
+    let d = Dir::new("seg-cli", "methods");
+    let out = d.join("out");
+    let run = |extra: &[&str]| -> (Value, String) {
+        let mut args = vec!["reproduce", "nakamaru-4.3", "--out", &out, "--resume"];
+        for s in ["rows=rings2,rings2m", "size=16", "segment=100", "cache=warm"]
+            .iter()
+            .chain(extra)
+        {
+            args.push("--set");
+            args.push(s);
+        }
+        let r = rtbench(&args);
+        let err = String::from_utf8_lossy(&r.stderr).to_string();
+        assert!(r.status.success(), "{err}");
+        let v = serde_json::from_slice(
+            &std::fs::read(Path::new(&out).join("nakamaru-4.3.json")).unwrap(),
+        )
+        .unwrap();
+        (v, err)
+    };
+    let (v, err) = run(&["methods=sgb"]);
+    assert_eq!(v["finished"], false);
+    assert!(!err.contains("basic store"), "{err}");
+    assert!(!err.contains("S+G …"), "{err}");
+    for i in 0..2 {
+        let m = &v["measured"][i];
+        assert!(m["sgb"]["passes"].as_u64().unwrap() > 0, "{m}");
+        assert!(m["basic"].is_null() && m["sg"].is_null(), "{m}");
+    }
+    let (v, err) = run(&["methods=basic", "basic-passes=1"]);
+    assert_eq!(v["finished"], false);
+    assert!(!err.contains("S+G+B …") && !err.contains("split store"), "{err}");
+    for i in 0..2 {
+        let m = &v["measured"][i];
+        let b = &m["basic"];
+        assert_eq!(b["capped"], true, "{b}");
+        assert_eq!(b["passes_from"], "S+G+B", "{b}");
+        assert_eq!(b["passes_total"], m["sgb"]["passes"], "{m}");
+        assert!(b["sweeps_total"].as_u64().unwrap() > 0, "{b}");
+        assert!(m["sg"].is_null(), "{m}");
+    }
+    // The stores gone (another machine): the split store the steps name is written again.
+    let stores = Path::new(&out).join(".partial/nakamaru-4.3/stores");
+    std::fs::remove_dir_all(&stores).unwrap();
+    let (v, err) = run(&["methods=sg,basic"]);
+    assert!(err.contains("rings2: the store saved steps name is not at"), "{err}");
+    assert_eq!(err.matches("split store (in segments)").count(), 1, "{err}");
+    assert_eq!(v["finished"], true);
+    assert!(v["measured"][1]["sg"]["passes"].as_u64().unwrap() > 0);
+    assert!(!Path::new(&out)
+        .join(".partial/nakamaru-4.3/stores")
+        .exists());
+    expect_input_error(
+        &["reproduce", "nakamaru-4.3", "--out", &out, "--set", "methods=sgb,fast"],
+        "methods 'fast'",
+    );
+    expect_input_error(
+        &["reproduce", "nakamaru-4.3", "--out", &out, "--set", "basic-subspaces=2"],
+        "basic-subspaces needs basic-passes",
+    );
+}

@@ -323,6 +323,15 @@ impl BreadthFirstConfig {
         };
         let grid = super::hires::config::GridKind::from_settings(&mut s)?;
         s.finish()?;
+        if let super::hires::config::GridKind::TwoLevel(tl) = &grid {
+            if let (Some(k), 0) = (tl.max_subspaces, max_passes) {
+                return Err(bad(
+                    "hrgrid_subspaces",
+                    &k.to_string(),
+                    "a partial grid's answers are not the scene's: it needs max_passes (whose runs claim no image)",
+                ));
+            }
+        }
         if buffer < 64 {
             return Err(bad("buffer", &buffer.to_string(), "at least 64 bytes"));
         }

@@ -247,3 +247,70 @@ fn a_resumed_grid_build_sweeps_only_the_subspaces_not_yet_on_disk() {
     drop(open("build", "5"));
     assert!(!progress.exists());
 }
+
+/// `hrgrid_subspaces=K`: the build sweeps the first K subspaces only (each reading every box
+/// of the store, as the whole build's do), the grid is opened at its whole length and then
+/// removed from the store, so that no later run takes it; without `max_passes` (a run that
+/// claims an image) or with `hrgrid=resume` the setting is refused.
+#[test]
+fn a_partial_grid_build_sweeps_k_subspaces_and_leaves_no_grid_behind() {
+    let input = spd(Program::Tetra, 4);
+    let dir = TempDir::new("hr-partial");
+    StoreWriter::create(&dir.0, "tetra4")
+        .unwrap()
+        .write_scene(&input.scene)
+        .unwrap();
+    let config = |extra: &[(&str, &str)]| {
+        let mut pairs = vec![("grid", "two-level"), ("upper", "4"), ("subspace", "5")];
+        pairs.extend_from_slice(extra);
+        BreadthFirstConfig::from_settings(Settings::new("breadth-first", kv(&pairs)))
+    };
+    let whole = BreadthFirst::open(&dir.0, config(&[]).unwrap()).unwrap();
+    let w = whole.build_stats().clone();
+    drop(whole);
+    let path = dir.0.join(FILE_NAME);
+    assert!(path.exists());
+    let e = BreadthFirst::open(
+        &dir.0,
+        config(&[("hrgrid_subspaces", "3"), ("max_passes", "1")]).unwrap(),
+    )
+    .unwrap();
+    let s = e.build_stats().clone();
+    assert_eq!(s["hr_subspaces"], 3.0);
+    assert_eq!(s["hr_subspaces_total"], w["hr_subspaces"]);
+    assert!(w["hr_subspaces"] >= 8.0);
+    assert_eq!((s["hr_build_partial"], w["hr_build_partial"]), (1.0, 0.0));
+    assert_eq!(
+        s["hr_build_boxes_read"] * w["hr_subspaces"],
+        w["hr_build_boxes_read"] * 3.0
+    );
+    assert!(!path.exists(), "a partial grid was left in the store");
+    // The run goes on with the grid it holds open: one pass, then the cap.
+    let rays: Vec<Ray> = (0..64)
+        .map(|i| {
+            Ray::new(
+                Vec3::new(-3.0, 0.01 * i as f32, 0.1),
+                Vec3::X,
+                0.0,
+                f32::INFINITY,
+            )
+        })
+        .collect();
+    let mut c = Counters::default();
+    let mut n = 0;
+    e.trace_stream(
+        &mut rays.iter().copied().enumerate().map(|(i, r)| (i as u32, r)),
+        false,
+        &mut |_, _| n += 1,
+        &mut c,
+    )
+    .unwrap();
+    assert_eq!(c.extra["bf_passes"], 1);
+    for bad in [
+        &[("hrgrid_subspaces", "3")][..],
+        &[("hrgrid_subspaces", "3"), ("max_passes", "1"), ("hrgrid", "resume")][..],
+    ] {
+        let e = config(bad).err().expect("refused").to_string();
+        assert!(e.contains("hrgrid_subspaces") && !e.contains('\n'), "{e}");
+    }
+}

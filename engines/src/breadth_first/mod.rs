@@ -46,6 +46,7 @@
 //! | `block` | bytes | 1/8 of `memory` | one X-slab block of the on-disk grid (`two-level`) |
 //! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
 //! | `hrgrid` | `build`, `reuse`, `resume` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there; `resume`: make it keeping `hrgrid.progress.json` after each subspace, and take up an interrupted or finished build of the same grid (its subspaces and seconds from the record: `hr_build_resumed_subspaces`, `hr_build_prior_s`, both counted in `hr_build_s` and `preprocess_s`) |
+//! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than a session, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -369,6 +370,7 @@ impl BreadthFirst {
                         tree.as_mut(),
                         &floor_ids,
                         tl.resume,
+                        tl.max_subspaces,
                     )
                     .map_err(|e| err(e.to_string()))?;
                     prior_s = st.prior_s;
@@ -376,6 +378,8 @@ impl BreadthFirst {
                     hr_stats.insert("hr_build_prior_s".into(), st.prior_s);
                     hr_stats.insert("hr_subspace_side".into(), st.side as f64);
                     hr_stats.insert("hr_subspaces".into(), st.subspaces as f64);
+                    hr_stats.insert("hr_subspaces_total".into(), st.total as f64);
+                    hr_stats.insert("hr_build_partial".into(), f64::from(u8::from(st.partial)));
                     hr_stats.insert("hr_build_boxes_read".into(), st.boxes_read as f64);
                     hr_stats.insert("hr_build_nodes_culled".into(), st.nodes_culled as f64);
                     hr_stats.insert("hr_build_objects_culled".into(), st.objects_culled as f64);
@@ -386,6 +390,13 @@ impl BreadthFirst {
                 hr_stats.insert("hr_build_s".into(), prior_s + tb.elapsed().as_secs_f64());
                 let grid = hires::disk_grid::DiskGrid::open(dir, &voxels, floor.len() as u64)
                     .map_err(|e| err(e.to_string()))?;
+                if tl.max_subspaces.is_some() {
+                    // A partial grid (`hrgrid_subspaces`) is held open and never left where
+                    // `hrgrid=reuse` or `resume` would take it.
+                    let path = dir.join(hires::disk_grid::FILE_NAME);
+                    std::fs::remove_file(&path)
+                        .map_err(|e| err(format!("{}: {e}", path.display())))?;
+                }
                 hr_stats.insert(
                     "hr_grid_file_bytes".into(),
                     (hires::disk_grid::HEADER + hires::disk_grid::flag_bytes(res3)) as f64,

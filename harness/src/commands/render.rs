@@ -252,7 +252,7 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
                    "peak_rss_bytes": workload::peak_rss_bytes()},
         "counters": r.counters,
         "io": {"workload": ooc.io},
-        "shading": {"group_rays": ooc.shade_group, "store_sweeps": ooc.shade_sweeps},
+        "shading": {"group_rays": ooc.shade_group, "store_sweeps": ooc.shade_sweeps, "cap_rays": ooc.shade_cap},
         "build_stats": rtbench_engines::Engine::build_stats(&engine),
         "image": {"width": a.size, "height": a.size, "sha256": sha, "incomplete": capped},
     });

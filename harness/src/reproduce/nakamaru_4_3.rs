@@ -93,6 +93,14 @@ const SPLIT_COMPRESS: Param = Param {
     key: "split-compress",
     help: "the split store: zstd (default; zstd blocks, ~2-3x smaller, so that 10^9 objects fit the disk), zstd:LEVEL or none",
 };
+const SUBSPACES: Param = Param {
+    key: "basic-subspaces",
+    help: "with basic-passes: build only the first K subspaces of the basic run's on-disk grid (hrgrid_subspaces=K; the rest left empty) and extrapolate the grid's build by the subspaces in all (a model; rings368's basic build is 27 sweeps of its 35 GB store, ~4 h)",
+};
+const METHODS: Param = Param {
+    key: "methods",
+    help: "the methods this invocation measures, of basic,sgb,sg (default all three); the others keep what earlier invocations saved, so a 10^9-object row can be measured one method a session (e.g. methods=sgb first: the split store and S+G+B only)",
+};
 const FRACTION: Param = Param {
     key: "basic-fraction",
     help: "trace the basic method on every N-th band of rows only and extrapolate (a model; default 1: whole)",
@@ -118,6 +126,8 @@ pub const TABLE: Table = Table {
         MAX_SECONDS,
         FRACTION,
         PASSES,
+        SUBSPACES,
+        METHODS,
         SPLIT_COMPRESS,
     ],
     claims: &[
@@ -234,6 +244,14 @@ struct Run {
     /// saved before S+G+B ran first).
     #[serde(default)]
     passes_from: String,
+    /// The on-disk grid's build: its seconds, and the subspaces it swept of the grid's all
+    /// (fewer with `basic-subspaces`: then a model). 0 in rows saved before they were kept.
+    #[serde(default)]
+    hr_build_s: f64,
+    #[serde(default)]
+    subspaces: u64,
+    #[serde(default)]
+    subspaces_total: u64,
 }
 
 impl Run {
@@ -246,12 +264,46 @@ impl Run {
         }
     }
 
+    /// Whether the grid's build stopped short of its subspaces (`basic-subspaces`).
+    fn partial_grid(&self) -> bool {
+        self.subspaces > 0 && self.subspaces < self.subspaces_total
+    }
+
+    /// Preprocessing, the grid's build extrapolated by its subspaces when it stopped short:
+    /// every subspace of the basic layout reads the whole store, so each costs about the same.
+    fn pre_s(&self) -> f64 {
+        if self.partial_grid() {
+            self.preprocess_s
+                + self.hr_build_s * (self.subspaces_total as f64 / self.subspaces as f64 - 1.0)
+        } else {
+            self.preprocess_s
+        }
+    }
+
+    /// Preprocessing, written out.
+    fn pre_text(&self) -> String {
+        if self.partial_grid() {
+            format!(
+                "pre {:.1} s, of which the grid's build {:.1} s over {} of its {} subspaces, × {} / {} = {:.1} s",
+                self.preprocess_s,
+                self.hr_build_s,
+                self.subspaces,
+                self.subspaces_total,
+                self.subspaces_total,
+                self.subspaces,
+                self.pre_s()
+            )
+        } else {
+            format!("pre {:.1} s", self.preprocess_s)
+        }
+    }
+
     /// Preprocessing + tracing, the tracing extrapolated when only a tile set or the first
     /// passes were traced ([`Run::split_model`] when the run kept its split).
     fn total_s(&self) -> f64 {
         match self.split_model() {
-            Some((passes_s, shade_s, other_s)) => self.preprocess_s + passes_s + shade_s + other_s,
-            None => self.preprocess_s + self.trace_s * self.scale,
+            Some((passes_s, shade_s, other_s)) => self.pre_s() + passes_s + shade_s + other_s,
+            None => self.pre_s() + self.trace_s * self.scale,
         }
     }
 
@@ -333,8 +385,40 @@ struct Setup {
     deadline: Option<Instant>,
     fraction: u32,
     passes: Option<u64>,
+    subspaces: Option<u64>,
     split_codec: Codec,
     view: View,
+    methods: Methods,
+}
+
+/// The methods one invocation measures (`methods`).
+#[derive(Clone, Copy)]
+struct Methods {
+    basic: bool,
+    sg: bool,
+    sgb: bool,
+}
+
+impl Methods {
+    fn parse(id: &str, list: Option<Vec<String>>) -> Result<Methods> {
+        let Some(list) = list else {
+            return Ok(Methods { basic: true, sg: true, sgb: true });
+        };
+        let mut m = Methods { basic: false, sg: false, sgb: false };
+        for item in &list {
+            match item.as_str() {
+                "basic" => m.basic = true,
+                "sg" => m.sg = true,
+                "sgb" => m.sgb = true,
+                other => {
+                    return Err(input(format!(
+                        "{id}: methods '{other}': expected basic, sg or sgb (comma-separated)"
+                    )))
+                }
+            }
+        }
+        Ok(m)
+    }
 }
 
 /// Writes (or goes on writing) the store at `dir`; `None` when stopped by the deadline.
@@ -412,6 +496,12 @@ fn trace(
         .copied()
         .unwrap_or(0.0);
     let preprocess_s = earlier_s + t.elapsed().as_secs_f64();
+    let stat = |k: &str| engine.build_stats().get(k).copied().unwrap_or(0.0);
+    let (hr_build_s, subspaces, subspaces_total) = (
+        stat("hr_build_s"),
+        stat("hr_subspaces") as u64,
+        stat("hr_subspaces_total") as u64,
+    );
     let ooc = out_of_core::render_view(&engine, s.size, tile, view)
         .map_err(|e| input(format!("{}: out-of-core render: {e}", dir.display())))?;
     let r = &ooc.render;
@@ -456,6 +546,9 @@ fn trace(
         generation_rays: r.stats.generations.iter().map(|g| g.rays).collect(),
         sweeps_total: 0,
         passes_from: String::new(),
+        hr_build_s,
+        subspaces,
+        subspaces_total,
     })
 }
 
@@ -498,13 +591,14 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
     if m.basic.is_some() {
         return Ok(true);
     }
-    if past(s) {
+    if past(s) || !s.methods.basic {
         return Ok(false);
     }
     let src = super::grid_runs::resolve(&m.scene, m.sf)?;
     let save = |m: &Measured| ctx.checkpoint.save(&row_key(m, s), m);
     let view = (m.view == "m").then_some(&s.view);
     let dir = store_dir(m, s, "basic");
+    forget_lost_store(&mut m.basic_store, &dir, &m.row);
     if m.basic_store.is_none() {
         eprintln!("nakamaru-4.3: {}: basic store (gzip, in segments) …", m.row);
         match write_store(&src, &dir, Layout::Basic, Codec::Gzip(1), s)? {
@@ -520,9 +614,15 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
     eprintln!("nakamaru-4.3: {}: basic …", m.row);
     let basic_sets = [("layout", "basic")];
     let cap = s.passes.map(|n| n.to_string());
-    let capped_sets = cap
-        .as_deref()
-        .map(|n| [("layout", "basic"), ("max_passes", n)]);
+    let subspaces = s.subspaces.map(|k| k.to_string());
+    let capped_sets: Option<Vec<(&str, &str)>> = cap.as_deref().map(|n| {
+        let mut v = vec![("layout", "basic"), ("max_passes", n)];
+        if let Some(k) = subspaces.as_deref() {
+            // A partial grid is built afresh (never resumed or left behind).
+            v.extend([("hrgrid", "build"), ("hrgrid_subspaces", k)]);
+        }
+        v
+    });
     if ctx.quick {
         // The model's test: the part beside the whole.
         m.basic_tile = Some(match &capped_sets {
@@ -531,7 +631,15 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
         });
         m.basic = Some(trace(&dir, s, view, None, &basic_sets, None)?);
     } else if let Some(sets) = &capped_sets {
-        m.basic = Some(trace(&dir, s, view, None, sets, None)?);
+        let mut b = trace(&dir, s, view, None, sets, None)?;
+        // Split runs measured before (`methods`): the model's totals from the first of them.
+        if let Some((name, r)) = [("S+G+B", &m.sgb), ("S+G", &m.sg)]
+            .into_iter()
+            .find_map(|(n, r)| r.as_ref().map(|r| (n, r)))
+        {
+            complete_model(&mut b, r, name);
+        }
+        m.basic = Some(b);
     } else {
         let tile = (s.fraction > 1).then_some(ShardSpec {
             k: 1,
@@ -546,25 +654,47 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
     Ok(true)
 }
 
+/// A store a saved step names but the disk no longer holds (the steps were carried to another
+/// machine, or the stores removed) is written again rather than traced and failed on.
+fn forget_lost_store(step: &mut Option<StoreStep>, dir: &Path, row: &str) {
+    if step.is_some() && StoreHeader::read(dir).is_err() {
+        eprintln!(
+            "nakamaru-4.3: {row}: the store saved steps name is not at {}; writing it again",
+            dir.display()
+        );
+        *step = None;
+    }
+}
+
 /// The split store (zstd blocks by default), S+G and S+G+B of one row; returns whether done.
 fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
     let src = super::grid_runs::resolve(&m.scene, m.sf)?;
     let save = |m: &Measured| ctx.checkpoint.save(&row_key(m, s), m);
     let view = (m.view == "m").then_some(&s.view);
+    let mut done = true;
     // S+G+B first: it is the method Table 4.3 compares with the basic one (S+G at 10^9 objects
     // takes hours, S+G+B minutes), so a budget spent between the two leaves that row measured.
     for (name, sets) in [
         ("S+G+B", &[("layout", "split"), ("hierarchy", "on")][..]),
         ("S+G", &[("layout", "split")][..]),
     ] {
-        let slot = if name == "S+G" { &m.sg } else { &m.sgb };
+        let (slot, wanted) = if name == "S+G" {
+            (&m.sg, s.methods.sg)
+        } else {
+            (&m.sgb, s.methods.sgb)
+        };
         if slot.is_some() {
+            continue;
+        }
+        if !wanted {
+            done = false;
             continue;
         }
         if past(s) {
             return Ok(false);
         }
         let dir = store_dir(m, s, "split");
+        forget_lost_store(&mut m.split_store, &dir, &m.row);
         if m.split_store.is_none() {
             eprintln!("nakamaru-4.3: {}: split store (in segments) …", m.row);
             match write_store(&src, &dir, Layout::Split, s.split_codec, s)? {
@@ -588,12 +718,7 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
         // The pass model's total: the passes of the first split run measured (the same grid,
         // rays and memory budget; S+G and S+G+B made the same passes on every row so far).
         for b in [m.basic.as_mut(), m.basic_tile.as_mut()].into_iter().flatten() {
-            if b.capped && b.passes > 0 && b.passes_total == 0 {
-                b.passes_total = r.passes;
-                b.passes_from = name.to_string();
-                b.scale = r.passes as f64 / b.passes as f64;
-                b.sweeps_total = sweeps(&r.generation_rays, b.shade_group);
-            }
+            complete_model(b, &r, name);
         }
         if name == "S+G" {
             m.sg = Some(r);
@@ -602,7 +727,19 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
         }
         save(m)?;
     }
-    Ok(true)
+    Ok(done)
+}
+
+/// A capped basic run's model totals, from a split run of the same row (the same grid, rays and
+/// memory budget: S+G and S+G+B made the same passes on every row so far): its pass count and
+/// the whole run's shading sweeps. Left alone once set, or when the run is not capped.
+fn complete_model(b: &mut Run, r: &Run, name: &str) {
+    if b.capped && b.passes > 0 && b.passes_total == 0 {
+        b.passes_total = r.passes;
+        b.passes_from = name.to_string();
+        b.scale = r.passes as f64 / b.passes as f64;
+        b.sweeps_total = sweeps(&r.generation_rays, b.shade_group);
+    }
 }
 
 /// A scene's rows share its stores: row `i` takes the `kind` store step of an earlier row of
@@ -645,6 +782,9 @@ fn measure_rows(ctx: &Ctx, measured: &mut [Measured], s: &Setup) -> Result<bool>
             scenes.push(base(m));
         }
     }
+    // A step left out by `methods` leaves its row unfinished, but the other steps go on; the
+    // time budget stops everything.
+    let mut all = true;
     for scene in &scenes {
         let group: Vec<usize> = (0..measured.len())
             .filter(|&i| base(&measured[i]) == *scene)
@@ -653,17 +793,23 @@ fn measure_rows(ctx: &Ctx, measured: &mut [Measured], s: &Setup) -> Result<bool>
             let keep_basic = group[k + 1..].iter().any(|&j| measured[j].basic.is_none());
             share_store(measured, &group[..k], i, s, "basic");
             if !measure_basic(ctx, &mut measured[i], s, keep_basic)? {
-                return Ok(false);
+                if past(s) || s.methods.basic {
+                    return Ok(false);
+                }
+                all = false;
             }
         }
         for (k, &i) in group.iter().enumerate() {
             share_store(measured, &group[..k], i, s, "split");
             if !measure_split(ctx, &mut measured[i], s)? {
-                return Ok(false);
+                if past(s) {
+                    return Ok(false);
+                }
+                all = false;
             }
         }
     }
-    Ok(true)
+    Ok(all)
 }
 
 fn run(ctx: &Ctx) -> Result<Output> {
@@ -675,6 +821,12 @@ fn run(ctx: &Ctx) -> Result<Output> {
     workload::check_size(size)?;
     let fraction = ctx.params.number::<u32>(FRACTION.key, 1)?.unwrap_or(1);
     let passes = ctx.params.number::<u64>(PASSES.key, 1)?;
+    let subspaces = ctx.params.number::<u64>(SUBSPACES.key, 1)?;
+    if subspaces.is_some() && passes.is_none() {
+        return Err(input(
+            "nakamaru-4.3: basic-subspaces needs basic-passes: a partial grid's answers are not the scene's, so its run is a capped model",
+        ));
+    }
     if passes.is_some() && fraction > 1 {
         return Err(input(
             "nakamaru-4.3: basic-passes and basic-fraction are two models of one run: give one",
@@ -710,8 +862,10 @@ fn run(ctx: &Ctx) -> Result<Output> {
         deadline: max_seconds.map(|x| Instant::now() + Duration::from_secs_f64(x)),
         fraction,
         passes,
+        subspaces,
         split_codec,
         view,
+        methods: Methods::parse(ctx.id, ctx.params.list(METHODS.key)?)?,
     };
     let names: Vec<String> = match ctx.params.list(ROWS.key)? {
         Some(l) => l,
@@ -855,13 +1009,13 @@ fn model_text(r: &Run) -> String {
     if r.capped {
         return if r.passes_total == 0 {
             format!(
-                "pre {:.1} s + trace {:.1} s (first {} passes) × (the split runs' passes, not yet measured)",
-                r.preprocess_s, r.trace_s, r.passes
+                "{} + trace {:.1} s (first {} passes) × (the split runs' passes, not yet measured)",
+                r.pre_text(), r.trace_s, r.passes
             )
         } else if let Some((passes_s, shade_s, other_s)) = r.split_model() {
             format!(
-                "pre {:.1} s + passes {:.1} s (first {}) × {} / {} ({}'s passes) + shading {:.1} s ({} sweeps of the store) × {} / {} (the whole run's groups of {} rays) + other {:.1} s = {:.1} s (passes {:.1} s, shading {:.1} s)",
-                r.preprocess_s,
+                "{} + passes {:.1} s (first {}) × {} / {} ({}'s passes) + shading {:.1} s ({} sweeps of the store) × {} / {} (the whole run's groups of {} rays) + other {:.1} s = {:.1} s (passes {:.1} s, shading {:.1} s)",
+                r.pre_text(),
                 r.intersect_s,
                 r.passes,
                 r.passes_total,
@@ -879,8 +1033,8 @@ fn model_text(r: &Run) -> String {
             )
         } else {
             format!(
-                "pre {:.1} s + trace {:.1} s (first {} passes) × {} / {} ({}'s passes) = {:.1} s",
-                r.preprocess_s,
+                "{} + trace {:.1} s (first {} passes) × {} / {} ({}'s passes) = {:.1} s",
+                r.pre_text(),
                 r.trace_s,
                 r.passes,
                 r.passes_total,
@@ -894,8 +1048,8 @@ fn model_text(r: &Run) -> String {
         format!("{:.1} s measured", r.total_s())
     } else {
         format!(
-            "pre {:.1} s + trace {:.1} s × {:.2} ({} of the rows traced) = {:.1} s",
-            r.preprocess_s,
+            "{} + trace {:.1} s × {:.2} ({} of the rows traced) = {:.1} s",
+            r.pre_text(),
             r.trace_s,
             r.scale,
             r.rows_traced,
@@ -1139,7 +1293,15 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                 split.push(vec![
                     m.row.clone(),
                     name.into(),
-                    if r.earlier_s > 0.0 {
+                    if r.partial_grid() {
+                        format!(
+                            "{:.2} ({} of the grid's {} subspaces; extrapolated {:.2})",
+                            r.preprocess_s,
+                            r.subspaces,
+                            r.subspaces_total,
+                            r.pre_s()
+                        )
+                    } else if r.earlier_s > 0.0 {
                         format!(
                             "{:.2} (of which {:.2} by earlier, stopped invocations)",
                             r.preprocess_s, r.earlier_s
@@ -1233,5 +1395,23 @@ mod tests {
         };
         assert!(old.split_model().is_none());
         assert_eq!(old.total_s(), 450.0);
+        // The grid built over 2 of its 27 subspaces (`basic-subspaces=2`): its 80 s of build
+        // × 27 / 2, the other 20 s of preprocessing as measured.
+        let partial = Run {
+            hr_build_s: 80.0,
+            subspaces: 2,
+            subspaces_total: 27,
+            ..b.clone()
+        };
+        assert_eq!(partial.pre_s(), 100.0 + 80.0 * 12.5);
+        assert_eq!(partial.total_s(), 1100.0 + 260.0);
+        let text = model_text(&partial);
+        assert!(text.starts_with("pre 100.0 s, of which the grid's build 80.0 s over 2 of its 27 subspaces, × 27 / 2 = 1100.0 s + passes"), "{text}");
+        // A whole build is no model.
+        let whole = Run {
+            subspaces: 27,
+            ..partial.clone()
+        };
+        assert_eq!(whole.pre_s(), 100.0);
     }
 }

@@ -37,13 +37,37 @@ use std::time::Instant;
 /// its buffer) would outnumber what the group saves.
 pub const MIN_GROUP: usize = 1 << 14;
 
+/// What a shading group may hold, on top of the engine's budget (whose rays the engine keeps
+/// between generations): with the image and the process itself, a run stays within the
+/// engine's budget + 64 MiB (Table 4.1's bound: 320 MiB at 256 MiB).
+pub const SHADE_BYTES: usize = 24 << 20;
+
+/// Bytes a shading group holds per ray with `lights` lights: the ray and its path, its term,
+/// hit and place in the object order, and what shading may emit for it (a reflected and a
+/// refracted ray, one shadow ray per light).
+pub fn shade_bytes_per_ray(lights: usize) -> usize {
+    use std::mem::size_of;
+    size_of::<(Ray, Path)>()
+        + size_of::<Vec3>()
+        + size_of::<Hit>()
+        + size_of::<u32>()
+        + 2 * size_of::<(u32, Ray, Path)>()
+        + lights * size_of::<(u32, Ray, u32, Vec3)>()
+}
+
 /// Rays shaded per group: Algorithm 3.6's "while memory not full of rays", the rays the engine
-/// holds in memory at once within its budget (at least [`MIN_GROUP`]). The basic layout reads
-/// the store forward once per group up to the last object hit, so at 10^9 objects (a 35 GB
-/// store, ~8 min a sweep) the group's size sets the shading time: a fixed 16,384 made the 263,169
-/// eye rays of a 512² image 17 sweeps where the 256 MiB budget's 88,850 rays make 3.
-pub fn shade_group(engine: &BreadthFirst) -> usize {
-    engine.ray_capacity().max(MIN_GROUP)
+/// holds in memory at once within its budget, as far as [`SHADE_BYTES`] holds them, and at least
+/// [`MIN_GROUP`]. The basic layout reads the store forward once per group up to the last object
+/// hit, so at 10^9 objects (a 35 GB store, ~8 min a sweep) the group's size sets the shading
+/// time: a fixed 16,384 made the 263,169 eye rays of a 512² image 17 sweeps where the 256 MiB
+/// budget's 88,850 rays on rings170 would make 3.
+/// Without the byte cap, a scene whose engine holds many rays (gears18: several hundred
+/// thousand) took its peak RSS past the 320 MiB bound.
+pub fn shade_group(engine: &BreadthFirst, lights: usize) -> usize {
+    engine
+        .ray_capacity()
+        .min(SHADE_BYTES / shade_bytes_per_ray(lights))
+        .max(MIN_GROUP)
 }
 
 /// Bytes of one ray record of a generation file, and of a shadow record.
@@ -84,6 +108,8 @@ pub struct OutOfCoreRender {
     /// one forward read of the store (the basic layout reads every object up to the last hit).
     pub shade_group: usize,
     pub shade_sweeps: u64,
+    /// The most rays [`SHADE_BYTES`] holds in a group with this scene's lights.
+    pub shade_cap: usize,
 }
 
 fn put_ray(b: &mut Vec<u8>, r: &Ray) {
@@ -273,7 +299,7 @@ pub fn render_view(
     let (mut intersect_s, mut shade_s) = (0.0, 0.0);
     let mut generation = 0u32;
     let mut record = ObjectRecord::default();
-    let group_len = shade_group(engine);
+    let group_len = shade_group(engine, lights.len());
     let mut shade_sweeps = 0u64;
     while rays.len > 0 {
         generation += 1;
@@ -335,8 +361,10 @@ pub fn render_view(
         let mut group: Vec<(Ray, Path)> = Vec::with_capacity(held);
         let mut order: Vec<u32> = Vec::with_capacity(held);
         let mut term = vec![Vec3::ZERO; held];
-        let mut out_next: Vec<(u32, Ray, Path)> = Vec::new();
-        let mut out_shadow: Vec<(u32, Ray, u32, Vec3)> = Vec::new();
+        // Reserved once at the most a group can emit (pages count only once written), so that
+        // growing them never copies the group's emissions.
+        let mut out_next: Vec<(u32, Ray, Path)> = Vec::with_capacity(2 * held);
+        let mut out_shadow: Vec<(u32, Ray, u32, Vec3)> = Vec::with_capacity(held * lights.len());
         let mut buf = [0u8; RAY_RECORD];
         let mut hb = [0u8; HIT_RECORD];
         let mut hits = vec![Hit::MISS; held];
@@ -505,5 +533,6 @@ pub fn render_view(
         io: io_total,
         shade_group: group_len,
         shade_sweeps,
+        shade_cap: SHADE_BYTES / shade_bytes_per_ray(lights.len()),
     })
 }

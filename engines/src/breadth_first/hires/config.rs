@@ -39,6 +39,12 @@ pub struct TwoLevelConfig {
     /// up an interrupted or finished build of the same grid with its recorded seconds
     /// ([`super::disk_grid::DiskGrid::build`]).
     pub resume: bool,
+    /// `hrgrid_subspaces=K`: build only the first K subspaces of the on-disk grid and leave the
+    /// rest empty: a timing model of a build longer than a session (rings368's basic build is 27
+    /// sweeps of a 35 GB store). The answers are then not the scene's, so it needs `max_passes`
+    /// (whose runs claim no image) and `hrgrid=build`, and the partial grid is removed from the
+    /// store once opened, so that no later run can take it.
+    pub max_subspaces: Option<u64>,
 }
 
 fn bad(key: &str, value: &str, reason: &str) -> EngineError {
@@ -69,12 +75,20 @@ impl GridKind {
         let block = s.get("block", super::super::config::Bytes(1))?.0;
         let subspace: u32 = s.get("subspace", 0u32)?;
         let hrgrid: String = s.get("hrgrid", "build".to_string())?;
+        let max_subspaces: u64 = s.get("hrgrid_subspaces", 0u64)?;
         let (reuse, resume) = match hrgrid.as_str() {
             "build" => (false, false),
             "reuse" => (true, false),
             "resume" => (false, true),
             v => return Err(bad("hrgrid", v, "build, reuse or resume")),
         };
+        if max_subspaces > 0 && (reuse || resume) {
+            return Err(bad(
+                "hrgrid_subspaces",
+                &max_subspaces.to_string(),
+                "a partial grid is a timing model: it needs hrgrid=build",
+            ));
+        }
         if upper > 4096 || lower > 64 {
             return Err(bad(
                 "upper",
@@ -96,6 +110,7 @@ impl GridKind {
                 subspace: (subspace > 0).then_some(subspace),
                 reuse,
                 resume,
+                max_subspaces: (max_subspaces > 0).then_some(max_subspaces),
             }),
             v => return Err(bad("grid", v, "cuberoot, single or two-level")),
         })
@@ -149,6 +164,7 @@ mod tests {
             subspace: None,
             reuse: false,
             resume: false,
+            max_subspaces: None,
         }
     }
 

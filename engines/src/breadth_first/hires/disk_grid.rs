@@ -42,6 +42,9 @@ pub struct BuildStats {
     /// when it had finished the grid), and the build seconds it had spent on them.
     pub resumed: u64,
     pub prior_s: f64,
+    /// The grid's subspaces, and whether the build stopped short of them (`hrgrid_subspaces`).
+    pub total: u64,
+    pub partial: bool,
 }
 
 /// `hrgrid=resume`'s record, `hrgrid.progress.json` beside the grid: written after each
@@ -252,6 +255,7 @@ impl DiskGrid {
         mut tree: Option<&mut Tree>,
         floor: &[u32],
         resume: bool,
+        limit: Option<u64>,
     ) -> io::Result<BuildStats> {
         let res = g.lattice.res;
         let path = dir.join(FILE_NAME);
@@ -269,6 +273,7 @@ impl DiskGrid {
         );
         let count = res.map(|r| r.div_ceil(side));
         let total = count.iter().map(|&c| c as u64).product::<u64>();
+        st.total = total;
         let mut record = Progress {
             header_crc: u32::from_le_bytes([head[56], head[57], head[58], head[59]]),
             side,
@@ -312,12 +317,16 @@ impl DiskGrid {
             let mut rec = ObjectRecord::default();
             let mut buf = Vec::new();
             let mut index = 0u64;
-            for bx in 0..count[0] {
+            'all: for bx in 0..count[0] {
                 for by in 0..count[1] {
                     for bz in 0..count[2] {
                         index += 1;
                         if index <= st.resumed {
                             continue;
+                        }
+                        if limit.is_some_and(|k| st.subspaces >= k) {
+                            st.partial = true;
+                            break 'all;
                         }
                         let s0 = [bx, by, bz].map(|b| b * side);
                         let s1 = [0, 1, 2].map(|i| ((s0[i] + side).min(res[i])) - 1);
@@ -373,6 +382,8 @@ impl DiskGrid {
                     }
                 }
             }
+            // The whole grid's length (a partial build leaves the rest of its flags empty).
+            f.set_len(HEADER + flag_bytes(res))?;
             f.sync_all()?;
             std::fs::rename(&tmp, &path)?;
             if resume {
