@@ -310,7 +310,10 @@ fn a_partial_grid_build_sweeps_k_subspaces_and_leaves_no_grid_behind() {
         &[("hrgrid_subspaces", "3")][..],
         &[("hrgrid_subspaces", "3"), ("max_passes", "1"), ("hrgrid", "resume")][..],
     ] {
-        let e = config(bad).err().expect("refused").to_string();
+        let Err(e) = config(bad) else {
+            panic!("{bad:?} was taken")
+        };
+        let e = e.to_string();
         assert!(e.contains("hrgrid_subspaces") && !e.contains('\n'), "{e}");
     }
 }

@@ -252,15 +252,31 @@ struct Run {
     subspaces: u64,
     #[serde(default)]
     subspaces_total: u64,
+    /// The rays the engine held a pass (`rays_in_memory`), and the rays of every stream it was
+    /// given, in order (each generation's rays, then its shadow rays): the engine fills a pass
+    /// from one stream, so a stream of n rays takes ⌈n / rays a pass⌉ passes. 0 / empty in rows
+    /// saved before they were kept.
+    #[serde(default)]
+    capacity: u64,
+    #[serde(default)]
+    stream_rays: Vec<u64>,
 }
 
 impl Run {
-    /// The split run the pass model counts by.
-    fn passes_from(&self) -> &str {
+    /// Passes of streams of `stream_rays` rays at `capacity` rays a pass.
+    fn passes_at(stream_rays: &[u64], capacity: u64) -> u64 {
+        stream_rays.iter().map(|&n| n.div_ceil(capacity.max(1))).sum()
+    }
+
+    /// What the pass model's total counts ("S+G+B's passes", or a split run's streams at this
+    /// run's rays a pass).
+    fn passes_from(&self) -> String {
         if self.passes_from.is_empty() {
-            "S+G"
+            "S+G's passes".into()
+        } else if self.passes_from.contains("streams") {
+            self.passes_from.clone()
         } else {
-            &self.passes_from
+            format!("{}'s passes", self.passes_from)
         }
     }
 
@@ -549,6 +565,13 @@ fn trace(
         hr_build_s,
         subspaces,
         subspaces_total,
+        capacity: stat("rays_in_memory") as u64,
+        stream_rays: r
+            .stats
+            .generations
+            .iter()
+            .flat_map(|g| [g.rays, g.shadow])
+            .collect(),
     })
 }
 
@@ -733,11 +756,28 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
 /// A capped basic run's model totals, from a split run of the same row (the same grid, rays and
 /// memory budget: S+G and S+G+B made the same passes on every row so far): its pass count and
 /// the whole run's shading sweeps. Left alone once set, or when the run is not capped.
+///
+/// Where both runs kept their streams and rays a pass, the passes are the split run's streams
+/// at the basic run's rays a pass: the methods hold different numbers of rays (at rings368 the
+/// basic method 41,213, S+G+B 36,816, whose hierarchy takes part of the budget), so the split
+/// run's own pass count would be another run's.
 fn complete_model(b: &mut Run, r: &Run, name: &str) {
-    if b.capped && b.passes > 0 && b.passes_total == 0 {
-        b.passes_total = r.passes;
-        b.passes_from = name.to_string();
-        b.scale = r.passes as f64 / b.passes as f64;
+    if !(b.capped && b.passes > 0) {
+        return;
+    }
+    let streams = b.capacity > 0 && !r.stream_rays.is_empty();
+    if b.passes_total == 0 || (streams && !b.passes_from.contains("streams")) {
+        b.passes_total = if streams {
+            Run::passes_at(&r.stream_rays, b.capacity)
+        } else {
+            r.passes
+        };
+        b.passes_from = if streams {
+            format!("{name}'s streams at the basic run's {} rays a pass", b.capacity)
+        } else {
+            name.to_string()
+        };
+        b.scale = b.passes_total as f64 / b.passes as f64;
         b.sweeps_total = sweeps(&r.generation_rays, b.shade_group);
     }
 }
@@ -1014,7 +1054,7 @@ fn model_text(r: &Run) -> String {
             )
         } else if let Some((passes_s, shade_s, other_s)) = r.split_model() {
             format!(
-                "{} + passes {:.1} s (first {}) × {} / {} ({}'s passes) + shading {:.1} s ({} sweeps of the store) × {} / {} (the whole run's groups of {} rays) + other {:.1} s = {:.1} s (passes {:.1} s, shading {:.1} s)",
+                "{} + passes {:.1} s (first {}) × {} / {} ({}) + shading {:.1} s ({} sweeps of the store) × {} / {} (the whole run's groups of {} rays) + other {:.1} s = {:.1} s (passes {:.1} s, shading {:.1} s)",
                 r.pre_text(),
                 r.intersect_s,
                 r.passes,
@@ -1033,7 +1073,7 @@ fn model_text(r: &Run) -> String {
             )
         } else {
             format!(
-                "{} + trace {:.1} s (first {} passes) × {} / {} ({}'s passes) = {:.1} s",
+                "{} + trace {:.1} s (first {} passes) × {} / {} ({}) = {:.1} s",
                 r.pre_text(),
                 r.trace_s,
                 r.passes,
@@ -1407,6 +1447,30 @@ mod tests {
         assert_eq!(partial.total_s(), 1100.0 + 260.0);
         let text = model_text(&partial);
         assert!(text.starts_with("pre 100.0 s, of which the grid's build 80.0 s over 2 of its 27 subspaces, × 27 / 2 = 1100.0 s + passes"), "{text}");
+        // The split run's streams at the basic run's rays a pass: 250, 100, 0 and 1 rays at 40
+        // a pass are 7 + 3 + 0 + 1 passes, where the split run (at 50 a pass) made 5 + 2 + 1.
+        let split = Run {
+            passes: 8,
+            capacity: 50,
+            stream_rays: vec![250, 100, 0, 1],
+            generation_rays: vec![250, 1],
+            ..Default::default()
+        };
+        assert_eq!(Run::passes_at(&split.stream_rays, split.capacity), split.passes);
+        let mut c = Run {
+            capacity: 40,
+            passes_total: 0,
+            sweeps_total: 0,
+            ..b.clone()
+        };
+        complete_model(&mut c, &split, "S+G+B");
+        assert_eq!((c.passes_total, c.sweeps_total), (11, 4));
+        assert!(model_text(&c).contains("× 11 / 2 (S+G+B's streams at the basic run's 40 rays a pass)"), "{}", model_text(&c));
+        // A basic run saved without its rays a pass takes the split run's passes, and keeps them.
+        let mut d = Run { capacity: 0, passes_total: 0, ..b.clone() };
+        complete_model(&mut d, &split, "S+G+B");
+        assert_eq!(d.passes_total, 8);
+        assert!(model_text(&d).contains("(S+G+B's passes)"), "{}", model_text(&d));
         // A whole build is no model.
         let whole = Run {
             subspaces: 27,
