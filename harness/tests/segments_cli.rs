@@ -269,7 +269,10 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
         let m = &v["measured"][i];
         let b = &m["basic"];
         assert_eq!(b["capped"], true, "{b}");
-        assert_eq!(b["passes_from"], "S+G+B", "{b}");
+        // The S+G+B run's streams at the basic run's rays a pass (the same passes here: both
+        // hold every stream in one pass).
+        let from = b["passes_from"].as_str().unwrap();
+        assert!(from.starts_with("S+G+B's streams at the basic run's"), "{b}");
         assert_eq!(b["passes_total"], m["sgb"]["passes"], "{m}");
         assert!(b["sweeps_total"].as_u64().unwrap() > 0, "{b}");
         assert!(m["sg"].is_null(), "{m}");

@@ -757,15 +757,20 @@ fn measure_split(ctx: &Ctx, m: &mut Measured, s: &Setup) -> Result<bool> {
 /// memory budget: S+G and S+G+B made the same passes on every row so far): its pass count and
 /// the whole run's shading sweeps. Left alone once set, or when the run is not capped.
 ///
-/// Where both runs kept their streams and rays a pass, the passes are the split run's streams
-/// at the basic run's rays a pass: the methods hold different numbers of rays (at rings368 the
+/// Where both runs kept their rays a pass and the split run's streams account for its passes,
+/// the passes are the split run's streams at the basic run's rays a pass: the methods hold different numbers of rays (at rings368 the
 /// basic method 41,213, S+G+B 36,816, whose hierarchy takes part of the budget), so the split
 /// run's own pass count would be another run's.
 fn complete_model(b: &mut Run, r: &Run, name: &str) {
     if !(b.capped && b.passes > 0) {
         return;
     }
-    let streams = b.capacity > 0 && !r.stream_rays.is_empty();
+    // Only where the split run's own passes are its streams at its own rays a pass (a pass
+    // that does not finish its rays, or a stream a pass cannot hold, would break the count).
+    let streams = b.capacity > 0
+        && r.capacity > 0
+        && !r.stream_rays.is_empty()
+        && Run::passes_at(&r.stream_rays, r.capacity) == r.passes;
     if b.passes_total == 0 || (streams && !b.passes_from.contains("streams")) {
         b.passes_total = if streams {
             Run::passes_at(&r.stream_rays, b.capacity)
@@ -1111,13 +1116,16 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
             format!("{}: a smaller stand-in, not a row of the table", m.row)
         };
         let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
-        if let (Some(b), Some(sg), Some(sgb)) = (&m.basic, &m.sg, &m.sgb) {
+        // Each claim as soon as the runs it compares are saved: a 10^9-object row is measured
+        // one method a session (`methods`).
+        if let Some(b) = &m.basic {
             let model = b.scale != 1.0 || b.capped;
             let tag = if model { " (basic: model)" } else { "" };
             for (claim, x, f) in [
-                ("sg-ratio", sg, (|r: &PublishedRow| r.sg) as fn(&PublishedRow) -> f64),
-                ("sgb-ratio", sgb, |r: &PublishedRow| r.sgb),
+                ("sg-ratio", &m.sg, (|r: &PublishedRow| r.sg) as fn(&PublishedRow) -> f64),
+                ("sgb-ratio", &m.sgb, |r: &PublishedRow| r.sgb),
             ] {
+                let Some(x) = x else { continue };
                 let v = ratio(b.total_s(), x.total_s());
                 let verdict = if claim == "sgb-ratio" && pubrow.is_some() {
                     let [lo, hi] = p.improvement_range;
@@ -1141,6 +1149,20 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     .with_note(note.clone()),
                 );
             }
+            rows.push(
+                Row::new(
+                    "basic-model",
+                    m.row.clone(),
+                    pubrow.map_or("-".into(), |r| format!("{} s", r.basic_s)),
+                    model_text(b),
+                    Kind::Ratio,
+                    Verdict::Shown,
+                )
+                .with_note(note.clone()),
+            );
+        }
+        if let (Some(b), Some(sg), Some(sgb)) = (&m.basic, &m.sg, &m.sgb) {
+            let model = b.scale != 1.0 || b.capped;
             let same = sg.sha256 == sgb.sha256 && (model || b.sha256 == sg.sha256);
             rows.push(
                 Row::new(
@@ -1159,26 +1181,29 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                 )
                 .with_note(note.clone()),
             );
-            let peak = b.peak_rss_bytes.max(sg.peak_rss_bytes).max(sgb.peak_rss_bytes);
+        }
+        let runs: Vec<(&str, &Run)> = [("basic", &m.basic), ("S+G", &m.sg), ("S+G+B", &m.sgb)]
+            .into_iter()
+            .filter_map(|(n, r)| r.as_ref().map(|r| (n, r)))
+            .collect();
+        if !runs.is_empty() {
+            let peak = runs.iter().map(|(_, r)| r.peak_rss_bytes).max().unwrap_or(0);
+            let of = if runs.len() < 3 {
+                format!(
+                    " ({} only)",
+                    runs.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                )
+            } else {
+                String::new()
+            };
             rows.push(
                 Row::new(
                     "memory",
                     m.row.clone(),
                     "256 MB machine; bound 320 MiB",
-                    format!("peak RSS {:.1} MiB", peak as f64 / 1048576.0),
+                    format!("peak RSS {:.1} MiB{of}", peak as f64 / 1048576.0),
                     Kind::Ordering,
                     Verdict::of(peak <= 320 << 20),
-                )
-                .with_note(note.clone()),
-            );
-            rows.push(
-                Row::new(
-                    "basic-model",
-                    m.row.clone(),
-                    pubrow.map_or("-".into(), |r| format!("{} s", r.basic_s)),
-                    model_text(b),
-                    Kind::Ratio,
-                    Verdict::Shown,
                 )
                 .with_note(note.clone()),
             );
@@ -1241,7 +1266,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                 }),
             );
         }
-        if m.sgb.is_none() {
+        if m.sgb.is_none() || m.basic.is_none() {
             rows.push(Row::new(
                 "sgb-ratio",
                 m.row.clone(),
