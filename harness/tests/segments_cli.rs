@@ -237,9 +237,14 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
     let out = d.join("out");
     let run = |extra: &[&str]| -> (Value, String) {
         let mut args = vec!["reproduce", "nakamaru-4.3", "--out", &out, "--resume"];
-        for s in ["rows=rings2,rings2m", "size=16", "segment=100", "cache=warm"]
-            .iter()
-            .chain(extra)
+        for s in [
+            "rows=rings2,rings2m",
+            "size=16",
+            "segment=100",
+            "cache=warm",
+        ]
+        .iter()
+        .chain(extra)
         {
             args.push("--set");
             args.push(s);
@@ -264,7 +269,10 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
     }
     let (v, err) = run(&["methods=basic", "basic-passes=1"]);
     assert_eq!(v["finished"], false);
-    assert!(!err.contains("S+G+B …") && !err.contains("split store"), "{err}");
+    assert!(
+        !err.contains("S+G+B …") && !err.contains("split store"),
+        "{err}"
+    );
     for i in 0..2 {
         let m = &v["measured"][i];
         let b = &m["basic"];
@@ -272,7 +280,10 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
         // The S+G+B run's streams at the basic run's rays a pass (the same passes here: both
         // hold every stream in one pass).
         let from = b["passes_from"].as_str().unwrap();
-        assert!(from.starts_with("S+G+B's streams at the basic run's"), "{b}");
+        assert!(
+            from.starts_with("S+G+B's streams at the basic run's"),
+            "{b}"
+        );
         assert_eq!(b["passes_total"], m["sgb"]["passes"], "{m}");
         assert!(b["sweeps_total"].as_u64().unwrap() > 0, "{b}");
         assert!(m["sg"].is_null(), "{m}");
@@ -281,7 +292,10 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
     let stores = Path::new(&out).join(".partial/nakamaru-4.3/stores");
     std::fs::remove_dir_all(&stores).unwrap();
     let (v, err) = run(&["methods=sg,basic"]);
-    assert!(err.contains("rings2: the store saved steps name is not at"), "{err}");
+    assert!(
+        err.contains("rings2: the store saved steps name is not at"),
+        "{err}"
+    );
     assert_eq!(err.matches("split store (in segments)").count(), 1, "{err}");
     assert_eq!(v["finished"], true);
     assert!(v["measured"][1]["sg"]["passes"].as_u64().unwrap() > 0);
@@ -289,11 +303,25 @@ fn nakamaru_4_3_measures_one_method_an_invocation() {
         .join(".partial/nakamaru-4.3/stores")
         .exists());
     expect_input_error(
-        &["reproduce", "nakamaru-4.3", "--out", &out, "--set", "methods=sgb,fast"],
+        &[
+            "reproduce",
+            "nakamaru-4.3",
+            "--out",
+            &out,
+            "--set",
+            "methods=sgb,fast",
+        ],
         "methods 'fast'",
     );
     expect_input_error(
-        &["reproduce", "nakamaru-4.3", "--out", &out, "--set", "basic-subspaces=2"],
+        &[
+            "reproduce",
+            "nakamaru-4.3",
+            "--out",
+            &out,
+            "--set",
+            "basic-subspaces=2",
+        ],
         "basic-subspaces needs basic-passes",
     );
 }

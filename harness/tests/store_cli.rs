@@ -95,7 +95,12 @@ fn shading_groups_follow_the_memory_budget_and_leave_the_image_unchanged() {
     assert!(in_memory(&small) < 16_384);
     // The engine's rays, as far as the shading bytes (`SHADE_BYTES`) hold them.
     let cap = large["shading"]["cap_rays"].as_u64().unwrap();
-    assert_eq!(group(&large), in_memory(&large).min(cap), "{}", large["shading"]);
+    assert_eq!(
+        group(&large),
+        in_memory(&large).min(cap),
+        "{}",
+        large["shading"]
+    );
     assert!(group(&large) > 161 * 161, "{}", large["shading"]);
     // Generation 1 alone takes 2 sweeps in the small budget's groups, 1 in the large one's.
     let gens = small["rays"]["generations"].as_array().unwrap().len() as u64;

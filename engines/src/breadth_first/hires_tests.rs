@@ -90,14 +90,20 @@ fn open_hr(dir: &std::path::Path, reuse: bool) -> Result<BreadthFirst, EngineErr
     BreadthFirst::open(dir, BreadthFirstConfig::from_settings(s).unwrap())
 }
 
-#[test]
-fn a_truncated_or_foreign_grid_is_refused_and_a_failed_build_leaves_nothing() {
+/// tetra SF 4 and its store in a new temporary folder.
+fn tetra4_store(name: &str) -> (crate::engine::BuildInput, TempDir) {
     let input = spd(Program::Tetra, 4);
-    let dir = TempDir::new("hr-bad");
+    let dir = TempDir::new(name);
     StoreWriter::create(&dir.0, "tetra4")
         .unwrap()
         .write_scene(&input.scene)
         .unwrap();
+    (input, dir)
+}
+
+#[test]
+fn a_truncated_or_foreign_grid_is_refused_and_a_failed_build_leaves_nothing() {
+    let (input, dir) = tetra4_store("hr-bad");
     let r = rays(&input.geometry, 200);
     let e = open_hr(&dir.0, false).unwrap();
     let want = answers(&e, &r, &mut Counters::default());
@@ -151,12 +157,7 @@ fn a_truncated_or_foreign_grid_is_refused_and_a_failed_build_leaves_nothing() {
 #[test]
 fn a_resumed_grid_build_sweeps_only_the_subspaces_not_yet_on_disk() {
     use super::hires::disk_grid::PROGRESS_FILE;
-    let input = spd(Program::Tetra, 4);
-    let dir = TempDir::new("hr-resume");
-    StoreWriter::create(&dir.0, "tetra4")
-        .unwrap()
-        .write_scene(&input.scene)
-        .unwrap();
+    let (_, dir) = tetra4_store("hr-resume");
     let open = |mode: &str, side: &str| {
         let s = Settings::new(
             "breadth-first",
@@ -254,12 +255,7 @@ fn a_resumed_grid_build_sweeps_only_the_subspaces_not_yet_on_disk() {
 /// claims an image) or with `hrgrid=resume` the setting is refused.
 #[test]
 fn a_partial_grid_build_sweeps_k_subspaces_and_leaves_no_grid_behind() {
-    let input = spd(Program::Tetra, 4);
-    let dir = TempDir::new("hr-partial");
-    StoreWriter::create(&dir.0, "tetra4")
-        .unwrap()
-        .write_scene(&input.scene)
-        .unwrap();
+    let (_, dir) = tetra4_store("hr-partial");
     let config = |extra: &[(&str, &str)]| {
         let mut pairs = vec![("grid", "two-level"), ("upper", "4"), ("subspace", "5")];
         pairs.extend_from_slice(extra);
@@ -308,7 +304,11 @@ fn a_partial_grid_build_sweeps_k_subspaces_and_leaves_no_grid_behind() {
     assert_eq!(c.extra["bf_passes"], 1);
     for bad in [
         &[("hrgrid_subspaces", "3")][..],
-        &[("hrgrid_subspaces", "3"), ("max_passes", "1"), ("hrgrid", "resume")][..],
+        &[
+            ("hrgrid_subspaces", "3"),
+            ("max_passes", "1"),
+            ("hrgrid", "resume"),
+        ][..],
     ] {
         let Err(e) = config(bad) else {
             panic!("{bad:?} was taken")

@@ -280,6 +280,12 @@ impl Run {
         }
     }
 
+    /// Whether the run stands in for a whole one (a tile set, the first passes, a partial grid):
+    /// a model, not a measurement.
+    fn is_model(&self) -> bool {
+        self.scale != 1.0 || self.capped || self.partial_grid()
+    }
+
     /// Whether the grid's build stopped short of its subspaces (`basic-subspaces`).
     fn partial_grid(&self) -> bool {
         self.subspaces > 0 && self.subspaces < self.subspaces_total
@@ -1119,7 +1125,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         // Each claim as soon as the runs it compares are saved: a 10^9-object row is measured
         // one method a session (`methods`).
         if let Some(b) = &m.basic {
-            let model = b.scale != 1.0 || b.capped;
+            let model = b.is_model();
             let tag = if model { " (basic: model)" } else { "" };
             for (claim, x, f) in [
                 ("sg-ratio", &m.sg, (|r: &PublishedRow| r.sg) as fn(&PublishedRow) -> f64),
@@ -1162,7 +1168,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
             );
         }
         if let (Some(b), Some(sg), Some(sgb)) = (&m.basic, &m.sg, &m.sgb) {
-            let model = b.scale != 1.0 || b.capped;
+            let model = b.is_model();
             let same = sg.sha256 == sgb.sha256 && (model || b.sha256 == sg.sha256);
             rows.push(
                 Row::new(
@@ -1326,7 +1332,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
             st(&m.basic_store),
             st(&m.split_store),
             match &m.basic {
-                Some(b) if b.scale != 1.0 => format!("{} (model)", secs(&m.basic)),
+                Some(b) if b.is_model() => format!("{} (model)", secs(&m.basic)),
                 _ => secs(&m.basic),
             },
             r(&m.sg),
