@@ -434,6 +434,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .iter()
         .map(|m| SizePoint {
             scene: m.scene.clone(),
+            sf: m.sf,
             objects: m.objects,
             seconds: [m.basic.total_s(), m.sg.total_s(), m.sgb.total_s()],
             peak_rss: [m.basic.peak_rss_bytes, m.sg.peak_rss_bytes, m.sgb.peak_rss_bytes],

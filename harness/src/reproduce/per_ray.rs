@@ -9,9 +9,12 @@
 use rtbench_reports::plot::{Chart, LegendAt, Panel, Point, Series, XyPanel};
 use rtbench_reports::{Document, Table as DocTable};
 
-/// One row: a scene at one size, each method's total seconds and peak RSS bytes.
+/// One row: a scene at one size, each method's total seconds and peak RSS bytes. A method not
+/// (yet) measured at this size has NaN seconds and 0 bytes: the plots leave its point out and the
+/// table prints "-" (a 10^9-object row is measured one method a session).
 pub struct SizePoint {
     pub scene: String,
+    pub sf: u32,
     pub objects: u64,
     /// basic, S+G, S+G+B.
     pub seconds: [f64; 3],
@@ -43,6 +46,7 @@ pub fn charts(id: &str, points: &[SizePoint], size: u32) -> Vec<Chart> {
                         color: k + 1,
                         points: ps
                             .iter()
+                            .filter(|p| p.seconds[k].is_finite())
                             .map(|p| Point {
                                 x: p.objects as f64,
                                 y: f(p, k),
@@ -99,7 +103,14 @@ pub fn table(doc: &mut Document, points: &[SizePoint], size: u32) {
     for scene in scenes {
         let mut ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
         ps.sort_by_key(|p| p.objects);
-        let us = |p: &SizePoint, k: usize| format!("{:.0}", 1e6 * per_eye_ray(p.seconds[k], size));
+        let us = |p: &SizePoint, k: usize| {
+            let s = p.seconds[k];
+            if s.is_finite() {
+                format!("{:.0}", 1e6 * per_eye_ray(s, size))
+            } else {
+                "-".into()
+            }
+        };
         let (a, b) = (ps[0], ps[ps.len() - 1]);
         let g = growth(points, scene);
         t.push(vec![
@@ -113,14 +124,22 @@ pub fn table(doc: &mut Document, points: &[SizePoint], size: u32) {
             format!("{} → {}", us(a, 1), us(b, 1)),
             format!("{} → {}", us(a, 2), us(b, 2)),
             g.map_or("-".into(), |(_, _, g)| {
-                format!("{:.2} / {:.2} / {:.2}", g[0], g[1], g[2])
+                g.map(|x| {
+                    if x.is_finite() {
+                        format!("{x:.2}")
+                    } else {
+                        "-".into()
+                    }
+                })
+                .join(" / ")
             }),
         ]);
     }
     doc.table(t);
 }
 
-/// Growth of the time per ray between the smallest and largest size of a scene, per method.
+/// Growth of the time per ray between the smallest and largest size of a scene, per method (NaN
+/// for a method missing at either end).
 pub fn growth(points: &[SizePoint], scene: &str) -> Option<(u64, u64, [f64; 3])> {
     let mut ps: Vec<&SizePoint> = points.iter().filter(|p| p.scene == scene).collect();
     ps.sort_by_key(|p| p.objects);
@@ -143,6 +162,7 @@ mod tests {
     fn one_chart_per_scene_with_three_methods_in_size_order() {
         let p = |scene: &str, objects, s: f64| SizePoint {
             scene: scene.into(),
+            sf: 1,
             objects,
             seconds: [s, s / 2.0, s / 4.0],
             peak_rss: [1 << 20, 2 << 20, 3 << 20],
@@ -165,5 +185,20 @@ mod tests {
         assert_eq!(t.series[2].points[1].y, 0.5);
         assert_eq!(growth(&pts, "mount"), Some((10, 100, [4.0, 4.0, 4.0])));
         assert_eq!(growth(&pts, "tetra"), None);
+        // A size with S+G+B only: its other methods' points are left out, their growth NaN.
+        let mut pts = pts;
+        pts[0].seconds = [f64::NAN, f64::NAN, 2.0];
+        let c = charts("x", &pts, 1);
+        let Panel::Xy(t) = &c[0].panels[0] else {
+            panic!()
+        };
+        assert_eq!(t.series[0].points.len(), 1);
+        assert_eq!(t.series[2].points.len(), 2);
+        let g = growth(&pts, "mount").unwrap().2;
+        assert!(g[0].is_nan() && g[1].is_nan() && g[2] == 4.0, "{g:?}");
+        let mut doc = Document::new("t");
+        table(&mut doc, &pts, 1);
+        let md = doc.to_markdown();
+        assert!(md.contains("- / - / 4.00"), "{md}");
     }
 }
