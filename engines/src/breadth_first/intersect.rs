@@ -274,6 +274,10 @@ impl Visit {
 
 impl Slot {
     /// The ray against object `id`'s primitives, keeping the nearest hit (any hit: the first).
+    /// Of two hits at the same t the object with the smaller id is kept, whichever is met
+    /// first: which voxel and which pass a ray meets an object in depends on the grid, so
+    /// keeping the first would make the image depend on the grid (rings118, session 14: one
+    /// pixel between the capped and the high-resolution grid).
     #[inline(never)]
     fn intersect(
         &mut self,
@@ -285,7 +289,13 @@ impl Slot {
     ) {
         let mut seg = self.ray;
         for prim in &record.prims {
-            seg.tmax = self.best_t;
+            // A hit at exactly best_t is taken from an object of a smaller id: the next float
+            // up as the (exclusive) limit. best_t is finite and positive once there is a hit.
+            seg.tmax = if self.has_hit && id < self.best.object {
+                f32::from_bits(self.best_t.to_bits() + 1)
+            } else {
+                self.best_t
+            };
             c.primitive_tests += 1;
             if let Some((th, u, v)) = prim.intersect(&seg, test, &self.wt) {
                 c.primitive_hits += 1;
@@ -606,5 +616,60 @@ impl Work {
                 i += 1;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tie_tests {
+    use super::*;
+    use crate::geometry::dda::Lattice;
+    use crate::geometry::Prim;
+
+    /// Of two objects hit at the same t, the one with the smaller id is kept whichever is met
+    /// first; a nearer hit still wins over a smaller id, and an object met again keeps its hit.
+    #[test]
+    fn a_tie_of_equal_t_keeps_the_smaller_object_id_in_either_order() {
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 1e-4, f32::INFINITY);
+        let lattice = Lattice::new(Vec3::splat(-2.0), Vec3::splat(2.0), [2, 2, 2]);
+        let slot = Slot {
+            boxray: BoxRay::new(&ray, 10.0),
+            best_t: ray.tmax,
+            mailbox: u32::MAX,
+            prev: [u32::MAX; 3],
+            has_hit: false,
+            exhausted: false,
+            ray,
+            best: Hit::MISS,
+            covered: f32::NEG_INFINITY,
+            id: 0,
+            last: [u32::MAX; 3],
+            wt: WatertightRay::new(ray.dir),
+            dda: Dda::start(&ray, &lattice).unwrap(),
+        };
+        let sphere = |z: f32| ObjectRecord {
+            material: 0,
+            surface: None,
+            prims: vec![Prim::Sphere {
+                center: Vec3::new(0.0, 0.0, z),
+                radius: 1.0,
+            }],
+        };
+        let (same, nearer) = (sphere(0.0), sphere(-0.5));
+        let run = |order: &[(u32, &ObjectRecord)]| {
+            let mut s = slot;
+            let mut c = Counters::default();
+            for (id, rec) in order {
+                s.intersect(*id, rec, false, TriangleTest::default(), &mut c);
+            }
+            (s.best.object, s.best.t)
+        };
+        let (a, ta) = run(&[(7, &same), (3, &same), (9, &same)]);
+        let (b, tb) = run(&[(3, &same), (7, &same), (9, &same)]);
+        assert_eq!((a, b), (3, 3));
+        assert_eq!(ta, 4.0);
+        assert_eq!(ta, tb);
+        // A nearer hit wins over a smaller id, before and after.
+        assert_eq!(run(&[(3, &same), (8, &nearer)]).0, 8);
+        assert_eq!(run(&[(8, &nearer), (3, &same)]).0, 8);
     }
 }
