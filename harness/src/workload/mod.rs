@@ -9,6 +9,7 @@ pub mod paging;
 pub mod pass_003;
 pub mod rayshade_memory;
 pub mod replacement;
+pub mod sched;
 pub mod surface;
 pub mod tiles;
 pub mod trace;
