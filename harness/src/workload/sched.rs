@@ -10,7 +10,9 @@
 //!
 //! With [`SCHED_VAR`] set, [`super::trace::render_chunked`] prints one line per pool thread of
 //! each render on stderr: these counts over the render's parallel region, and the wall seconds
-//! the thread spent inside bands.
+//! the thread spent inside bands; one line per CPU with its seconds by state (user, system,
+//! idle, iowait, steal) over the same region; with `RTBENCH_SCHED=bands` also one line per band
+//! (thread, the CPU it started and ended on, start and end seconds).
 
 /// Environment variable that makes [`super::trace::render_chunked`] print the pool threads'
 /// scheduler accounting (one `sched` line per thread) on stderr.
@@ -174,6 +176,12 @@ pub fn cpu_lines(before: &[(usize, [u64; 8])], after: &[(usize, [u64; 8])]) -> V
             ))
         })
         .collect()
+}
+
+/// The CPU the calling thread is running on now (-1 where unknown).
+pub fn cpu() -> i32 {
+    // SAFETY: sched_getcpu has no preconditions.
+    unsafe { libc::sched_getcpu() }
 }
 
 /// Wall seconds covered by a set of (start, end) intervals (their union): the time a thread was

@@ -476,6 +476,10 @@ pub fn render_chunked(
     let sched_start = Instant::now();
     let cpus_before = sched_on.then(super::sched::read_cpus);
     let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
+    // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
+    // ended on, and its start and end.
+    let sched_bands =
+        sched_on && std::env::var_os(super::sched::SCHED_VAR).is_some_and(|v| v == "bands");
     let band_times: Mutex<Vec<(usize, f64, f64)>> = Mutex::new(Vec::new());
     // One wavefront per pool thread, reused from band to band. A thread that runs a second band
     // while its first waits inside the engine's batches (rayon's join lets it) gets a fresh one.
@@ -507,11 +511,17 @@ pub fn render_chunked(
             };
             let rows = band_rows.min(w - j0);
             let cpu = bands.then(super::thread_cpu_seconds);
-            let band_start = sched_on.then(|| t.elapsed().as_secs_f64());
+            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), super::sched::cpu()));
             let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
-            if let Some(s) = band_start {
+            if let Some((s, cpu0)) = band_start {
                 let e = t.elapsed().as_secs_f64();
                 let i = rayon::current_thread_index().unwrap_or(usize::MAX);
+                if sched_bands {
+                    eprintln!(
+                        "sched band {k} thread {i} cpu {cpu0} {} start_s {s:.6} end_s {e:.6}",
+                        super::sched::cpu()
+                    );
+                }
                 band_times
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
