@@ -323,6 +323,23 @@ mod tests {
         assert!(!lines[1].ends_with("steal_s 0.00"), "{}", lines[1]);
     }
 
+    /// `RTBENCH_PIN_THREADS`' pinning: a thread pinned to one of its allowed CPUs may then run
+    /// only there (a thread of its own, so the test's other threads keep their CPUs).
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_pinned_thread_runs_on_its_cpu() {
+        std::thread::spawn(|| {
+            let cpus = crate::workload::allowed_cpus();
+            assert!(!cpus.is_empty());
+            let last = *cpus.last().unwrap();
+            crate::workload::pin_to_cpu(last);
+            assert_eq!(crate::workload::allowed_cpus(), vec![last]);
+            assert_eq!(cpu(), last as i32);
+        })
+        .join()
+        .unwrap();
+    }
+
     #[test]
     fn covered_seconds_is_the_union() {
         assert_eq!(covered_seconds(&[]), 0.0);
