@@ -178,6 +178,41 @@ pub fn cpu_lines(before: &[(usize, [u64; 8])], after: &[(usize, [u64; 8])]) -> V
         .collect()
 }
 
+/// Every thread of this process with its nanoseconds on a CPU so far (`/proc/self/task/*/schedstat`).
+pub fn process_threads() -> Vec<(i64, u64)> {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return Vec::new();
+    };
+    dir.filter_map(|e| {
+        let e = e.ok()?;
+        let tid = e.file_name().to_str()?.parse::<i64>().ok()?;
+        let t = std::fs::read_to_string(e.path().join("schedstat")).ok()?;
+        Some((tid, parse_schedstat(&t)?.0))
+    })
+    .collect()
+}
+
+/// The `sched process` line: how many threads the process has at the end of a region, and the
+/// seconds its threads outside the pool (`pool`: their ids) ran during it (`before`, `after`:
+/// [`process_threads`] at its start and end; a thread started during the region counts whole).
+/// A library's worker thread spinning beside the trace shows here.
+pub fn process_line(before: &[(i64, u64)], after: &[(i64, u64)], pool: &[i64]) -> String {
+    let others: u64 = after
+        .iter()
+        .filter(|(tid, _)| !pool.contains(tid))
+        .map(|(tid, ns)| {
+            let was = before.iter().find(|b| b.0 == *tid).map_or(0, |b| b.1);
+            ns.saturating_sub(was)
+        })
+        .sum();
+    format!(
+        "sched process threads {} pool {} others_run_s {:.6}",
+        after.len(),
+        pool.len(),
+        others as f64 * 1e-9
+    )
+}
+
 /// The CPU the calling thread is running on now (-1 where unknown).
 pub fn cpu() -> i32 {
     // SAFETY: sched_getcpu has no preconditions.
@@ -321,6 +356,16 @@ mod tests {
         assert_eq!(lines.len(), 2);
         assert!(lines[0].ends_with("steal_s 0.00"), "{}", lines[0]);
         assert!(!lines[1].ends_with("steal_s 0.00"), "{}", lines[1]);
+    }
+
+    #[test]
+    fn the_process_line_counts_threads_outside_the_pool() {
+        let before = [(1, 100), (2, 1_000), (3, 5_000)];
+        let after = [(1, 300), (2, 2_000_000_000), (3, 5_000), (4, 500_000_000)];
+        // Threads 2 and 3 are the pool's; 1 ran 200 ns more, 4 started during the region.
+        let l = process_line(&before, &after, &[2, 3]);
+        assert_eq!(l, "sched process threads 4 pool 2 others_run_s 0.500000");
+        assert!(process_threads().iter().any(|t| t.1 > 0));
     }
 
     /// `RTBENCH_PIN_THREADS`' pinning: a thread pinned to one of its allowed CPUs may then run

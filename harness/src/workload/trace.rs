@@ -475,6 +475,7 @@ pub fn render_chunked(
     // band's (thread, start, end) seconds from the region's start.
     let sched_start = Instant::now();
     let cpus_before = sched_on.then(super::sched::read_cpus);
+    let process_before = sched_on.then(super::sched::process_threads);
     let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
     // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
     // ended on, and its start and end.
@@ -562,10 +563,11 @@ pub fn render_chunked(
         })
         .collect();
     let region_s = t.elapsed().as_secs_f64();
-    if let (Some(before), Some(cpus)) = (sched_before, cpus_before) {
+    if let (Some(before), Some(cpus), Some(process)) = (sched_before, cpus_before, process_before) {
         print_sched(
             &before,
             &cpus,
+            &process,
             sched_start,
             &band_times.into_inner().unwrap_or_default(),
         );
@@ -620,11 +622,17 @@ pub fn render_chunked(
 fn print_sched(
     before: &[Option<super::sched::ThreadSched>],
     cpus: &[(usize, [u64; 8])],
+    process: &[(i64, u64)],
     start: Instant,
     band_times: &[(usize, f64, f64)],
 ) {
     let after = rayon::broadcast(|_| super::sched::read_self());
     let region_s = start.elapsed().as_secs_f64();
+    let pool: Vec<i64> = after.iter().flatten().map(|t| t.tid).collect();
+    eprintln!(
+        "{}",
+        super::sched::process_line(process, &super::sched::process_threads(), &pool)
+    );
     for l in super::sched::cpu_lines(cpus, &super::sched::read_cpus()) {
         eprintln!("{l}");
     }
