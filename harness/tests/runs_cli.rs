@@ -520,3 +520,35 @@ fn sched_lines_account_each_pool_thread() {
         "{err}"
     );
 }
+
+/// Session 14 (issue 20, acceptance 3): a run-one of Embree drops its untimed engine before the
+/// timed ones; releasing that engine's Embree device lifted TBB's one-thread limit and oneTBB
+/// started a worker thread that spun in `sched_yield` beside every later trace. Now the process
+/// has no thread beyond its own: the main thread, the two-thread pool and the one-thread pool of
+/// the pairs (`sched process` lines of RTBENCH_SCHED), and none outside the pool ran for long.
+#[test]
+fn embree_leaves_no_thread_spinning_beside_the_trace() {
+    let _one_at_a_time = serial();
+    let out = rtbench()
+        .env("RTBENCH_MAX_THREADS", "2")
+        .env("RTBENCH_SCHED", "1")
+        .args([
+            "run-one", "--scene", "balls", "--sf", "2", "--engine", "embree", "--threads", "2",
+            "--repeat", "2", "--size", "64", "--no-check", "--paired-threads", "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(ok(&out), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("sched process"))
+        .collect();
+    // The untimed render, two repeats, the one-thread pool's untimed render and one pair.
+    assert_eq!(lines.len(), 6, "{err}");
+    for l in &lines {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        let threads: usize = w[3].parse().unwrap();
+        assert!(threads <= 4, "a thread beyond main and the pools: {l}");
+    }
+}
