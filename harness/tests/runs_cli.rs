@@ -533,8 +533,22 @@ fn embree_leaves_no_thread_spinning_beside_the_trace() {
         .env("RTBENCH_MAX_THREADS", "2")
         .env("RTBENCH_SCHED", "1")
         .args([
-            "run-one", "--scene", "balls", "--sf", "2", "--engine", "embree", "--threads", "2",
-            "--repeat", "2", "--size", "64", "--no-check", "--paired-threads", "1",
+            "run-one",
+            "--scene",
+            "balls",
+            "--sf",
+            "2",
+            "--engine",
+            "embree",
+            "--threads",
+            "2",
+            "--repeat",
+            "2",
+            "--size",
+            "64",
+            "--no-check",
+            "--paired-threads",
+            "1",
         ])
         .output()
         .unwrap();
