@@ -443,3 +443,126 @@ fn paired_threads_above_the_limit_is_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--paired-threads 1001"), "{err}");
 }
+
+/// `RTBENCH_SCHED=bands` (issue 20, acceptance 3): a two-thread render prints one `sched thread`
+/// line per pool thread (run + run-queue wait + off-CPU seconds make its wall seconds, the bands
+/// it counts are its band lines), one `sched cpu` line per CPU and one `sched band` line per
+/// band, and the image is the one rendered without it.
+#[test]
+fn sched_lines_account_each_pool_thread() {
+    let _one_at_a_time = serial();
+    let render = |sched: bool| {
+        let mut c = rtbench();
+        c.env("RTBENCH_MAX_THREADS", "2").args([
+            "render",
+            "--scene",
+            "tetra",
+            "--sf",
+            "2",
+            "--engine",
+            "bvh8",
+            "--threads",
+            "2",
+            "--size",
+            "96",
+            "--json",
+        ]);
+        if sched {
+            c.env("RTBENCH_SCHED", "bands");
+        } else {
+            c.env_remove("RTBENCH_SCHED");
+        }
+        let out = c.output().unwrap();
+        assert!(ok(&out), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (
+            v["image"]["sha256"].clone(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (plain, quiet) = render(false);
+    assert!(!quiet.contains("sched "), "{quiet}");
+    let (image, err) = render(true);
+    assert_eq!(image, plain, "RTBENCH_SCHED changes no answer");
+    let field = |l: &str, k: &str| -> f64 {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        let i = w
+            .iter()
+            .position(|x| *x == k)
+            .unwrap_or_else(|| panic!("{k} in {l}"));
+        w[i + 1].parse().unwrap()
+    };
+    let threads: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("sched thread"))
+        .collect();
+    assert_eq!(threads.len(), 2, "{err}");
+    let bands = err.lines().filter(|l| l.starts_with("sched band")).count();
+    assert!(bands > 2, "{err}");
+    let mut counted = 0.0;
+    for (i, l) in threads.iter().enumerate() {
+        assert!(l.starts_with(&format!("sched thread {i} tid ")), "{l}");
+        let wall = field(l, "wall_s");
+        let sum = field(l, "run_s") + field(l, "runq_wait_s") + field(l, "off_s");
+        assert!(wall > 0.0 && field(l, "run_s") > 0.0, "{l}");
+        // off_s is what is left of the wall time, so the three add up (to the printed digits)
+        // unless run + wait exceed it (readings a little apart): then off_s is 0.
+        assert!(sum >= wall - 1e-5, "{l}");
+        assert!(
+            field(l, "in_bands_s") <= field(l, "last_band_end_s") + 1e-6,
+            "{l}"
+        );
+        counted += field(l, "bands");
+    }
+    assert_eq!(counted as usize, bands, "{err}");
+    assert!(
+        err.lines().any(|l| l.starts_with("sched cpu 0 user_s")),
+        "{err}"
+    );
+}
+
+/// Session 14 (issue 20, acceptance 3): a run-one of Embree drops its untimed engine before the
+/// timed ones; releasing that engine's Embree device lifted TBB's one-thread limit and oneTBB
+/// started a worker thread that spun in `sched_yield` beside every later trace. Now the process
+/// has no thread beyond its own: the main thread, the two-thread pool and the one-thread pool of
+/// the pairs (`sched process` lines of RTBENCH_SCHED), and none outside the pool ran for long.
+#[test]
+fn embree_leaves_no_thread_spinning_beside_the_trace() {
+    let _one_at_a_time = serial();
+    let out = rtbench()
+        .env("RTBENCH_MAX_THREADS", "2")
+        .env("RTBENCH_SCHED", "1")
+        .args([
+            "run-one",
+            "--scene",
+            "balls",
+            "--sf",
+            "2",
+            "--engine",
+            "embree",
+            "--threads",
+            "2",
+            "--repeat",
+            "2",
+            "--size",
+            "64",
+            "--no-check",
+            "--paired-threads",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(ok(&out), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("sched process"))
+        .collect();
+    // The untimed render, two repeats, the one-thread pool's untimed render and one pair.
+    assert_eq!(lines.len(), 6, "{err}");
+    for l in &lines {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        let threads: usize = w[3].parse().unwrap();
+        assert!(threads <= 4, "a thread beyond main and the pools: {l}");
+    }
+}

@@ -17,14 +17,14 @@ use std::time::Instant;
 const TRIANGLES: u32 = 0;
 const USER: u32 = 1;
 
-/// The `embree` engine. Field order is drop order and matters: the scene is released first
-/// (Embree then frees the BVH and reports it to the monitor, whose state the device owns), then
-/// the user primitives the scene's callbacks read, then the device.
+/// The `embree` engine. The scene is released first (in `Drop`, under the device's build lock:
+/// Embree then frees the BVH and reports it to the monitor), then the user primitives the
+/// scene's callbacks read. The device is the process's shared one of this configuration
+/// ([`Device::shared`]), never released.
 pub struct EmbreeEngine {
     scene: Scene,
     _user: Box<UserPrims>,
-    /// Kept for its lifetime only: the scene and the memory monitor need it.
-    _device: Device,
+    device: &'static Device,
     /// primID → scene object, per geomID (`objects[TRIANGLES]`, `objects[USER]`).
     objects: [Vec<u32>; 2],
     stats: BTreeMap<String, f64>,
@@ -52,7 +52,14 @@ impl EmbreeEngine {
     pub fn build(input: &BuildInput, config: &EmbreeConfig) -> Result<EmbreeEngine, EngineError> {
         let t0 = Instant::now();
         let geo = &input.geometry;
-        let device = Device::new(&config.device_config()).map_err(build_err)?;
+        let device = Device::shared(&config.device_config()).map_err(build_err)?;
+        // Until the commit, the monitor counts this scene only: its bytes are the difference.
+        let _building = device.state.build.lock().unwrap_or_else(|e| e.into_inner());
+        let (bytes_before, _) = device.memory();
+        device
+            .state
+            .peak_bytes
+            .store(bytes_before, std::sync::atomic::Ordering::Relaxed);
 
         // Split the prepared primitives: triangles for Embree, the rest for the user geometry.
         let mut tri_object = Vec::new();
@@ -189,7 +196,8 @@ impl EmbreeEngine {
         let commit_seconds = t1.elapsed().as_secs_f64();
         device.check("rtcCommitScene").map_err(build_err)?;
 
-        let (embree_bytes, embree_peak) = device.memory();
+        let (bytes_now, peak_now) = device.memory();
+        let (embree_bytes, embree_peak) = (bytes_now - bytes_before, peak_now - bytes_before);
         let own_bytes = (tri_object.capacity() + user_object.capacity()) * 4
             + user.prims.capacity() * std::mem::size_of::<Prim>();
         let structure_bytes = embree_bytes.max(0) as u64 + own_bytes as u64;
@@ -218,7 +226,7 @@ impl EmbreeEngine {
         Ok(EmbreeEngine {
             scene,
             _user: user,
-            _device: device,
+            device,
             objects: [tri_object, user_object],
             stats,
             structure_bytes,
@@ -240,6 +248,20 @@ impl EmbreeEngine {
                 .entry("user_primitive_hits".into())
                 .or_insert(0) += hits;
         }
+    }
+}
+
+impl Drop for EmbreeEngine {
+    fn drop(&mut self) {
+        // Released under the build lock, so that a build on another thread reads only its own
+        // scene's bytes; the user primitives (a later field) are still alive for Embree here.
+        let _releasing = self
+            .device
+            .state
+            .build
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        drop(std::mem::replace(&mut self.scene, Scene(null_mut())));
     }
 }
 

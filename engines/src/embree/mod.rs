@@ -62,7 +62,7 @@ pub fn info() -> EngineInfo {
 fn available() -> Result<(), String> {
     static AVAILABLE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     AVAILABLE
-        .get_or_init(|| raw::Device::new("verbose=0").map(|_| ()))
+        .get_or_init(|| raw::Device::shared(&EmbreeConfig::default().device_config()).map(|_| ()))
         .clone()
 }
 
@@ -90,7 +90,9 @@ fn build(_input: &BuildInput, settings: Settings) -> Result<Box<dyn Engine>, Eng
 pub fn version() -> Result<String, String> {
     #[cfg(feature = "embree")]
     {
-        raw::Device::new("verbose=0").map(|d| d.version())
+        // The engines' default device (see `raw::Device::shared`): making and releasing a
+        // device of another configuration here would lift TBB's thread limit.
+        raw::Device::shared(&EmbreeConfig::default().device_config()).map(|d| d.version())
     }
     #[cfg(not(feature = "embree"))]
     {

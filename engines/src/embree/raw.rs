@@ -8,10 +8,11 @@
 //! callbacks read only its first field (`instID[0]`, where it always was).
 
 use super::api as sys;
+use std::collections::HashMap;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::ptr::null_mut;
 use std::sync::atomic::{AtomicI64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// What Embree's callbacks on a device record: memory in use and its peak (from the memory
 /// monitor), and the last error message (from the error callback).
@@ -20,6 +21,10 @@ pub struct DeviceState {
     pub bytes: AtomicI64,
     pub peak_bytes: AtomicI64,
     pub last_error: Mutex<Option<String>>,
+    /// Held by a build from before its scene is made until it is committed, and by an engine
+    /// releasing its scene: the memory monitor's counts then change only for that scene, so a
+    /// build reads its own bytes as a difference on a device that other scenes share.
+    pub build: Mutex<()>,
 }
 
 /// Embree's memory monitor: `bytes` > 0 before an allocation, < 0 after a release. Called from
@@ -86,6 +91,29 @@ impl Device {
         Ok(Device { handle, state })
     }
 
+    /// The process's one device of configuration `config`, made on first use and never released
+    /// (issue 20, acceptance 3). Embree configures TBB's thread count once per device: a device
+    /// of `threads=1` installs a `tbb::global_control` of one thread, and releasing the last
+    /// device (or making another) destroys it. With that limit lifted oneTBB woke a worker
+    /// thread that then spun in `sched_yield` for the rest of the process (a whole CPU of system
+    /// time, from the first Embree engine dropped on), and on two cores the scheduler stacked the
+    /// two trace threads on the other CPU for a fifth to a third of a two-thread trace
+    /// (docs/benchmarks.md, session 14). One device per configuration for the process's life
+    /// keeps the limit in place: no worker is ever started for `threads=1`.
+    pub fn shared(config: &str) -> Result<&'static Device, String> {
+        static DEVICES: OnceLock<Mutex<HashMap<String, &'static Device>>> = OnceLock::new();
+        let mut map = DEVICES
+            .get_or_init(Mutex::default)
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        if let Some(d) = map.get(config) {
+            return Ok(*d);
+        }
+        let d: &'static Device = Box::leak(Box::new(Device::new(config)?));
+        map.insert(config.to_string(), d);
+        Ok(d)
+    }
+
     /// `Err` with Embree's code and last message if the device has an error pending (clears it).
     pub fn check(&self, what: &str) -> Result<(), String> {
         // SAFETY: `self.handle` is a live device.
@@ -126,6 +154,13 @@ impl Device {
     }
 }
 
+// SAFETY: an Embree device handle may be used from any thread (Embree's API is thread-safe for
+// the calls made here: making scenes and geometries, reading properties and errors); the state
+// is atomics and mutexes.
+unsafe impl Send for Device {}
+// SAFETY: see `Send`.
+unsafe impl Sync for Device {}
+
 impl Drop for Device {
     fn drop(&mut self) {
         // SAFETY: we own one reference to the device; `state` is still alive here (fields are
@@ -139,6 +174,9 @@ pub struct Scene(pub sys::RTCScene);
 
 impl Drop for Scene {
     fn drop(&mut self) {
+        if self.0.is_null() {
+            return;
+        }
         // SAFETY: we own one reference to the scene, which is not used after this.
         unsafe { sys::rtcReleaseScene(self.0) }
     }

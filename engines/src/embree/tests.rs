@@ -369,6 +369,32 @@ mod with_embree {
         }
     }
 
+    /// Engines of one configuration share the process's one device, never released (releasing
+    /// it let oneTBB start a worker that spun beside the trace: session 14), and each still
+    /// reports its own scene's bytes: two builds of one scene read the same, before and after
+    /// another engine on the device is dropped.
+    #[test]
+    fn engines_share_one_device_and_count_their_own_bytes() {
+        let cfg = EmbreeConfig::default().device_config();
+        let d = raw::Device::shared(&cfg).unwrap();
+        assert!(std::ptr::eq(d, raw::Device::shared(&cfg).unwrap()));
+        let mut rng = Rng(11);
+        let inp = input(random_scene(&mut rng));
+        let bytes = |e: &dyn crate::engine::Engine| {
+            let s = e.build_stats();
+            (s["embree_bytes"], s["embree_peak_bytes"])
+        };
+        let a = build_embree(&inp, vec![]).unwrap();
+        let b = build_embree(&inp, vec![]).unwrap();
+        let (ab, bb) = (bytes(a.as_ref()), bytes(b.as_ref()));
+        assert!(ab.0 > 0.0 && ab.1 >= ab.0, "{ab:?}");
+        assert_eq!(ab, bb);
+        drop(a);
+        let c = build_embree(&inp, vec![]).unwrap();
+        assert_eq!(bytes(c.as_ref()), ab);
+        assert_eq!(b.structure_bytes(), c.structure_bytes());
+    }
+
     #[test]
     fn memory_and_stats_are_reported() {
         let mut rng = Rng(7);

@@ -9,6 +9,7 @@ pub mod paging;
 pub mod pass_003;
 pub mod rayshade_memory;
 pub mod replacement;
+pub mod sched;
 pub mod surface;
 pub mod tiles;
 pub mod trace;
@@ -131,10 +132,49 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
             "--threads {n}: more than the {most} this machine runs at once"
         )));
     }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
+    let mut b = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0));
+    if std::env::var_os(PIN_THREADS_VAR).is_some() {
+        let cpus = allowed_cpus();
+        if !cpus.is_empty() {
+            b = b.start_handler(move |i| pin_to_cpu(cpus[i % cpus.len()]));
+        }
+    }
+    b.build()
         .map_err(|e| input(format!("cannot start threads: {e}")))
+}
+
+/// Environment variable that pins each thread of every pool [`pool`] makes to one CPU of those
+/// the process may run on (thread i to the i-th, round robin): an experiment on where the
+/// scheduler puts the pool's threads (issue 20, acceptance 3), not a default.
+pub const PIN_THREADS_VAR: &str = "RTBENCH_PIN_THREADS";
+
+/// The CPUs the calling thread may run on (empty where that cannot be read).
+pub fn allowed_cpus() -> Vec<usize> {
+    // SAFETY: a zeroed cpu_set_t is a valid empty set; sched_getaffinity writes only into it.
+    let mut set: libc::cpu_set_t = unsafe { std::mem::zeroed() };
+    // SAFETY: pid 0 is the calling thread; the size is the set's own.
+    let rc =
+        unsafe { libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) };
+    if rc != 0 {
+        return Vec::new();
+    }
+    (0..libc::CPU_SETSIZE as usize)
+        // SAFETY: `c` is below CPU_SETSIZE, the set's capacity.
+        .filter(|&c| unsafe { libc::CPU_ISSET(c, &set) })
+        .collect()
+}
+
+/// Pins the calling thread to `cpu` (best effort: a refusal leaves it where it was).
+pub fn pin_to_cpu(cpu: usize) {
+    // SAFETY: as in `allowed_cpus`; CPU_SET writes only into `set`, `cpu` < CPU_SETSIZE is checked.
+    unsafe {
+        if cpu >= libc::CPU_SETSIZE as usize {
+            return;
+        }
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_SET(cpu, &mut set);
+        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
+    }
 }
 
 /// Bytes the workload holds per pixel corner, at least: measured 80 (in-memory engines) to 210

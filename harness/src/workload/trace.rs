@@ -470,6 +470,18 @@ pub fn render_chunked(
     let seams = Mutex::new(seams);
     let recording = record.is_some();
     let bands = std::env::var_os(BANDS_VAR).is_some();
+    let sched_on = std::env::var_os(super::sched::SCHED_VAR).is_some();
+    // With RTBENCH_SCHED: each pool thread's scheduler counts before the region, and every
+    // band's (thread, start, end) seconds from the region's start.
+    let sched_start = Instant::now();
+    let cpus_before = sched_on.then(super::sched::read_cpus);
+    let process_before = sched_on.then(super::sched::process_threads);
+    let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
+    // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
+    // ended on, and its start and end.
+    let sched_bands =
+        sched_on && std::env::var_os(super::sched::SCHED_VAR).is_some_and(|v| v == "bands");
+    let band_times: Mutex<Vec<(usize, f64, f64)>> = Mutex::new(Vec::new());
     // One wavefront per pool thread, reused from band to band. A thread that runs a second band
     // while its first waits inside the engine's batches (rayon's join lets it) gets a fresh one.
     let threads = rayon::current_num_threads().max(1);
@@ -500,7 +512,22 @@ pub fn render_chunked(
             };
             let rows = band_rows.min(w - j0);
             let cpu = bands.then(super::thread_cpu_seconds);
+            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), super::sched::cpu()));
             let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
+            if let Some((s, cpu0)) = band_start {
+                let e = t.elapsed().as_secs_f64();
+                let i = rayon::current_thread_index().unwrap_or(usize::MAX);
+                if sched_bands {
+                    eprintln!(
+                        "sched band {k} thread {i} cpu {cpu0} {} start_s {s:.6} end_s {e:.6}",
+                        super::sched::cpu()
+                    );
+                }
+                band_times
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push((i, s, e));
+            }
             if let Some(cpu) = cpu {
                 let c = &part.counters;
                 eprintln!(
@@ -536,6 +563,15 @@ pub fn render_chunked(
         })
         .collect();
     let region_s = t.elapsed().as_secs_f64();
+    if let (Some(before), Some(cpus), Some(process)) = (sched_before, cpus_before, process_before) {
+        print_sched(
+            &before,
+            &cpus,
+            &process,
+            sched_start,
+            &band_times.into_inner().unwrap_or_default(),
+        );
+    }
     debug_assert!(seams
         .into_inner()
         .unwrap_or_else(|e| e.into_inner())
@@ -576,6 +612,52 @@ pub fn render_chunked(
         shade_s: shade_s * share,
         trace_s: start.elapsed().as_secs_f64(),
         trace_cpu_s: pool_cpu_seconds() - cpu_start,
+    }
+}
+
+/// The `sched` lines of [`super::sched::SCHED_VAR`]: each pool thread's scheduler counts over
+/// the parallel region (`before`: read by each thread at the region's start, in thread order,
+/// after `start`; the wall seconds are from `start` to when every thread has read its counts
+/// again) and its bands' wall seconds (`band_times`: thread, start, end).
+fn print_sched(
+    before: &[Option<super::sched::ThreadSched>],
+    cpus: &[(usize, [u64; 8])],
+    process: &[(i64, u64)],
+    start: Instant,
+    band_times: &[(usize, f64, f64)],
+) {
+    let after = rayon::broadcast(|_| super::sched::read_self());
+    let region_s = start.elapsed().as_secs_f64();
+    let pool: Vec<i64> = after.iter().flatten().map(|t| t.tid).collect();
+    eprintln!(
+        "{}",
+        super::sched::process_line(process, &super::sched::process_threads(), &pool)
+    );
+    for l in super::sched::cpu_lines(cpus, &super::sched::read_cpus()) {
+        eprintln!("{l}");
+    }
+    for (i, (b, a)) in before.iter().zip(&after).enumerate() {
+        let (Some(b), Some(a)) = (b, a) else {
+            eprintln!("sched thread {i} unavailable (no /proc/thread-self/schedstat)");
+            continue;
+        };
+        let mine: Vec<(f64, f64)> = band_times
+            .iter()
+            .filter(|x| x.0 == i)
+            .map(|x| (x.1, x.2))
+            .collect();
+        let last = mine.iter().map(|x| x.1).fold(0.0, f64::max);
+        eprintln!(
+            "{}",
+            super::sched::line(
+                i,
+                region_s,
+                &a.since(b),
+                mine.len(),
+                super::sched::covered_seconds(&mine),
+                last
+            )
+        );
     }
 }
 
