@@ -3,7 +3,7 @@
 # traces (`run-one --threads 2 --paired-threads 5`, session 12's protocol) with each pool thread's scheduler
 # accounting and every band's CPU per render (RTBENCH_SCHED=bands), then the same with the pool's threads pinned
 # one per CPU (RTBENCH_PIN_THREADS=1). Usage: window.sh BIN OUTDIR
-B=$1; O=$2; Q=${QUIET_FILE:-/work/runs/QUIET}; mkdir -p $O
+B=$1; O=$2; Q=${QUIET_FILE:?set QUIET_FILE to the file that marks the quiet window}; mkdir -p $O
 stamp() { echo "$1 $(date -u +%H:%M:%S) load $(cut -d' ' -f1-3 /proc/loadavg) quiet $(test -e $Q && echo yes || echo no) $(grep '^cpu ' /proc/stat)"; }
 one() { # tag engine scene sf [env...]
   local tag=$1 e=$2 n=$3 sf=$4; shift 4

@@ -2,7 +2,7 @@
 # Issue 20 acceptance 3, session 14 helper, second part of the quiet window: session 12's acceptance run
 # (embree, bvh4, bvh8 on the seven scenes, two threads, 5 pairs) with the pool's threads free and pinned one
 # per CPU (RTBENCH_PIN_THREADS=1), alternating, as long as the window lasts. Usage: window2.sh BIN OUTDIR
-B=$1; O=$2; Q=${QUIET_FILE:-/work/runs/QUIET}; mkdir -p $O
+B=$1; O=$2; Q=${QUIET_FILE:?set QUIET_FILE to the file that marks the quiet window}; mkdir -p $O
 stamp() { echo "$1 $(date -u +%H:%M:%S) load $(cut -d' ' -f1-3 /proc/loadavg) quiet $(test -e $Q && echo yes || echo no) $(grep '^cpu ' /proc/stat)"; }
 stamp start
 for sc in balls gears mount rings teapot tetra tree; do

@@ -470,7 +470,8 @@ pub fn render_chunked(
     let seams = Mutex::new(seams);
     let recording = record.is_some();
     let bands = std::env::var_os(BANDS_VAR).is_some();
-    let sched_on = std::env::var_os(super::sched::SCHED_VAR).is_some();
+    let sched = std::env::var_os(super::sched::SCHED_VAR);
+    let sched_on = sched.is_some();
     // With RTBENCH_SCHED: each pool thread's scheduler counts before the region, and every
     // band's (thread, start, end) seconds from the region's start.
     let sched_start = Instant::now();
@@ -479,8 +480,7 @@ pub fn render_chunked(
     let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
     // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
     // ended on, and its start and end.
-    let sched_bands =
-        sched_on && std::env::var_os(super::sched::SCHED_VAR).is_some_and(|v| v == "bands");
+    let sched_bands = sched.is_some_and(|v| v == "bands");
     let band_times: Mutex<Vec<(usize, f64, f64)>> = Mutex::new(Vec::new());
     // One wavefront per pool thread, reused from band to band. A thread that runs a second band
     // while its first waits inside the engine's batches (rayon's join lets it) gets a fresh one.
