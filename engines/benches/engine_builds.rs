@@ -1,8 +1,11 @@
 //! Build times against Embree's, side by side (issue 20, acceptance 4):
 //! `cargo bench -p rtbench-engines --bench engine_builds -- [SCENE[:SF] ...] [--rounds R]`.
 //!
-//! Each round builds every engine below once over the same prepared geometry, in an order that
-//! rotates from round to round, so that load from other processes falls on all of them; each
+//! Each round builds every engine below once, each build in a child process of its own (Embree
+//! keeps one device per thread setting for the process's life, and a live `threads=2` device lets
+//! a `threads=1` build use two threads: 1.6–1.8 CPUs in one process, issue 20, session 15), in an
+//! order that rotates from round to round, so that load from other processes falls on all of
+//! them. Each line also prints the build's CPU time over its wall time. Each
 //! build's wall time is the engine's whole build (`build_engine`: Embree's device, scene and
 //! BVH; bvh8's primitive boxes, tree, collapse and leaf layout). Printed per engine: the median
 //! and range of the rounds, and per round the ratio of bvh8's time to Embree's at the same
@@ -31,9 +34,95 @@ const ENGINES: &[Setup] = &[
     ("bvh8 2 threads", "bvh8", &[("build_threads", "2")]),
 ];
 
+/// CPU time of the whole process (every thread) so far, in seconds.
+fn process_cpu_s() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec to write; CLOCK_PROCESS_CPUTIME_ID is always available on Linux.
+    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// The scene of `program` at `sf` (the standard SF when `None`), tessellated as the harness's
+/// `--tessellate 3` makes it, and the engines' input over it.
+fn input_of(program: Program, sf: Option<u32>) -> (Options, BuildInput) {
+    let mut opts = Options {
+        tessellate: Some(3),
+        ..Options::standard(program)
+    };
+    if let Some(sf) = sf {
+        opts.size_factor = sf;
+    }
+    let scene = Arc::new(generate_scene(program, &opts).expect("scene"));
+    let geometry = Arc::new(Geometry::from_scene(&scene));
+    (opts, BuildInput { scene, geometry })
+}
+
+/// One build of `ENGINES[k]` in this process (a child of the bench): prints its wall and CPU
+/// seconds and the primitive count.
+fn child(k: usize, program: Program, sf: Option<u32>) {
+    let (_, input) = input_of(program, sf);
+    let (_, name, set) = ENGINES[k];
+    let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
+    let (t, c, r) = (Instant::now(), process_cpu_s(), usage());
+    let engine = build_engine(name, &input, s.collect()).expect("engine");
+    let (wall, cpu, r2) = (t.elapsed().as_secs_f64(), process_cpu_s() - c, usage());
+    drop(engine);
+    println!(
+        "{wall} {cpu} {} {} {}",
+        input.geometry.prims.len(),
+        r2.0 - r.0,
+        r2.1 - r.1
+    );
+}
+
+/// `ENGINES[k]` built once in a child process of its own: (wall s, CPU s, primitives).
+fn build_in_child(k: usize, scene: &str) -> (f64, f64, usize) {
+    let out = std::process::Command::new(std::env::current_exe().expect("the bench's path"))
+        .args(["--child", &k.to_string(), scene])
+        .output()
+        .expect("run the bench as a child");
+    assert!(
+        out.status.success(),
+        "child build of {} failed: {}",
+        ENGINES[k].0,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let f: Vec<&str> = text.split_whitespace().collect();
+    (
+        f[0].parse().unwrap(),
+        f[1].parse().unwrap(),
+        f[2].parse().unwrap(),
+    )
+}
+
+/// The process's minor page faults and system CPU seconds so far.
+fn usage() -> (i64, f64) {
+    // SAFETY: an all-zero `rusage` is valid, and getrusage writes only into it.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: RUSAGE_SELF with a valid pointer.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    (
+        u.ru_minflt,
+        u.ru_stime.tv_sec as f64 + u.ru_stime.tv_usec as f64 * 1e-6,
+    )
+}
+
+fn load() -> String {
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    load.split_whitespace()
+        .take(3)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 fn main() {
-    let mut scenes: Vec<(Program, Option<u32>)> = Vec::new();
+    let mut scenes: Vec<(String, Program, Option<u32>)> = Vec::new();
     let mut rounds = 5usize;
+    let mut child_of: Option<usize> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -43,54 +132,41 @@ fn main() {
                     .and_then(|s| s.parse().ok())
                     .expect("--rounds R")
             }
+            "--child" => child_of = args.next().and_then(|s| s.parse().ok()),
             s if !s.starts_with('-') => {
                 let (name, sf) = match s.split_once(':') {
                     Some((n, f)) => (n, Some(f.parse().expect("SCENE:SF"))),
                     None => (s, None),
                 };
-                scenes.push((name.parse().expect("an SPD program"), sf));
+                scenes.push((s.to_string(), name.parse().expect("an SPD program"), sf));
             }
             _ => {}
         }
     }
     if scenes.is_empty() {
-        scenes = vec![(Program::Balls, None)];
+        scenes = vec![("balls".to_string(), Program::Balls, None)];
     }
-    for (program, sf) in scenes {
-        let mut opts = Options {
-            tessellate: Some(3),
-            ..Options::standard(program)
-        };
-        if let Some(sf) = sf {
-            opts.size_factor = sf;
-        }
-        let scene = Arc::new(generate_scene(program, &opts).expect("scene"));
-        let geometry = Arc::new(Geometry::from_scene(&scene));
-        let input = BuildInput {
-            scene: scene.clone(),
-            geometry: geometry.clone(),
-        };
-        let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    if let Some(k) = child_of {
+        let (_, program, sf) = &scenes[0];
+        return child(k, *program, *sf);
+    }
+    for (arg, program, sf) in scenes {
+        let sf = sf.unwrap_or(Options::standard(program).size_factor);
         println!(
-            "{} sf {} tessellated: {} primitives; {rounds} rounds; load before {}",
+            "{} sf {sf} tessellated: {rounds} rounds, each build in a process of its own; load before {}",
             program.name(),
-            opts.size_factor,
-            geometry.prims.len(),
-            load.split_whitespace()
-                .take(3)
-                .collect::<Vec<_>>()
-                .join(" ")
+            load()
         );
         let mut times = vec![Vec::new(); ENGINES.len()];
+        let mut cpu = vec![Vec::new(); ENGINES.len()];
+        let mut prims = 0;
         for round in 0..rounds {
             for k in 0..ENGINES.len() {
                 let e = (k + round) % ENGINES.len();
-                let (_, name, set) = ENGINES[e];
-                let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
-                let t = Instant::now();
-                let engine = build_engine(name, &input, s.collect()).expect("engine");
-                times[e].push(t.elapsed().as_secs_f64());
-                drop(engine);
+                let (wall, c, n) = build_in_child(e, &arg);
+                times[e].push(wall);
+                cpu[e].push(c);
+                prims = n;
             }
             println!(
                 "  round {}: {}; bvh8/embree 1 thread {:.2}, 2 threads {:.2}",
@@ -98,13 +174,19 @@ fn main() {
                 ENGINES
                     .iter()
                     .zip(&times)
-                    .map(|((l, _, _), t)| format!("{l} {:.3} s", t[round]))
+                    .zip(&cpu)
+                    .map(|(((l, _, _), t), c)| format!(
+                        "{l} {:.3} s (CPU {:.2}×)",
+                        t[round],
+                        c[round] / t[round]
+                    ))
                     .collect::<Vec<_>>()
                     .join(", "),
                 times[1][round] / times[0][round],
                 times[3][round] / times[2][round],
             );
         }
+        println!("  {prims} primitives");
         for ((label, _, _), t) in ENGINES.iter().zip(&times) {
             let mut s = t.clone();
             s.sort_by(f64::total_cmp);
@@ -123,13 +205,6 @@ fn main() {
             "  bvh8 / embree, median of rounds: 1 thread {:.2} (min {:.2}, max {:.2}), 2 threads {:.2} (min {:.2}, max {:.2})",
             r1[rounds / 2], r1[0], r1[rounds - 1], r2[rounds / 2], r2[0], r2[rounds - 1]
         );
-        let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-        println!(
-            "  load after {}",
-            load.split_whitespace()
-                .take(3)
-                .collect::<Vec<_>>()
-                .join(" ")
-        );
+        println!("  load after {}", load());
     }
 }

@@ -11,6 +11,7 @@
 use super::node::{is_leaf, leaf_range, packet_leaf_ref, WideNode, EMPTY_SLOT};
 use crate::geometry::triangle_simd::TrianglePacket;
 use crate::geometry::{Geometry, Prim};
+use std::mem::MaybeUninit;
 
 /// Triangles per leaf packet (Embree's `Triangle4`: one SSE test, or one half of AVX).
 pub const PACKET: usize = 4;
@@ -99,48 +100,52 @@ pub fn lay_out_threads<const N: usize>(
             node.child[slot] = place(node.child[slot]);
         }
     }
-    let blank = LeafPacket {
-        tri: TrianglePacket::new(&[]),
-        object: [u32::MAX; PACKET],
-    };
-    out.packets = vec![blank; next as usize];
-    let fill = |slice: &mut [LeafPacket], mine: &[(u32, u32, u32)], from: usize| {
+    // Every packet 0..next belongs to exactly one job (numbered in order above), so the fill
+    // below writes each once, straight into the spare capacity: no pass on one thread blanks
+    // 32 MB first (balls4 tessellated; issue 20, session 15).
+    let mut packets: Vec<LeafPacket> = Vec::with_capacity(next as usize);
+    let fill = |slice: &mut [MaybeUninit<LeafPacket>], mine: &[(u32, u32, u32)], from: usize| {
         for &(first, count, at) in mine {
             let ids = &order[first as usize..(first + count) as usize];
             let at = at as usize - from;
             for (p, o) in slice[at..].iter_mut().zip(ids.chunks(PACKET)) {
-                *p = packet_of(o, geometry);
+                p.write(packet_of(o, geometry));
             }
         }
     };
+    let all = &mut packets.spare_capacity_mut()[..next as usize];
     if threads <= 1 {
-        fill(&mut out.packets, &jobs, 0);
-        return out;
+        fill(all, &jobs, 0);
+    } else {
+        // Cut the jobs where the packets reach each thread's share; each part fills its own
+        // contiguous packets.
+        let share = (next as usize).div_ceil(threads).max(1);
+        std::thread::scope(|scope| {
+            let mut rest: &mut [MaybeUninit<LeafPacket>] = all;
+            let mut jobs_left: &[(u32, u32, u32)] = &jobs;
+            let mut base = 0usize;
+            while !jobs_left.is_empty() {
+                let end = base + share;
+                let k = jobs_left
+                    .iter()
+                    .position(|j| j.2 as usize >= end)
+                    .unwrap_or(jobs_left.len());
+                let (mine, more_jobs) = jobs_left.split_at(k);
+                let upto = more_jobs.first().map_or(next as usize, |j| j.2 as usize);
+                let (slice, more) = std::mem::take(&mut rest).split_at_mut(upto - base);
+                let from = base;
+                let fill = &fill;
+                scope.spawn(move || fill(slice, mine, from));
+                rest = more;
+                jobs_left = more_jobs;
+                base = upto;
+            }
+        });
     }
-    // Cut the jobs where the packets reach each thread's share; each part fills its own
-    // contiguous packets.
-    let share = (next as usize).div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        let mut rest: &mut [LeafPacket] = &mut out.packets;
-        let mut jobs_left: &[(u32, u32, u32)] = &jobs;
-        let mut base = 0usize;
-        while !jobs_left.is_empty() {
-            let end = base + share;
-            let k = jobs_left
-                .iter()
-                .position(|j| j.2 as usize >= end)
-                .unwrap_or(jobs_left.len());
-            let (mine, more_jobs) = jobs_left.split_at(k);
-            let upto = more_jobs.first().map_or(next as usize, |j| j.2 as usize);
-            let (slice, more) = std::mem::take(&mut rest).split_at_mut(upto - base);
-            let from = base;
-            let fill = &fill;
-            scope.spawn(move || fill(slice, mine, from));
-            rest = more;
-            jobs_left = more_jobs;
-            base = upto;
-        }
-    });
+    // SAFETY: the jobs' packets cover 0..next, each written once above (every job's
+    // `count.div_ceil(PACKET)` packets from its `at`); all threads joined at the scope's end.
+    unsafe { packets.set_len(next as usize) };
+    out.packets = packets;
     out
 }
 

@@ -80,16 +80,20 @@ pub struct BvhEngine<const N: usize> {
 /// Builds the tree of `config` over `geometry`: a build tree with at most `config.width`
 /// children per node.
 pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
-    let prims = BuildPrims::new_threads(geometry, config.build_threads);
+    let mut phases = Phases::new();
+    // The primitives' boxes and centres, made when a builder needs them: the binned build of a
+    // wide tree of packets (the default) makes its own boxes from the geometry instead.
+    let cell = std::cell::OnceCell::new();
+    let prims = || cell.get_or_init(|| BuildPrims::new_threads(geometry, config.build_threads));
     let (width, leaf) = (config.width, config.leaf);
     if width > 2 && config.wide == WideMethod::Direct {
         return match config.builder {
-            Builder::Median => build_median::nway(&prims, leaf, width),
+            Builder::Median => build_median::nway(prims(), leaf, width),
             Builder::SahSweep => {
-                build_sah::wide_same_axis(build_sah::Sweep::new(&prims), leaf, width)
+                build_sah::wide_same_axis(build_sah::Sweep::new(prims()), leaf, width)
             }
             Builder::SahBinned => {
-                build_sah::wide_same_axis(build_sah::Binned::new(&prims, config.bins), leaf, width)
+                build_sah::wide_same_axis(build_sah::Binned::new(prims(), config.bins), leaf, width)
             }
         };
     }
@@ -122,22 +126,24 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
         block,
         packable: &all,
     };
+    phases.mark("leaf rule");
     let binary = match config.builder {
         Builder::SahSweep if block_leaves => {
-            build_sah::binary_blocks(build_sah::Sweep::new(&prims).with_block(block), &rule)
+            build_sah::binary_blocks(build_sah::Sweep::new(prims()).with_block(block), &rule)
         }
         Builder::SahBinned if block_leaves => build_sah::binary_blocks_threads(
-            build_sah::Binned::new_threads(&prims, config.bins, config.build_threads)
+            build_sah::Binned::of_geometry(geometry, config.bins, config.build_threads)
                 .with_block(block),
             &rule,
             config.build_threads,
         ),
-        Builder::Median => build_median::binary(&prims, binary_leaf),
-        Builder::SahSweep => build_sah::binary(build_sah::Sweep::new(&prims), binary_leaf),
+        Builder::Median => build_median::binary(prims(), binary_leaf),
+        Builder::SahSweep => build_sah::binary(build_sah::Sweep::new(prims()), binary_leaf),
         Builder::SahBinned => {
-            build_sah::binary(build_sah::Binned::new(&prims, config.bins), binary_leaf)
+            build_sah::binary(build_sah::Binned::new(prims(), config.bins), binary_leaf)
         }
     };
+    phases.mark("binary tree");
     if width == 2 {
         binary
     } else {
@@ -157,7 +163,40 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
             split_leaves: config.split_leaves,
             scalar_before: scalar_before.as_deref(),
         };
-        collapse::collapse(&binary, width, leaves)
+        let wide = collapse::collapse_threads(&binary, width, leaves, config.build_threads);
+        phases.mark("collapse");
+        wide
+    }
+}
+
+/// Wall time per build phase on stderr when `RTBENCH_BUILD_PHASES` is set (a diagnostic, issue
+/// 20: which parts of a two-thread build run alone); nothing otherwise.
+struct Phases(Option<(Instant, f64, i64)>);
+
+impl Phases {
+    fn new() -> Phases {
+        Phases(std::env::var_os("RTBENCH_BUILD_PHASES").map(|_| Self::now()))
+    }
+    /// Now, the process's CPU seconds (every thread) and its minor page faults.
+    fn now() -> (Instant, f64, i64) {
+        // SAFETY: an all-zero `rusage` is valid, and getrusage writes only into it.
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: RUSAGE_SELF with a valid pointer.
+        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+        let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+        (Instant::now(), s(u.ru_utime) + s(u.ru_stime), u.ru_minflt)
+    }
+    fn mark(&mut self, what: &str) {
+        if let Some((t, cpu, faults)) = self.0 {
+            let (t2, cpu2, faults2) = Self::now();
+            eprintln!(
+                "build phase {what}: {:.1} ms, CPU {:.1} ms, {} page faults",
+                (t2 - t).as_secs_f64() * 1e3,
+                (cpu2 - cpu) * 1e3,
+                faults2 - faults
+            );
+            self.0 = Some(Self::now());
+        }
     }
 }
 
@@ -225,16 +264,17 @@ pub fn build_bvh<const N: usize>(
         return Ok((bvh, s));
     }
     let tree = build_tree(geometry, config);
+    let mut phases = Phases::new();
     debug_assert_eq!(
         tree.validate(&BuildPrims::new(geometry), N),
         Ok(()),
         "builder broke an invariant"
     );
-    let mut flat = if config.build_threads > 1 {
-        node::flatten_threads::<N>(&tree, config.build_threads)
-    } else {
-        flatten::<N>(&tree)
-    };
+    // One thread: flattening on two (session 12) copied the halves once more and took their
+    // page faults on fresh pages, 7.7–11 ms against 1.9 ms on one thread in a fresh process
+    // (balls4 tessellated; issue 20, session 15).
+    let mut flat = flatten::<N>(&tree);
+    phases.mark("flatten");
     let extent = flat
         .root_bounds
         .lo
@@ -271,6 +311,7 @@ pub fn build_bvh<const N: usize>(
         );
         (s, leaves)
     };
+    phases.mark("statistics and leaf layout");
     Ok((
         Bvh {
             nodes: flat.nodes,

@@ -144,17 +144,6 @@ pub fn flatten<const N: usize>(tree: &BuildTree) -> Flat<N> {
 }
 
 fn emit<const N: usize>(tree: &BuildTree, i: u32, out: &mut Vec<WideNode<N>>) -> u32 {
-    emit_at(tree, i, out, 0)
-}
-
-/// [`emit`] into `out`, whose first node will sit at position `base` of the flat tree: child
-/// references are positions in the whole tree.
-fn emit_at<const N: usize>(
-    tree: &BuildTree,
-    i: u32,
-    out: &mut Vec<WideNode<N>>,
-    base: usize,
-) -> u32 {
     match tree.nodes[i as usize].kind {
         BuildKind::Leaf { first, count } => leaf_ref(first, count),
         BuildKind::Inner { children, len } => {
@@ -163,84 +152,13 @@ fn emit_at<const N: usize>(
             let len = len as usize;
             assert!(len <= N, "a build node has {len} children, more than {N}");
             for (slot, &c) in children[..len].iter().enumerate() {
-                let r = emit_at(tree, c, out, base);
+                let r = emit(tree, c, out);
                 let b = tree.nodes[c as usize].bounds;
                 out[me].set(slot, &b, r);
             }
             out[me].len = len as u32;
-            (base + me) as u32
+            me as u32
         }
-    }
-}
-
-/// Inner nodes of the subtree under build node `i`: the flat nodes [`emit`] makes of it.
-fn inner_count(tree: &BuildTree, i: u32) -> usize {
-    match tree.nodes[i as usize].kind {
-        BuildKind::Leaf { .. } => 0,
-        BuildKind::Inner { children, len } => {
-            1 + children[..len as usize]
-                .iter()
-                .map(|&c| inner_count(tree, c))
-                .sum::<usize>()
-        }
-    }
-}
-
-/// [`flatten`] with the root's children's subtrees emitted on two threads (the first children
-/// on one, the rest on the other, cut where the nodes are about half): each subtree's nodes go
-/// where the one-thread depth-first order puts them, so the nodes are [`flatten`]'s. Flattening
-/// was 82 M of the instructions the first thread ran alone in a two-thread build of balls4
-/// tessellated (callgrind, issue 20, session 12).
-pub fn flatten_threads<const N: usize>(tree: &BuildTree, threads: usize) -> Flat<N> {
-    assert!(N <= MAX_WIDTH);
-    let (children, len) = match tree.nodes[0].kind {
-        BuildKind::Inner { children, len } if threads > 1 => (children, len as usize),
-        _ => return flatten(tree),
-    };
-    assert!(len <= N, "a build node has {len} children, more than {N}");
-    let counts: Vec<usize> = children[..len]
-        .iter()
-        .map(|&c| inner_count(tree, c))
-        .collect();
-    let total: usize = counts.iter().sum();
-    // Where each child's subtree starts in the flat tree (the root is node 0).
-    let mut starts = Vec::with_capacity(len);
-    let mut at = 1;
-    for n in &counts {
-        starts.push(at);
-        at += n;
-    }
-    let cut = (1..len)
-        .min_by_key(|&k| (starts[k] - 1).abs_diff(total - (starts[k] - 1)))
-        .unwrap_or(len);
-    let part = |range: std::ops::Range<usize>| {
-        let base = range.clone().next().map_or(at, |k| starts[k]);
-        let n: usize = counts[range.clone()].iter().sum();
-        let mut out = Vec::with_capacity(n);
-        let refs: Vec<u32> = range
-            .map(|k| emit_at(tree, children[k], &mut out, base))
-            .collect();
-        (out, refs)
-    };
-    let ((first, mut refs), (second, more)) = std::thread::scope(|scope| {
-        let h = scope.spawn(|| part(cut..len));
-        let a = part(0..cut);
-        (a, h.join().expect("a flattening thread panicked"))
-    });
-    refs.extend(more);
-    let mut nodes = Vec::with_capacity(1 + total);
-    let mut root = WideNode::empty();
-    for (slot, (&c, &r)) in children[..len].iter().zip(&refs).enumerate() {
-        root.set(slot, &tree.nodes[c as usize].bounds, r);
-    }
-    root.len = len as u32;
-    nodes.push(root);
-    nodes.extend(first);
-    nodes.extend(second);
-    Flat {
-        nodes,
-        root: 0,
-        root_bounds: tree.nodes[0].bounds,
     }
 }
 

@@ -46,6 +46,47 @@ impl BuildTree {
         (self.nodes.len() - 1) as u32
     }
 
+    /// Appends the nodes of a tree built on its own (children numbered from its node 0),
+    /// renumbered by where they land, copied on `threads` threads straight into the spare
+    /// capacity; gives where its node 0 landed. Copying a subtree built on another thread
+    /// (hundreds of thousands of nodes) was a pass on one thread alone (issue 20, session 15).
+    pub fn append_shifted(&mut self, sub: &[BuildNode], threads: usize) -> u32 {
+        let at = self.nodes.len();
+        let n = sub.len();
+        self.nodes.reserve(n);
+        let part = n.div_ceil(threads.max(1)).max(1);
+        let shift = |node: &BuildNode| {
+            let mut node = *node;
+            if let BuildKind::Inner { children, len } = &mut node.kind {
+                for c in &mut children[..*len as usize] {
+                    *c += at as u32;
+                }
+            }
+            node
+        };
+        let dst = &mut self.nodes.spare_capacity_mut()[..n];
+        if threads <= 1 || n < 2 * PARALLEL_MIN {
+            for (d, s) in dst.iter_mut().zip(sub) {
+                d.write(shift(s));
+            }
+        } else {
+            std::thread::scope(|scope| {
+                for (d, s) in dst.chunks_mut(part).zip(sub.chunks(part)) {
+                    let shift = &shift;
+                    scope.spawn(move || {
+                        for (d, s) in d.iter_mut().zip(s) {
+                            d.write(shift(s));
+                        }
+                    });
+                }
+            });
+        }
+        // SAFETY: slots at..at + n were each written above (the chunks of `dst` and `sub`
+        // pair up one for one), and every thread joined at the scope's end.
+        unsafe { self.nodes.set_len(at + n) };
+        at as u32
+    }
+
     /// An inner node's children.
     pub fn children(&self, node: u32) -> &[u32] {
         match &self.nodes[node as usize].kind {
@@ -103,6 +144,34 @@ impl BuildTree {
 /// more than boxing a few thousand.
 pub const PARALLEL_MIN: usize = 4096;
 
+/// The `n` items `make(0)`, …, `make(n − 1)` made on `threads` threads, each writing a
+/// contiguous part straight into the vector's spare capacity: no pass on one thread fills the
+/// vector first, and each thread takes the page faults of its own part (a fresh process's build
+/// of balls4 tessellated took 7,000 faults in its first pass alone; issue 20, session 15).
+pub fn par_collect<T: Send, F: Fn(usize) -> T + Sync>(n: usize, threads: usize, make: F) -> Vec<T> {
+    let mut v = Vec::with_capacity(n);
+    if threads <= 1 {
+        v.extend((0..n).map(make));
+        return v;
+    }
+    let part = n.div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for (k, chunk) in v.spare_capacity_mut()[..n].chunks_mut(part).enumerate() {
+            let make = &make;
+            scope.spawn(move || {
+                for (j, slot) in chunk.iter_mut().enumerate() {
+                    slot.write(make(k * part + j));
+                }
+            });
+        }
+    });
+    // SAFETY: the parts cover slots 0..n and every thread wrote each slot of its part; the
+    // scope joined them all (a panic in one propagates out of the scope before this line, and
+    // the vector is then dropped with length 0).
+    unsafe { v.set_len(n) };
+    v
+}
+
 /// What builders read of each primitive: its box and the box's centre (001 §1.2: the centre of
 /// the primitive's box, not its barycentre, orders and splits primitives).
 #[derive(Clone, Debug, Default)]
@@ -134,25 +203,11 @@ impl BuildPrims {
         if threads <= 1 || n < 2 * PARALLEL_MIN {
             return BuildPrims::new(g);
         }
-        let mut bounds = vec![Aabb::EMPTY; n];
-        let mut centroid = vec![Vec3::ZERO; n];
-        let part = n.div_ceil(threads);
-        std::thread::scope(|scope| {
-            for ((prims, b), c) in g
-                .prims
-                .chunks(part)
-                .zip(bounds.chunks_mut(part))
-                .zip(centroid.chunks_mut(part))
-            {
-                scope.spawn(move || {
-                    for ((p, b), c) in prims.iter().zip(b).zip(c) {
-                        let (lo, hi) = p.bounds();
-                        *b = Aabb::new(lo, hi);
-                        *c = b.centre();
-                    }
-                });
-            }
+        let bounds = par_collect(n, threads, |i| {
+            let (lo, hi) = g.prims[i].bounds();
+            Aabb::new(lo, hi)
         });
+        let centroid = par_collect(n, threads, |i| bounds[i].centre());
         BuildPrims { bounds, centroid }
     }
 

@@ -110,7 +110,7 @@ const FORK_MIN: usize = 4096;
 /// one the one-thread build chooses, so the tree is the same node for node (test
 /// `build_sah::tests::threads_build_the_same_tree`); what runs in parallel is the binning of
 /// the subtrees, 86% of the build (callgrind, issue 20).
-pub fn binary_blocks_threads(mut s: Binned, rule: &BlockLeaves, threads: usize) -> BuildTree {
+pub fn binary_blocks_threads(mut s: Binned<'_>, rule: &BlockLeaves, threads: usize) -> BuildTree {
     if threads <= 1 {
         return binary_blocks(s, rule);
     }
@@ -119,15 +119,17 @@ pub fn binary_blocks_threads(mut s: Binned, rule: &BlockLeaves, threads: usize) 
         nodes: Vec::with_capacity(2 * root.len() / rule.min.max(1) + 1),
         order: Vec::new(),
     };
-    // Two subtrees per thread so that an uneven split still keeps both cores busy.
-    let forks = threads.next_power_of_two().trailing_zeros() as usize + 1;
+    // Four subtrees per thread, so that uneven splits still keep every core busy: a fresh
+    // process's two-thread build of balls4 tessellated took 0.220–0.227 s so, 0.243–0.254 s
+    // with two per thread (issue 20, session 15). Sides too small to fork do not count.
+    let forks = threads.next_power_of_two().trailing_zeros() as usize + 2;
     fork_node(&mut s, &mut tree, &root, 0, rule, forks, threads);
     tree.order = s.into_order();
     tree
 }
 
 fn fork_node(
-    s: &mut Binned,
+    s: &mut Binned<'_>,
     tree: &mut BuildTree,
     r: &Range,
     depth: usize,
@@ -150,10 +152,36 @@ fn fork_node(
         return tree.push(r.bounds, leaf_kind(r));
     }
     let me = tree.push(r.bounds, leaf_kind(r));
-    let mut right_s = s.fork(split.right.start);
-    let (left, right) = std::thread::scope(|scope| {
+    let mut children = [0; MAX_WIDTH];
+    if split.left.len().min(split.right.len()) < FORK_MIN {
+        // One side is too small for a thread of its own (balls4 tessellated: its top split
+        // cuts 18 triangles of the floor from 797,132): it is built here, the other side
+        // splits on with every thread, and no splitter part is copied. The nodes come in the
+        // one-thread build's order, as `block_node` pushes them.
+        children[0] = if split.left.len() < FORK_MIN {
+            block_node(s, tree, &split.left, depth + 1, rule)
+        } else {
+            fork_node(s, tree, &split.left, depth + 1, rule, forks, threads)
+        };
+        children[1] = if split.left.len() < FORK_MIN {
+            fork_node(s, tree, &split.right, depth + 1, rule, forks, threads)
+        } else {
+            block_node(s, tree, &split.right, depth + 1, rule)
+        };
+        tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
+        return me;
+    }
+    // The two sides split the splitter in place (`Binned::fork`). The left side is built on
+    // this thread straight into `tree`, where the one-thread build puts it (right after `me`);
+    // the right side into a tree of its own, reserved up front (growing it by doubling cost
+    // copies and page faults), and appended after the left.
+    let (mut left_s, mut right_s) = s.fork(split.right.start);
+    let right = std::thread::scope(|scope| {
         let right = scope.spawn(|| {
-            let mut t = BuildTree::default();
+            let mut t = BuildTree {
+                nodes: Vec::with_capacity(2 * split.right.len() / rule.min.max(1) + 1),
+                order: Vec::new(),
+            };
             fork_node(
                 &mut right_s,
                 &mut t,
@@ -165,28 +193,18 @@ fn fork_node(
             );
             t
         });
-        let mut t = BuildTree::default();
-        fork_node(s, &mut t, &split.left, depth + 1, rule, forks - 1, 1);
-        (t, right.join().expect("a build thread panicked"))
+        children[0] = fork_node(
+            &mut left_s,
+            tree,
+            &split.left,
+            depth + 1,
+            rule,
+            forks - 1,
+            1,
+        );
+        right.join().expect("a build thread panicked")
     });
-    s.join(right_s);
-    let mut children = [0; MAX_WIDTH];
-    children[0] = graft(tree, left);
-    children[1] = graft(tree, right);
+    children[1] = tree.append_shifted(&right.nodes, threads);
     tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
     me
-}
-
-/// Appends a subtree built on its own (root at its node 0) and gives its root's index.
-fn graft(tree: &mut BuildTree, sub: BuildTree) -> u32 {
-    let at = tree.nodes.len() as u32;
-    for mut node in sub.nodes {
-        if let BuildKind::Inner { children, len } = &mut node.kind {
-            for c in &mut children[..*len as usize] {
-                *c += at;
-            }
-        }
-        tree.nodes.push(node);
-    }
-    at
 }

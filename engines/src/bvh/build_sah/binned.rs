@@ -1,8 +1,9 @@
 //! Wald 2007's binned SAH split search.
 
 use super::{blocks, split_cost, Range, Split, Splitter};
-use crate::bvh::tree::{BuildPrims, PARALLEL_MIN};
+use crate::bvh::tree::{par_collect, BuildPrims, PARALLEL_MIN};
 use crate::geometry::aabb::Aabb;
+use crate::geometry::Geometry;
 use glam::Vec3A;
 
 /// A box in SIMD registers (glam's `Vec3A`): the binned builder's inner loops grow boxes
@@ -53,11 +54,11 @@ impl Box3A {
 /// `bins − 1` planes between bins are evaluated with a prefix/suffix sweep over the bins. The
 /// range is then partitioned in place, which also gives both sides' bounds. Primitive boxes
 /// are kept contiguous (Embree's `PrimRef`), with their indices alongside.
-pub struct Binned {
+pub struct Binned<'a> {
     /// The boxes and indices of positions `off..off + boxes.len()` of the primitive order (all
-    /// of it, or the part a [`Binned::fork`] took).
-    boxes: Vec<Box3A>,
-    ids: Vec<u32>,
+    /// of it, or one side of a [`Binned::fork`]: a part of its parent's, borrowed).
+    boxes: Store<'a, Box3A>,
+    ids: Store<'a, u32>,
     off: usize,
     nb: usize,
     /// Indexed by a `u8` bin number, so no bounds check is needed in the binning loop.
@@ -69,6 +70,33 @@ pub struct Binned {
     right_count: Box<[u32; 256]>,
     /// The SAH counts primitives in blocks of this many ([`super::blocks`]; 1: one by one).
     block: usize,
+}
+
+/// A splitter's boxes or indices: its own, or a part of its parent's (a fork's side, split
+/// in place without copying: the copies and their page faults were a pass on one thread per
+/// fork; issue 20, session 15).
+enum Store<'a, T> {
+    Owned(Vec<T>),
+    Part(&'a mut [T]),
+}
+
+impl<T> std::ops::Deref for Store<'_, T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        match self {
+            Store::Owned(v) => v,
+            Store::Part(p) => p,
+        }
+    }
+}
+
+impl<T> std::ops::DerefMut for Store<'_, T> {
+    fn deref_mut(&mut self) -> &mut [T] {
+        match self {
+            Store::Owned(v) => v,
+            Store::Part(p) => p,
+        }
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -138,19 +166,21 @@ fn truncate(t: Vec3A) -> [u32; 4] {
     [t.x as u32, t.y as u32, t.z as u32, 0]
 }
 
-impl Binned {
-    pub fn new(prims: &BuildPrims, bins: usize) -> Binned {
+impl Binned<'static> {
+    pub fn new(prims: &BuildPrims, bins: usize) -> Binned<'static> {
         let nb = bins.clamp(2, 256);
         Binned {
-            boxes: prims
-                .bounds
-                .iter()
-                .map(|b| Box3A {
-                    lo: b.lo.into(),
-                    hi: b.hi.into(),
-                })
-                .collect(),
-            ids: (0..prims.len() as u32).collect(),
+            boxes: Store::Owned(
+                prims
+                    .bounds
+                    .iter()
+                    .map(|b| Box3A {
+                        lo: b.lo.into(),
+                        hi: b.hi.into(),
+                    })
+                    .collect(),
+            ),
+            ids: Store::Owned((0..prims.len() as u32).collect()),
             off: 0,
             nb,
             bins: Box::new([[Bin::EMPTY; 3]; 256]),
@@ -161,69 +191,58 @@ impl Binned {
         }
     }
 
-    /// [`Binned::new`] with the boxes converted on `threads` threads (contiguous parts; the
-    /// same boxes and order).
-    pub fn new_threads(prims: &BuildPrims, bins: usize, threads: usize) -> Binned {
-        let n = prims.len();
-        if threads <= 1 || n < 2 * PARALLEL_MIN {
-            return Binned::new(prims, bins);
-        }
-        let mut b = Binned {
-            boxes: vec![Box3A::EMPTY; n],
+    /// [`Binned::new`] over `BuildPrims::new(geometry)`'s boxes, made straight from the
+    /// geometry on `threads` threads (contiguous parts; the same boxes and order), without the
+    /// primitive boxes and centres of [`BuildPrims`] in between: 29 MB and a pass fewer on
+    /// balls4 tessellated (issue 20, session 15).
+    pub fn of_geometry(geometry: &Geometry, bins: usize, threads: usize) -> Binned<'static> {
+        let n = geometry.prims.len();
+        let threads = if n < 2 * PARALLEL_MIN { 1 } else { threads };
+        Binned {
+            boxes: Store::Owned(par_collect(n, threads, |i| {
+                let (lo, hi) = geometry.prims[i].bounds();
+                let b = Aabb::new(lo, hi);
+                Box3A {
+                    lo: b.lo.into(),
+                    hi: b.hi.into(),
+                }
+            })),
+            ids: Store::Owned(par_collect(n, threads, |i| i as u32)),
             ..Binned::new(&BuildPrims::default(), bins)
-        };
-        b.ids = (0..n as u32).collect();
-        let part = n.div_ceil(threads);
-        std::thread::scope(|scope| {
-            for (from, to) in prims.bounds.chunks(part).zip(b.boxes.chunks_mut(part)) {
-                scope.spawn(move || {
-                    for (f, t) in from.iter().zip(to) {
-                        *t = Box3A {
-                            lo: f.lo.into(),
-                            hi: f.hi.into(),
-                        };
-                    }
-                });
-            }
-        });
-        b
+        }
     }
 
     /// The same search with the SAH counting primitives in blocks of `block` (Embree's
     /// `sahBlockSize`), for leaves whose primitives are tested `block` at a time.
-    pub fn with_block(mut self, block: usize) -> Binned {
+    pub fn with_block(mut self, block: usize) -> Binned<'static> {
         assert!(block.is_power_of_two(), "block {block}");
         self.block = block;
         self
     }
+}
 
-    /// Takes positions `mid..` of the order out into a splitter of their own, so that a range
-    /// on each side can be split on its own thread ([`super::binary::binary_blocks_threads`]);
-    /// [`Binned::join`] puts them back.
-    pub fn fork(&mut self, mid: usize) -> Binned {
+impl Binned<'_> {
+    /// Both sides of position `mid` as splitters of their own, borrowing this one's boxes and
+    /// indices in place, so that a range on each side can be split on its own thread
+    /// ([`super::binary::binary_blocks_threads`]); when both are dropped, this splitter holds
+    /// what they did to its positions.
+    pub fn fork(&mut self, mid: usize) -> (Binned<'_>, Binned<'_>) {
         let at = mid - self.off;
-        Binned {
-            boxes: self.boxes.split_off(at),
-            ids: self.ids.split_off(at),
-            off: mid,
-            nb: self.nb,
+        let (off, nb, block) = (self.off, self.nb, self.block);
+        let (bl, br) = self.boxes.split_at_mut(at);
+        let (il, ir) = self.ids.split_at_mut(at);
+        let side = |boxes, ids, off| Binned {
+            boxes: Store::Part(boxes),
+            ids: Store::Part(ids),
+            off,
+            nb,
             bins: Box::new([[Bin::EMPTY; 3]; 256]),
             filled: Box::new([0; 256]),
             right_area: Box::new([0.0; 256]),
             right_count: Box::new([0; 256]),
-            block: self.block,
-        }
-    }
-
-    /// Puts back the positions a [`Binned::fork`] of this splitter took.
-    pub fn join(&mut self, mut tail: Binned) {
-        assert_eq!(
-            tail.off,
-            self.off + self.boxes.len(),
-            "join: not this splitter's tail"
-        );
-        self.boxes.append(&mut tail.boxes);
-        self.ids.append(&mut tail.ids);
+            block,
+        };
+        (side(bl, il, off), side(br, ir, mid))
     }
 
     fn range(&self, start: usize, end: usize) -> Range {
@@ -316,7 +335,7 @@ fn bin_threads(
     }
 }
 
-impl Binned {
+impl Binned<'_> {
     /// [`Splitter::split`] with the binning pass (48 instructions per primitive, issue 20
     /// session 10) on `threads` threads when the range is large: for the top split of a
     /// parallel build, where every other thread would wait (`binary_blocks_threads`). The
@@ -458,7 +477,7 @@ impl Binned {
     }
 }
 
-impl Splitter for Binned {
+impl Splitter for Binned<'_> {
     fn root(&self) -> Range {
         self.range(self.off, self.off + self.boxes.len())
     }
@@ -473,7 +492,10 @@ impl Splitter for Binned {
 
     fn into_order(self) -> Vec<u32> {
         debug_assert_eq!(self.off, 0, "the order of a fork");
-        self.ids
+        match self.ids {
+            Store::Owned(v) => v,
+            Store::Part(p) => p.to_vec(),
+        }
     }
 }
 
