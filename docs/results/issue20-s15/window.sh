@@ -2,7 +2,7 @@
 # Issue 20, session 15: acceptance 3 (two threads, paired) and acceptance 1 (one thread, paired with Embree) in one
 # quiet window (both cores free). Usage: window.sh BIN OUTDIR
 B=$1; O=$2; mkdir -p $O
-stamp() { echo "$1 $(date -u +%H:%M:%S) load $(cut -d' ' -f1-3 /proc/loadavg)"; }
+stamp() { echo "== $1 $(date -u +%H:%M:%S) load $(cut -d' ' -f1-3 /proc/loadavg)"; }
 stamp start
 for i in 1 2; do
   $B run --engines embree,bvh4,bvh8,grid --scenes standard --threads 2 --repeat 1 --paired-threads 5 --no-check \
