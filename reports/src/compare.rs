@@ -14,7 +14,7 @@
 
 use crate::anchor::{Anchors, EMBREE};
 use crate::number;
-use crate::results::{read_environment, read_results, RunRecord};
+use crate::results::{read_environment, read_results, Environment, RunRecord};
 use crate::summary::latest_per_key;
 use crate::ReportError;
 use serde::Serialize;
@@ -76,6 +76,11 @@ pub struct Comparison {
     /// The git commits the sets were measured at (from `env.json`), when recorded.
     pub a_commit: Option<String>,
     pub b_commit: Option<String>,
+    /// What differs between the machines A and B were measured on (from their `env.json`): the
+    /// CPU model, its flags, cores, memory, OS, Rust compiler, Embree. Ratios to Embree then
+    /// measure the machines as well as the code (issue 20, session 15: a host with AVX-512
+    /// replaced an AVX2 one between sessions, and every ratio moved).
+    pub machine_differences: Vec<String>,
     pub threshold_pct: f64,
     /// Keys present in both sets.
     pub matched: usize,
@@ -113,6 +118,13 @@ impl Comparison {
         };
         let _ = writeln!(s, "- **A**: `{}`{}", self.a, commit(&self.a_commit));
         let _ = writeln!(s, "- **B**: `{}`{}", self.b, commit(&self.b_commit));
+        if !self.machine_differences.is_empty() {
+            let _ = writeln!(
+                s,
+                "- **different machines**: {}. Time ratios across machines measure the machines as well as the code.",
+                self.machine_differences.join("; ")
+            );
+        }
         let _ = writeln!(
             s,
             "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%\n",
@@ -191,7 +203,66 @@ fn cell(v: &Value) -> String {
     }
 }
 
-fn read_set(dir: &Path) -> Result<(Vec<RunRecord>, Option<String>), ReportError> {
+/// What differs between the machines of two `env.json`s, one phrase each (empty: the same
+/// machine as far as they record it). Memory is compared in whole GiB: the kernel's total moves
+/// by a few MiB between boots.
+pub fn machine_differences(a: &Environment, b: &Environment) -> Vec<String> {
+    let mut out = Vec::new();
+    if a.cpu_model != b.cpu_model {
+        out.push(format!("CPU {} → {}", a.cpu_model, b.cpu_model));
+    }
+    let (fa, fb): (BTreeSet<&str>, BTreeSet<&str>) = (
+        a.cpu_flags.iter().map(String::as_str).collect(),
+        b.cpu_flags.iter().map(String::as_str).collect(),
+    );
+    let list = |v: Vec<&str>| {
+        let n = v.len();
+        let mut s = v.into_iter().take(8).collect::<Vec<_>>().join(" ");
+        if n > 8 {
+            s.push_str(&format!(" and {} more", n - 8));
+        }
+        s
+    };
+    let added: Vec<&str> = fb.difference(&fa).copied().collect();
+    let removed: Vec<&str> = fa.difference(&fb).copied().collect();
+    if !added.is_empty() {
+        out.push(format!("CPU flags only B has: {}", list(added)));
+    }
+    if !removed.is_empty() {
+        out.push(format!("CPU flags only A has: {}", list(removed)));
+    }
+    if (a.cores_logical, a.cores_physical) != (b.cores_logical, b.cores_physical) {
+        let c = |e: &Environment| match e.cores_physical {
+            Some(p) => format!("{} logical / {p} physical", e.cores_logical),
+            None => format!("{} logical", e.cores_logical),
+        };
+        out.push(format!("cores {} → {}", c(a), c(b)));
+    }
+    let gib = |m: u64| (m as f64 / (1u64 << 30) as f64).round() as u64;
+    if gib(a.memory_bytes) != gib(b.memory_bytes) {
+        out.push(format!(
+            "memory {} → {} GiB",
+            gib(a.memory_bytes),
+            gib(b.memory_bytes)
+        ));
+    }
+    for (what, x, y) in [("OS", &a.os, &b.os), ("rustc", &a.rustc, &b.rustc)] {
+        if x != y {
+            out.push(format!("{what} {x} → {y}"));
+        }
+    }
+    if a.embree_version != b.embree_version {
+        let v = |e: &Option<String>| e.clone().unwrap_or_else(|| "none".to_string());
+        out.push(format!(
+            "Embree {} → {}",
+            v(&a.embree_version),
+            v(&b.embree_version)
+        ));
+    }
+    out
+}
+
+fn read_set(dir: &Path) -> Result<(Vec<RunRecord>, Option<Environment>), ReportError> {
     let results = dir.join("results.jsonl");
     if !results.is_file() {
         return Err(ReportError::NoResults {
@@ -199,10 +270,7 @@ fn read_set(dir: &Path) -> Result<(Vec<RunRecord>, Option<String>), ReportError>
         });
     }
     let records = latest_per_key(read_results(dir)?);
-    let commit = read_environment(dir)?
-        .map(|e| e.git_commit)
-        .filter(|c| !c.is_empty());
-    Ok((records, commit))
+    Ok((records, read_environment(dir)?))
 }
 
 /// Compares result set `b` against `a` (see the module doc). `threshold_pct` is the smallest change of a
@@ -211,13 +279,22 @@ pub fn compare(a: &Path, b: &Path, threshold_pct: f64) -> Result<Comparison, Rep
     if !threshold_pct.is_finite() || threshold_pct < 0.0 {
         return Err(ReportError::BadThreshold(threshold_pct));
     }
-    let (runs_a, a_commit) = read_set(a)?;
-    let (runs_b, b_commit) = read_set(b)?;
+    let (runs_a, env_a) = read_set(a)?;
+    let (runs_b, env_b) = read_set(b)?;
+    let commit = |e: &Option<Environment>| {
+        e.as_ref()
+            .map(|e| e.git_commit.clone())
+            .filter(|c| !c.is_empty())
+    };
     let mut c = Comparison {
         a: a.display().to_string(),
         b: b.display().to_string(),
-        a_commit,
-        b_commit,
+        a_commit: commit(&env_a),
+        b_commit: commit(&env_b),
+        machine_differences: match (&env_a, &env_b) {
+            (Some(x), Some(y)) => machine_differences(x, y),
+            _ => Vec::new(),
+        },
         threshold_pct,
         matched: 0,
         times_compared: 0,

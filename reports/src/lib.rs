@@ -35,7 +35,7 @@ mod summary;
 mod table;
 
 pub use anchor::EMBREE;
-pub use compare::{compare, Comparison, Finding, FindingKind};
+pub use compare::{compare, machine_differences, Comparison, Finding, FindingKind};
 pub use document::{Block, Document, Table};
 pub use error::ReportError;
 pub use report::{write_report, Format};

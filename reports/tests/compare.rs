@@ -332,3 +332,39 @@ fn a_fallen_thread_speedup_is_a_regression() {
         .iter()
         .any(|f| f.kind == FindingKind::ThreadSpeedup && f.key == "grid/balls3@1"));
 }
+
+/// Sets from different machines say so (CPU flags, cores, memory, Embree), and the same machine
+/// says nothing; a few MiB of memory between boots is the same machine.
+#[test]
+fn different_machines_are_named() {
+    let (da, db) = (TempDir::new("mach-a"), TempDir::new("mach-b"));
+    write_set(da.path(), &base());
+    write_set(db.path(), &base());
+    let same = compare(da.path(), db.path(), 5.0).unwrap();
+    assert!(same.machine_differences.is_empty());
+    assert!(!same.to_markdown().contains("different machines"));
+
+    let mut env = common::environment();
+    env.cpu_flags.push("avx512f".to_string());
+    env.memory_bytes += 5 << 20;
+    env.embree_version = Some("4.4.0".to_string());
+    std::fs::write(
+        db.path().join("env.json"),
+        serde_json::to_string_pretty(&env).unwrap(),
+    )
+    .unwrap();
+    let c = compare(da.path(), db.path(), 5.0).unwrap();
+    assert_eq!(
+        c.machine_differences,
+        vec![
+            "CPU flags only B has: avx512f".to_string(),
+            "Embree 4.3.3 → 4.4.0".to_string()
+        ]
+    );
+    let md = c.to_markdown();
+    assert!(md.contains(
+        "- **different machines**: CPU flags only B has: avx512f; Embree 4.3.3 → 4.4.0."
+    ));
+    // A note, not a verdict: the same runs still compare.
+    assert!(!c.is_regression() && c.matched == 6);
+}
