@@ -13,7 +13,7 @@
 //! (resolution 3; balls4: 797,150 triangles).
 
 use rtbench_engines::geometry::Geometry;
-use rtbench_engines::{build_engine, BuildInput};
+use rtbench_engines::{build_engine, usage, BuildInput};
 use rtbench_scenes::generate_scene;
 use rtbench_scenes::spd::{Options, Program};
 use std::sync::Arc;
@@ -34,20 +34,9 @@ const ENGINES: &[Setup] = &[
     ("bvh8 2 threads", "bvh8", &[("build_threads", "2")]),
 ];
 
-/// CPU time of the whole process (every thread) so far, in seconds.
-fn process_cpu_s() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid timespec to write; CLOCK_PROCESS_CPUTIME_ID is always available on Linux.
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
 /// The scene of `program` at `sf` (the standard SF when `None`), tessellated as the harness's
 /// `--tessellate 3` makes it, and the engines' input over it.
-fn input_of(program: Program, sf: Option<u32>) -> (Options, BuildInput) {
+fn input_of(program: Program, sf: Option<u32>) -> BuildInput {
     let mut opts = Options {
         tessellate: Some(3),
         ..Options::standard(program)
@@ -57,25 +46,20 @@ fn input_of(program: Program, sf: Option<u32>) -> (Options, BuildInput) {
     }
     let scene = Arc::new(generate_scene(program, &opts).expect("scene"));
     let geometry = Arc::new(Geometry::from_scene(&scene));
-    (opts, BuildInput { scene, geometry })
+    BuildInput { scene, geometry }
 }
 
 /// One build of `ENGINES[k]` in this process (a child of the bench): prints its wall and CPU
 /// seconds and the primitive count.
 fn child(k: usize, program: Program, sf: Option<u32>) {
-    let (_, input) = input_of(program, sf);
+    let input = input_of(program, sf);
     let (_, name, set) = ENGINES[k];
     let s = set.iter().map(|(k, v)| (k.to_string(), v.to_string()));
-    let (t, c, r) = (Instant::now(), process_cpu_s(), usage());
+    let (t, (c, _)) = (Instant::now(), usage::process());
     let engine = build_engine(name, &input, s.collect()).expect("engine");
-    let (wall, cpu, r2) = (t.elapsed().as_secs_f64(), process_cpu_s() - c, usage());
+    let (wall, cpu) = (t.elapsed().as_secs_f64(), usage::process().0 - c);
     drop(engine);
-    println!(
-        "{wall} {cpu} {} {} {}",
-        input.geometry.prims.len(),
-        r2.0 - r.0,
-        r2.1 - r.1
-    );
+    println!("{wall} {cpu} {}", input.geometry.prims.len());
 }
 
 /// `ENGINES[k]` built once in a child process of its own: (wall s, CPU s, primitives).
@@ -96,18 +80,6 @@ fn build_in_child(k: usize, scene: &str) -> (f64, f64, usize) {
         f[0].parse().unwrap(),
         f[1].parse().unwrap(),
         f[2].parse().unwrap(),
-    )
-}
-
-/// The process's minor page faults and system CPU seconds so far.
-fn usage() -> (i64, f64) {
-    // SAFETY: an all-zero `rusage` is valid, and getrusage writes only into it.
-    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: RUSAGE_SELF with a valid pointer.
-    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
-    (
-        u.ru_minflt,
-        u.ru_stime.tv_sec as f64 + u.ru_stime.tv_usec as f64 * 1e-6,
     )
 }
 

@@ -29,6 +29,7 @@ pub mod store;
 #[cfg(test)]
 mod test_support;
 pub mod testing;
+pub mod usage;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
 pub use geometry::TriangleTest;

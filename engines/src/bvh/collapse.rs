@@ -44,15 +44,7 @@ impl Leaves<'_> {
 }
 
 pub fn collapse(bin: &BuildTree, width: usize, leaves: Leaves) -> BuildTree {
-    assert!((2..=MAX_WIDTH).contains(&width) && leaves.leaf >= 1);
-    let mut span = vec![(0u32, 0u32); bin.nodes.len()];
-    spans(bin, 0, &mut span);
-    let mut out = BuildTree {
-        nodes: Vec::with_capacity(bin.nodes.len() / (width - 1) + 1),
-        order: bin.order.clone(),
-    };
-    node(bin, &span, 0, width, &leaves, &mut out);
-    out
+    collapse_threads(bin, width, leaves, 1)
 }
 
 /// (first, count) of the primitives under each node.
@@ -154,15 +146,16 @@ pub fn collapse_threads(
     threads: usize,
 ) -> BuildTree {
     assert!((2..=MAX_WIDTH).contains(&width) && leaves.leaf >= 1);
-    if threads <= 1 || bin.nodes.len() < 2 * super::tree::PARALLEL_MIN {
-        return collapse(bin, width, leaves);
-    }
     let mut span = vec![(0u32, 0u32); bin.nodes.len()];
     spans(bin, 0, &mut span);
     let mut out = BuildTree {
         nodes: Vec::with_capacity(bin.nodes.len() / (width - 1) + 1),
         order: bin.order.clone(),
     };
+    if threads <= 1 || bin.nodes.len() < 2 * super::tree::PARALLEL_MIN {
+        node(bin, &span, 0, width, &leaves, &mut out);
+        return out;
+    }
     let root = &bin.nodes[0];
     let Some((kids, len)) = kids_of(bin, &span, 0, width, &leaves) else {
         let (first, count) = span[0];

@@ -9,9 +9,9 @@
 //! leaf stays scalar.
 
 use super::node::{is_leaf, leaf_range, packet_leaf_ref, WideNode, EMPTY_SLOT};
+use super::tree::extend_par;
 use crate::geometry::triangle_simd::TrianglePacket;
 use crate::geometry::{Geometry, Prim};
-use std::mem::MaybeUninit;
 
 /// Triangles per leaf packet (Embree's `Triangle4`: one SSE test, or one half of AVX).
 pub const PACKET: usize = 4;
@@ -53,9 +53,9 @@ fn packet_of(ids: &[u32], geometry: &Geometry) -> LeafPacket {
 }
 
 /// [`lay_out`] with the triangle packets made on `threads` threads: one pass numbers the
-/// leaves and rewrites the references (and copies the scalar leaves' primitives), then each
-/// thread fills a contiguous part of the packets; one thread fills them all in that pass's
-/// order. The same references, packets and primitives at any thread count. Packet making was
+/// leaves and rewrites the references (and copies the scalar leaves' primitives), noting each
+/// packet's range of `order`, then each thread makes a contiguous part of the packets
+/// ([`extend_par`]); one thread makes them all in order. The same references, packets and primitives at any thread count. Packet making was
 /// 80 M of the 403 M instructions the first thread ran alone in a two-thread build of balls4
 /// tessellated (callgrind, issue 20, session 12).
 pub fn lay_out_threads<const N: usize>(
@@ -67,9 +67,9 @@ pub fn lay_out_threads<const N: usize>(
     threads: usize,
 ) -> Leaves {
     let mut out = Leaves::default();
-    // (first of the leaf's range of `order`, its count, its first packet), in packet order.
-    let mut jobs: Vec<(u32, u32, u32)> = Vec::new();
-    let mut next = 0u32;
+    // Each packet's first position in `order` and its triangle count (1 to PACKET), in packet
+    // order.
+    let mut ranges: Vec<(u32, u8)> = Vec::new();
     let mut place = |r: u32| -> u32 {
         if !is_leaf(r) || r == EMPTY_SLOT {
             return r;
@@ -81,9 +81,10 @@ pub fn lay_out_threads<const N: usize>(
                 .iter()
                 .all(|&i| matches!(geometry.prims[i as usize], Prim::Triangle(_)))
         {
-            let at = next;
-            next += count.div_ceil(PACKET) as u32;
-            jobs.push((first as u32, count as u32, at));
+            let at = ranges.len() as u32;
+            for k in (0..count).step_by(PACKET) {
+                ranges.push(((first + k) as u32, (count - k).min(PACKET) as u8));
+            }
             packet_leaf_ref(at, count as u32)
         } else {
             let at = out.prims.len() as u32;
@@ -100,52 +101,13 @@ pub fn lay_out_threads<const N: usize>(
             node.child[slot] = place(node.child[slot]);
         }
     }
-    // Every packet 0..next belongs to exactly one job (numbered in order above), so the fill
-    // below writes each once, straight into the spare capacity: no pass on one thread blanks
-    // 32 MB first (balls4 tessellated; issue 20, session 15).
-    let mut packets: Vec<LeafPacket> = Vec::with_capacity(next as usize);
-    let fill = |slice: &mut [MaybeUninit<LeafPacket>], mine: &[(u32, u32, u32)], from: usize| {
-        for &(first, count, at) in mine {
-            let ids = &order[first as usize..(first + count) as usize];
-            let at = at as usize - from;
-            for (p, o) in slice[at..].iter_mut().zip(ids.chunks(PACKET)) {
-                p.write(packet_of(o, geometry));
-            }
-        }
-    };
-    let all = &mut packets.spare_capacity_mut()[..next as usize];
-    if threads <= 1 {
-        fill(all, &jobs, 0);
-    } else {
-        // Cut the jobs where the packets reach each thread's share; each part fills its own
-        // contiguous packets.
-        let share = (next as usize).div_ceil(threads).max(1);
-        std::thread::scope(|scope| {
-            let mut rest: &mut [MaybeUninit<LeafPacket>] = all;
-            let mut jobs_left: &[(u32, u32, u32)] = &jobs;
-            let mut base = 0usize;
-            while !jobs_left.is_empty() {
-                let end = base + share;
-                let k = jobs_left
-                    .iter()
-                    .position(|j| j.2 as usize >= end)
-                    .unwrap_or(jobs_left.len());
-                let (mine, more_jobs) = jobs_left.split_at(k);
-                let upto = more_jobs.first().map_or(next as usize, |j| j.2 as usize);
-                let (slice, more) = std::mem::take(&mut rest).split_at_mut(upto - base);
-                let from = base;
-                let fill = &fill;
-                scope.spawn(move || fill(slice, mine, from));
-                rest = more;
-                jobs_left = more_jobs;
-                base = upto;
-            }
-        });
-    }
-    // SAFETY: the jobs' packets cover 0..next, each written once above (every job's
-    // `count.div_ceil(PACKET)` packets from its `at`); all threads joined at the scope's end.
-    unsafe { packets.set_len(next as usize) };
-    out.packets = packets;
+    extend_par(&mut out.packets, ranges.len(), threads, |p| {
+        let (first, count) = ranges[p];
+        packet_of(
+            &order[first as usize..first as usize + count as usize],
+            geometry,
+        )
+    });
     out
 }
 

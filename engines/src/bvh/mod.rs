@@ -84,7 +84,7 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     // The primitives' boxes and centres, made when a builder needs them: the binned build of a
     // wide tree of packets (the default) makes its own boxes from the geometry instead.
     let cell = std::cell::OnceCell::new();
-    let prims = || cell.get_or_init(|| BuildPrims::new_threads(geometry, config.build_threads));
+    let prims = || cell.get_or_init(|| BuildPrims::new(geometry));
     let (width, leaf) = (config.width, config.leaf);
     if width > 2 && config.wide == WideMethod::Direct {
         return match config.builder {
@@ -177,14 +177,9 @@ impl Phases {
     fn new() -> Phases {
         Phases(std::env::var_os("RTBENCH_BUILD_PHASES").map(|_| Self::now()))
     }
-    /// Now, the process's CPU seconds (every thread) and its minor page faults.
     fn now() -> (Instant, f64, i64) {
-        // SAFETY: an all-zero `rusage` is valid, and getrusage writes only into it.
-        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-        // SAFETY: RUSAGE_SELF with a valid pointer.
-        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
-        let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-        (Instant::now(), s(u.ru_utime) + s(u.ru_stime), u.ru_minflt)
+        let (cpu, faults) = crate::usage::process();
+        (Instant::now(), cpu, faults)
     }
     fn mark(&mut self, what: &str) {
         if let Some((t, cpu, faults)) = self.0 {
@@ -270,9 +265,9 @@ pub fn build_bvh<const N: usize>(
         Ok(()),
         "builder broke an invariant"
     );
-    // One thread: flattening on two (session 12) copied the halves once more and took their
-    // page faults on fresh pages, 7.7–11 ms against 1.9 ms on one thread in a fresh process
-    // (balls4 tessellated; issue 20, session 15).
+    // On one thread: in a fresh process's two-thread build of balls4 tessellated, flattening
+    // on two threads (session 12) took 7.7–11 ms and on one 8.3–8.7 ms, both mostly faulting in
+    // fresh pages (issue 20, session 15), so the threaded copy was dropped.
     let mut flat = flatten::<N>(&tree);
     phases.mark("flatten");
     let extent = flat

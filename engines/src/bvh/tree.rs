@@ -47,44 +47,26 @@ impl BuildTree {
     }
 
     /// Appends the nodes of a tree built on its own (children numbered from its node 0),
-    /// renumbered by where they land, copied on `threads` threads straight into the spare
-    /// capacity; gives where its node 0 landed. Copying a subtree built on another thread
-    /// (hundreds of thousands of nodes) was a pass on one thread alone (issue 20, session 15).
+    /// renumbered by where they land, copied on `threads` threads ([`extend_par`]); gives where
+    /// its node 0 landed. Copying a subtree built on another thread (hundreds of thousands of
+    /// nodes) was a pass on one thread alone (issue 20, session 15).
     pub fn append_shifted(&mut self, sub: &[BuildNode], threads: usize) -> u32 {
-        let at = self.nodes.len();
-        let n = sub.len();
-        self.nodes.reserve(n);
-        let part = n.div_ceil(threads.max(1)).max(1);
-        let shift = |node: &BuildNode| {
-            let mut node = *node;
+        let at = self.nodes.len() as u32;
+        let threads = if sub.len() < 2 * PARALLEL_MIN {
+            1
+        } else {
+            threads
+        };
+        extend_par(&mut self.nodes, sub.len(), threads, |i| {
+            let mut node = sub[i];
             if let BuildKind::Inner { children, len } = &mut node.kind {
                 for c in &mut children[..*len as usize] {
-                    *c += at as u32;
+                    *c += at;
                 }
             }
             node
-        };
-        let dst = &mut self.nodes.spare_capacity_mut()[..n];
-        if threads <= 1 || n < 2 * PARALLEL_MIN {
-            for (d, s) in dst.iter_mut().zip(sub) {
-                d.write(shift(s));
-            }
-        } else {
-            std::thread::scope(|scope| {
-                for (d, s) in dst.chunks_mut(part).zip(sub.chunks(part)) {
-                    let shift = &shift;
-                    scope.spawn(move || {
-                        for (d, s) in d.iter_mut().zip(s) {
-                            d.write(shift(s));
-                        }
-                    });
-                }
-            });
-        }
-        // SAFETY: slots at..at + n were each written above (the chunks of `dst` and `sub`
-        // pair up one for one), and every thread joined at the scope's end.
-        unsafe { self.nodes.set_len(at + n) };
-        at as u32
+        });
+        at
     }
 
     /// An inner node's children.
@@ -144,16 +126,23 @@ impl BuildTree {
 /// more than boxing a few thousand.
 pub const PARALLEL_MIN: usize = 4096;
 
-/// The `n` items `make(0)`, …, `make(n − 1)` made on `threads` threads, each writing a
-/// contiguous part straight into the vector's spare capacity: no pass on one thread fills the
-/// vector first, and each thread takes the page faults of its own part (a fresh process's build
-/// of balls4 tessellated took 7,000 faults in its first pass alone; issue 20, session 15).
-pub fn par_collect<T: Send, F: Fn(usize) -> T + Sync>(n: usize, threads: usize, make: F) -> Vec<T> {
-    let mut v = Vec::with_capacity(n);
+/// Appends the `n` items `make(0)`, …, `make(n − 1)` to `v`, made on `threads` threads, each
+/// writing a contiguous part straight into the vector's spare capacity: no pass on one thread
+/// fills the vector first, and each thread takes the page faults of its own part (a fresh
+/// process's build of balls4 tessellated took 7,000 faults in its first pass alone; issue 20,
+/// session 15). One thread makes them all in order on the calling thread.
+pub fn extend_par<T: Send, F: Fn(usize) -> T + Sync>(
+    v: &mut Vec<T>,
+    n: usize,
+    threads: usize,
+    make: F,
+) {
     if threads <= 1 {
         v.extend((0..n).map(make));
-        return v;
+        return;
     }
+    let len = v.len();
+    v.reserve(n);
     let part = n.div_ceil(threads).max(1);
     std::thread::scope(|scope| {
         for (k, chunk) in v.spare_capacity_mut()[..n].chunks_mut(part).enumerate() {
@@ -165,11 +154,10 @@ pub fn par_collect<T: Send, F: Fn(usize) -> T + Sync>(n: usize, threads: usize, 
             });
         }
     });
-    // SAFETY: the parts cover slots 0..n and every thread wrote each slot of its part; the
-    // scope joined them all (a panic in one propagates out of the scope before this line, and
-    // the vector is then dropped with length 0).
-    unsafe { v.set_len(n) };
-    v
+    // SAFETY: the parts cover the n slots after `len` and every thread wrote each slot of its
+    // part; the scope joined them all (a panic in one propagates out of the scope before this
+    // line, and the vector keeps its old length).
+    unsafe { v.set_len(len + n) };
 }
 
 /// What builders read of each primitive: its box and the box's centre (001 §1.2: the centre of
@@ -191,23 +179,6 @@ impl BuildPrims {
             })
             .collect();
         let centroid = bounds.iter().map(|b| b.centre()).collect();
-        BuildPrims { bounds, centroid }
-    }
-
-    /// [`BuildPrims::new`] on `threads` threads, each boxing a contiguous part of the
-    /// primitives: the same boxes and centres (each is a function of its primitive alone). At
-    /// two threads this pass was 94 M of the 403 M instructions the build's first thread ran
-    /// alone on balls4 tessellated (callgrind, issue 20, session 12).
-    pub fn new_threads(g: &Geometry, threads: usize) -> BuildPrims {
-        let n = g.prims.len();
-        if threads <= 1 || n < 2 * PARALLEL_MIN {
-            return BuildPrims::new(g);
-        }
-        let bounds = par_collect(n, threads, |i| {
-            let (lo, hi) = g.prims[i].bounds();
-            Aabb::new(lo, hi)
-        });
-        let centroid = par_collect(n, threads, |i| bounds[i].centre());
         BuildPrims { bounds, centroid }
     }
 

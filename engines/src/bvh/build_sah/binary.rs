@@ -104,12 +104,12 @@ fn block_node<S: Splitter>(
 const FORK_MIN: usize = 4096;
 
 /// [`binary_blocks`] over the binned search on `threads` threads: the ranges on both sides of
-/// the top `⌈log2 threads⌉ + 1` levels of splits are built on threads of their own
-/// (`std::thread::scope`), each with its own part of the splitter ([`Binned::fork`]), and the
-/// subtrees are grafted back in the order the one-thread build makes them. Every split is the
-/// one the one-thread build chooses, so the tree is the same node for node (test
-/// `build_sah::tests::threads_build_the_same_tree`); what runs in parallel is the binning of
-/// the subtrees, 86% of the build (callgrind, issue 20).
+/// the top `⌈log2 threads⌉ + 2` levels of splits (not counting splits with a side below
+/// [`FORK_MIN`]) are built on threads of their own (`std::thread::scope`), each splitting its
+/// own side of the splitter in place ([`Binned::fork`]), and the subtrees are appended in the
+/// order the one-thread build makes them. Every split is the one the one-thread build chooses,
+/// so the tree is the same node for node (test `bvh::tests::threads_build_the_same_tree`);
+/// what runs in parallel is the binning of the subtrees, 86% of the build (callgrind, issue 20).
 pub fn binary_blocks_threads(mut s: Binned<'_>, rule: &BlockLeaves, threads: usize) -> BuildTree {
     if threads <= 1 {
         return binary_blocks(s, rule);
@@ -119,9 +119,10 @@ pub fn binary_blocks_threads(mut s: Binned<'_>, rule: &BlockLeaves, threads: usi
         nodes: Vec::with_capacity(2 * root.len() / rule.min.max(1) + 1),
         order: Vec::new(),
     };
-    // Four subtrees per thread, so that uneven splits still keep every core busy: a fresh
-    // process's two-thread build of balls4 tessellated took 0.220–0.227 s so, 0.243–0.254 s
-    // with two per thread (issue 20, session 15). Sides too small to fork do not count.
+    // Four subtrees per thread, so that uneven splits still keep every core busy. Fresh
+    // processes' two-thread builds of balls4 tessellated (issue 20, session 15): with forks
+    // that copied the splitter, two per thread took 0.243–0.254 s (3 builds) and four
+    // 0.225–0.234 s (4); with forks in place, four 0.220–0.227 s (4) and eight 0.222–0.227 s (4).
     let forks = threads.next_power_of_two().trailing_zeros() as usize + 2;
     fork_node(&mut s, &mut tree, &root, 0, rule, forks, threads);
     tree.order = s.into_order();
@@ -158,12 +159,13 @@ fn fork_node(
         // cuts 18 triangles of the floor from 797,132): it is built here, the other side
         // splits on with every thread, and no splitter part is copied. The nodes come in the
         // one-thread build's order, as `block_node` pushes them.
-        children[0] = if split.left.len() < FORK_MIN {
+        let left_small = split.left.len() < FORK_MIN;
+        children[0] = if left_small {
             block_node(s, tree, &split.left, depth + 1, rule)
         } else {
             fork_node(s, tree, &split.left, depth + 1, rule, forks, threads)
         };
-        children[1] = if split.left.len() < FORK_MIN {
+        children[1] = if left_small {
             fork_node(s, tree, &split.right, depth + 1, rule, forks, threads)
         } else {
             block_node(s, tree, &split.right, depth + 1, rule)

@@ -1,7 +1,7 @@
 //! Wald 2007's binned SAH split search.
 
 use super::{blocks, split_cost, Range, Split, Splitter};
-use crate::bvh::tree::{par_collect, BuildPrims, PARALLEL_MIN};
+use crate::bvh::tree::{extend_par, BuildPrims, PARALLEL_MIN};
 use crate::geometry::aabb::Aabb;
 use crate::geometry::Geometry;
 use glam::Vec3A;
@@ -166,29 +166,44 @@ fn truncate(t: Vec3A) -> [u32; 4] {
     [t.x as u32, t.y as u32, t.z as u32, 0]
 }
 
-impl Binned<'static> {
-    pub fn new(prims: &BuildPrims, bins: usize) -> Binned<'static> {
-        let nb = bins.clamp(2, 256);
+impl From<&Aabb> for Box3A {
+    fn from(b: &Aabb) -> Box3A {
+        Box3A {
+            lo: b.lo.into(),
+            hi: b.hi.into(),
+        }
+    }
+}
+
+impl<'a> Binned<'a> {
+    /// A splitter over `boxes` and `ids`, positions `off..` of the primitive order, with
+    /// `bins` bins per axis (2 to 256) and empty scratch.
+    fn over(
+        boxes: Store<'a, Box3A>,
+        ids: Store<'a, u32>,
+        off: usize,
+        bins: usize,
+        block: usize,
+    ) -> Binned<'a> {
         Binned {
-            boxes: Store::Owned(
-                prims
-                    .bounds
-                    .iter()
-                    .map(|b| Box3A {
-                        lo: b.lo.into(),
-                        hi: b.hi.into(),
-                    })
-                    .collect(),
-            ),
-            ids: Store::Owned((0..prims.len() as u32).collect()),
-            off: 0,
-            nb,
+            boxes,
+            ids,
+            off,
+            nb: bins.clamp(2, 256),
             bins: Box::new([[Bin::EMPTY; 3]; 256]),
             filled: Box::new([0; 256]),
             right_area: Box::new([0.0; 256]),
             right_count: Box::new([0; 256]),
-            block: 1,
+            block,
         }
+    }
+}
+
+impl Binned<'static> {
+    pub fn new(prims: &BuildPrims, bins: usize) -> Binned<'static> {
+        let boxes = prims.bounds.iter().map(Box3A::from).collect();
+        let ids = (0..prims.len() as u32).collect();
+        Binned::over(Store::Owned(boxes), Store::Owned(ids), 0, bins, 1)
     }
 
     /// [`Binned::new`] over `BuildPrims::new(geometry)`'s boxes, made straight from the
@@ -198,18 +213,13 @@ impl Binned<'static> {
     pub fn of_geometry(geometry: &Geometry, bins: usize, threads: usize) -> Binned<'static> {
         let n = geometry.prims.len();
         let threads = if n < 2 * PARALLEL_MIN { 1 } else { threads };
-        Binned {
-            boxes: Store::Owned(par_collect(n, threads, |i| {
-                let (lo, hi) = geometry.prims[i].bounds();
-                let b = Aabb::new(lo, hi);
-                Box3A {
-                    lo: b.lo.into(),
-                    hi: b.hi.into(),
-                }
-            })),
-            ids: Store::Owned(par_collect(n, threads, |i| i as u32)),
-            ..Binned::new(&BuildPrims::default(), bins)
-        }
+        let (mut boxes, mut ids) = (Vec::new(), Vec::new());
+        extend_par(&mut boxes, n, threads, |i| {
+            let (lo, hi) = geometry.prims[i].bounds();
+            Box3A::from(&Aabb::new(lo, hi))
+        });
+        extend_par(&mut ids, n, threads, |i| i as u32);
+        Binned::over(Store::Owned(boxes), Store::Owned(ids), 0, bins, 1)
     }
 
     /// The same search with the SAH counting primitives in blocks of `block` (Embree's
@@ -231,17 +241,8 @@ impl Binned<'_> {
         let (off, nb, block) = (self.off, self.nb, self.block);
         let (bl, br) = self.boxes.split_at_mut(at);
         let (il, ir) = self.ids.split_at_mut(at);
-        let side = |boxes, ids, off| Binned {
-            boxes: Store::Part(boxes),
-            ids: Store::Part(ids),
-            off,
-            nb,
-            bins: Box::new([[Bin::EMPTY; 3]; 256]),
-            filled: Box::new([0; 256]),
-            right_area: Box::new([0.0; 256]),
-            right_count: Box::new([0; 256]),
-            block,
-        };
+        let side =
+            |boxes, ids, off| Binned::over(Store::Part(boxes), Store::Part(ids), off, nb, block);
         (side(bl, il, off), side(br, ir, mid))
     }
 
@@ -533,14 +534,7 @@ mod tests {
     /// (axis, left ids sorted, cost).
     fn brute_force(p: &BuildPrims, r: &Range, nb: usize, block: usize) -> (usize, Vec<u32>, f32) {
         let map = BinMap::new(&r.centroids, nb);
-        let boxes: Vec<Box3A> = p
-            .bounds
-            .iter()
-            .map(|b| Box3A {
-                lo: b.lo.into(),
-                hi: b.hi.into(),
-            })
-            .collect();
+        let boxes: Vec<Box3A> = p.bounds.iter().map(Box3A::from).collect();
         let mut best: Option<(usize, u32, f32)> = None;
         for a in 0..3 {
             for plane in 1..nb as u32 {
