@@ -8,12 +8,19 @@ use std::path::PathBuf;
 #[command(
     name = "rtbench",
     version,
-    about = "Benchmark and reproducibility harness for ray-tracing acceleration structures"
+    about = "Benchmark and reproducibility harness for ray-tracing acceleration structures",
+    after_help = ENV_HELP
 )]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
 }
+
+/// The environment variables rtbench reads, as `--help` names them (`rtbench env` says more).
+pub const ENV_HELP: &str = "Environment (read once at the start; a malformed value is exit 2; \
+`rtbench env` lists the accepted forms): RTBENCH_MAX_THREADS, RTBENCH_PIN_THREADS, RTBENCH_SCHED, \
+RTBENCH_BANDS, RTBENCH_MEMORY_PHASES, RTBENCH_PLANT, RTBENCH_BUILD_PHASES, RTBENCH_PLUGIN_DIR, \
+RTBENCH_TEST_ENGINES, RTBENCH_TEST_SLOWDOWN.";
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
@@ -53,6 +60,11 @@ pub enum Command {
     Merge(MergeArgs),
     /// A plan's jobs, groups and shards, without running them (for cluster job arrays).
     Plan(PlanCmdArgs),
+    /// The RTBENCH_* environment variables: each one's value here, accepted forms and effect.
+    Env {
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Args, Debug, Clone)]
@@ -248,9 +260,9 @@ pub struct RunOneArgs {
     pub engine: String,
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
     #[arg(long, default_value_t = 512)]
@@ -293,9 +305,9 @@ pub struct ReproduceArgs {
     /// (beside the HDD-like 8 ms and the SSD-like 0.1 ms).
     #[arg(long)]
     pub fault_ms: Option<f64>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, value_parser = crate::measure::threads::parse_threads)]
+    pub threads: Option<crate::measure::threads::Threads>,
     /// yamauchi-* only: image size of 003's pass (default 512, 128 with --quick).
     #[arg(long)]
     pub size: Option<u32>,
@@ -439,9 +451,9 @@ pub struct RenderArgs {
     /// Image size in pixels (rays go through the (size+1)² pixel corners).
     #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
     pub size: u32,
-    /// Threads for tracing (default: all cores; more than the machine runs at once is refused).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
     #[arg(long)]
     pub png: Option<PathBuf>,
     #[arg(long)]
@@ -527,9 +539,9 @@ pub struct CheckArgs {
     /// Minimum hit agreement (fraction of rays) for the check to pass (default 0.9999).
     #[arg(long)]
     pub threshold: Option<f64>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
     #[arg(long)]
     pub json: bool,
     /// Run a suite instead of one scene: `hard` (hard cases, acne, speed against error) or

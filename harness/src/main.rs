@@ -39,6 +39,7 @@ use error::Result;
 use source::Source;
 
 fn run(cli: Cli) -> Result<()> {
+    measure::vars::load()?;
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
         Command::Scene(SceneCommand::Gen { scene, output }) => commands::scene::gen(
@@ -95,6 +96,7 @@ fn run(cli: Cli) -> Result<()> {
             json,
         }) => commands::scene::stats(&Source::from_args(&scene.scene, &scene.opts)?, json),
         Command::Engines { json } => commands::engines::list(json),
+        Command::Env { json } => commands::env::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),
         Command::TreeStats(a) => commands::tree_stats::run(&a),

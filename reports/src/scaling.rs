@@ -38,7 +38,7 @@ impl ThreadScaling {
             threads,
             one_thread_s: Spread::of(&col(|p| p.0)),
             threads_s: Spread::of(&col(|p| p.1)),
-            speedup: Spread::of(&col(|p| p.0 / p.1.max(1e-12))),
+            speedup: Spread::of_ratios(&col(|p| p.0 / p.1.max(1e-12))),
             one_thread_cpu_s: Spread::of(&col(|p| p.2)),
             threads_cpu_s: Spread::of(&col(|p| p.3)),
         }

@@ -259,8 +259,8 @@ pub fn render_view(
     tile: Option<crate::shard::ShardSpec>,
     view: Option<&rtbench_scenes::View>,
 ) -> io::Result<OutOfCoreRender> {
-    let start = Instant::now();
-    let cpu_start = crate::measure::clock::thread_cpu_seconds();
+    // One thread does all the work here.
+    let span = crate::measure::span::Span::start(crate::measure::span::Workers::Caller);
     let h = engine.header();
     let config = engine.config();
     let buffer = config.buffer as usize;
@@ -517,6 +517,7 @@ pub fn render_view(
     }
     io_total.add(&rays.remove()?);
     io_total.add(&scene.io());
+    let sample = span.stop();
     Ok(OutOfCoreRender {
         render: Render {
             pixels: super::trace::pixels_of(size, &corners),
@@ -525,9 +526,9 @@ pub fn render_view(
             counters,
             intersect_s,
             shade_s,
-            trace_s: start.elapsed().as_secs_f64(),
-            // One thread does all the work here.
-            trace_cpu_s: crate::measure::clock::thread_cpu_seconds() - cpu_start,
+            trace_s: sample.wall_s,
+            trace_cpu_s: sample.thread_cpu_s,
+            sample,
         },
         io: io_total,
         shade_group: group_len,

@@ -1,0 +1,31 @@
+//! `rtbench env [--json]`: every `RTBENCH_*` variable rtbench reads, its value in this
+//! environment, the forms it accepts and what it does.
+
+use crate::error::Result;
+use crate::measure::vars::VARS;
+use crate::output::print_json;
+use serde_json::json;
+
+pub fn list(as_json: bool) -> Result<()> {
+    let value = |name: &str| std::env::var_os(name).map(|v| v.to_string_lossy().into_owned());
+    if as_json {
+        let rows: Vec<_> = VARS
+            .iter()
+            .map(|v| json!({"name": v.name, "value": value(v.name), "forms": v.forms, "about": v.about}))
+            .collect();
+        print_json(&json!(rows));
+        return Ok(());
+    }
+    println!("| variable | value | accepts | does |");
+    println!("|---|---|---|---|");
+    for v in VARS {
+        println!(
+            "| {} | {} | {} | {} |",
+            v.name,
+            value(v.name).unwrap_or_else(|| "(unset)".into()),
+            v.forms,
+            v.about
+        );
+    }
+    Ok(())
+}
