@@ -56,6 +56,10 @@ pub struct Sample {
     /// Page faults of the process during the span: minor (no I/O) and major (I/O).
     pub minor_faults: u64,
     pub major_faults: u64,
+    /// Context switches of the process during the span, voluntary (it blocked or slept) and
+    /// involuntary (it was preempted): how much the machine's other load took the CPUs away.
+    #[serde(default)]
+    pub context_switches: u64,
 }
 
 impl Spread {

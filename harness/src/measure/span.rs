@@ -1,6 +1,6 @@
 //! The one way a timed region is measured: a [`Span`] started before it and stopped after it
 //! gives one [`Sample`] (wall seconds, the workers' CPU seconds, the process's CPU seconds, page
-//! faults). A field added to [`Sample`] is measured here and recorded with every repeat of every
+//! faults, context switches). A field added to [`Sample`] is measured here and recorded with every repeat of every
 //! run, table and night.
 
 use super::clock::{process_cpu_seconds, thread_cpu_seconds};
@@ -32,6 +32,7 @@ pub struct Span {
 struct Usage {
     minor_faults: u64,
     major_faults: u64,
+    context_switches: u64,
 }
 
 fn usage() -> Usage {
@@ -44,6 +45,7 @@ fn usage() -> Usage {
     Usage {
         minor_faults: u.ru_minflt as u64,
         major_faults: u.ru_majflt as u64,
+        context_switches: (u.ru_nvcsw + u.ru_nivcsw) as u64,
     }
 }
 
@@ -96,6 +98,9 @@ impl Span {
             process_cpu_s,
             minor_faults: u.minor_faults.saturating_sub(self.usage.minor_faults),
             major_faults: u.major_faults.saturating_sub(self.usage.major_faults),
+            context_switches: u
+                .context_switches
+                .saturating_sub(self.usage.context_switches),
         }
     }
 }
