@@ -39,7 +39,10 @@ use error::Result;
 use source::Source;
 
 fn run(cli: Cli) -> Result<()> {
-    measure::vars::load()?;
+    // `rtbench env` shows the variables as they are, malformed ones too.
+    if !matches!(cli.command, Command::Env { .. }) {
+        measure::vars::load()?;
+    }
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
         Command::Scene(SceneCommand::Gen { scene, output }) => commands::scene::gen(

@@ -11,7 +11,11 @@ pub fn list(as_json: bool) -> Result<()> {
     if as_json {
         let rows: Vec<_> = VARS
             .iter()
-            .map(|v| json!({"name": v.name, "value": value(v.name), "forms": v.forms, "about": v.about}))
+            .map(|v| {
+                let val = value(v.name);
+                let accepted = val.as_deref().map(|x| v.accepts(x));
+                json!({"name": v.name, "value": val, "accepted": accepted, "forms": v.forms, "about": v.about})
+            })
             .collect();
         print_json(&json!(rows));
         return Ok(());
@@ -22,7 +26,11 @@ pub fn list(as_json: bool) -> Result<()> {
         println!(
             "| {} | {} | {} | {} |",
             v.name,
-            value(v.name).unwrap_or_else(|| "(unset)".into()),
+            match value(v.name) {
+                None => "(unset)".to_string(),
+                Some(x) if v.accepts(&x) => x,
+                Some(x) => format!("{x} (not accepted: every other command stops with exit 2)"),
+            },
             v.forms,
             v.about
         );

@@ -17,6 +17,13 @@ pub struct Var {
     check: fn(&str) -> bool,
 }
 
+impl Var {
+    /// Whether `value` is one of the accepted forms.
+    pub fn accepts(&self, value: &str) -> bool {
+        (self.check)(value.trim())
+    }
+}
+
 fn flag(v: &str) -> bool {
     v == "1" || v == "0"
 }
@@ -122,7 +129,7 @@ static VALUES: OnceLock<Values> = OnceLock::new();
 pub fn parse(get: impl Fn(&str) -> Option<String>) -> Result<Values> {
     for v in VARS {
         if let Some(value) = get(v.name) {
-            if !(v.check)(value.trim()) {
+            if !v.accepts(&value) {
                 return Err(input(format!("{}='{value}': expected {}", v.name, v.forms)));
             }
         }
