@@ -123,7 +123,7 @@ EOF
     say "Embree 4 ready in .embree/lib ($(basename "$embree"))"
 fi
 
-# --- Meshes for the examples and docs (issue 21) -----------------------------------------------------------------
+# --- Meshes for the examples and docs -----------------------------------------------------------------
 # Real meshes from Debian packages, into .meshes/ (git-ignored, never committed):
 #   bunny.ply            the Stanford bunny (75,408 triangles, a range scan), from libcgal-demo's
 #                        data/meshes/bunny00.off, converted to ASCII PLY here

@@ -397,7 +397,7 @@ pub enum SceneCommand {
         hierarchy: bool,
         /// Write in segments of N objects, each made durable with a checkpoint
         /// (`segments.json`; compressed: one gzip member, zstd frame or zstd block ends per segment), in place: a store too
-        /// large for one session (seed 000 Table 4.3). Not with --hierarchy.
+        /// large to write in one sitting (seed 000 Table 4.3). Not with --hierarchy.
         #[arg(long, value_name = "N")]
         segment: Option<u64>,
         /// Go on with the store being written in the directory (with --segment).

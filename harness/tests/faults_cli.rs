@@ -1,4 +1,4 @@
-//! Faults of the out-of-core method from the command line (issue 19, acceptance 6): a hierarchy
+//! Faults of the out-of-core method from the command line: a hierarchy
 //! file that disagrees with its level below, and a full disk during preprocessing. Each must end
 //! in exit status 2 with one line on stderr, and leave nothing half-written behind. (A truncated
 //! on-disk grid is `hires_cli`'s `every_grid_renders_the_same_image_and_a_truncated_grid_exits_2`.)

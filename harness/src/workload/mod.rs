@@ -145,7 +145,7 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 
 /// Environment variable that pins each thread of every pool [`pool`] makes to one CPU of those
 /// the process may run on (thread i to the i-th, round robin): an experiment on where the
-/// scheduler puts the pool's threads (issue 20, acceptance 3), not a default.
+/// scheduler puts the pool's threads, not a default.
 pub const PIN_THREADS_VAR: &str = "RTBENCH_PIN_THREADS";
 
 /// The CPUs the calling thread may run on (empty where that cannot be read).
