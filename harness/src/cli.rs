@@ -19,7 +19,10 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Generate SPD scenes, show their statistics.
-    #[command(subcommand, after_help = "Examples:\n  rtbench scene list\n  rtbench scene gen mount --sf 8 --hash jenkins -o mount8.nff\n  rtbench scene stats bunny.ply --json")]
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  rtbench scene list\n  rtbench scene gen mount --sf 8 --hash jenkins -o mount8.nff\n  rtbench scene stats bunny.ply --json"
+    )]
     Scene(SceneCommand),
     /// List the engines and whether each can run here.
     #[command(after_help = "Examples:\n  rtbench engines\n  rtbench engines --json")]
@@ -29,43 +32,68 @@ pub enum Command {
         json: bool,
     },
     /// Trace the SPD workload for one scene with one engine.
-    #[command(after_help = "Examples:\n  rtbench render --scene gears --engine bvh8 --png gears.png                  # trace gears4, save the image\n  rtbench render --scene balls --sf 2 --engine embree --size 128 --json       # ray counts, times, memory as JSON\n  rtbench render --scene mount10/ --engine breadth-first --set memory=32MiB   # out of core, from a scene store")]
+    #[command(
+        after_help = "Examples:\n  rtbench render --scene gears --engine bvh8 --png gears.png                  # trace gears4, save the image\n  rtbench render --scene balls --sf 2 --engine embree --size 128 --json       # ray counts, times, memory as JSON\n  rtbench render --scene mount10/ --engine breadth-first --set memory=32MiB   # out of core, from a scene store"
+    )]
     Render(RenderArgs),
     /// Cross-check an engine's hits against Embree or the reference engine on the same rays.
-    #[command(after_help = "Examples:\n  rtbench check --scene balls --sf 2 --engine bvh8                       # hits against Embree on the same rays\n  rtbench check --scene tetra --engine grid --against reference --json\n  rtbench check --suite hard --engine bvh4,embree --out out/hard         # hard cases, acne, speed against error")]
+    #[command(
+        after_help = "Examples:\n  rtbench check --scene balls --sf 2 --engine bvh8                       # hits against Embree on the same rays\n  rtbench check --scene tetra --engine grid --against reference --json\n  rtbench check --suite hard --engine bvh4,embree --out out/hard         # hard cases, acne, speed against error"
+    )]
     Check(CheckArgs),
     /// 001's statistics of a BVH of any width 2–16 (even), built but not traced.
-    #[command(after_help = "Examples:\n  rtbench tree-stats --scene tree --sf 10 --tessellate --width 16")]
+    #[command(
+        after_help = "Examples:\n  rtbench tree-stats --scene tree --sf 10 --tessellate --width 16"
+    )]
     TreeStats(TreeStatsArgs),
     /// Remeasure a published table: `reproduce list`, `reproduce <id> --out DIR`.
-    #[command(after_help = "Examples:\n  rtbench reproduce list                                         # every table, its seed, fidelity counts and run time\n  rtbench reproduce spd-stats --engines embree --out out/repro   # writes out/repro/spd-stats.md, .json, .html\n  rtbench reproduce nakamaru-3.1 --quick --out out/repro         # a scaled-down run")]
+    #[command(
+        after_help = "Examples:\n  rtbench reproduce list                                         # every table, its seed, fidelity counts and run time\n  rtbench reproduce spd-stats --engines embree --out out/repro   # writes out/repro/spd-stats.md, .json, .html\n  rtbench reproduce nakamaru-3.1 --quick --out out/repro         # a scaled-down run"
+    )]
     Reproduce(ReproduceArgs),
     /// Many engines × scenes × SFs, each run in its own process, results to DIR/results.jsonl.
-    #[command(after_help = "Examples:\n  rtbench run --engines embree,bvh8 --scenes gears --sf 2 --out out/gears\n  rtbench run --engines bvh4,bvh4:simd=off,embree --scenes standard --paired 5 --out out/simd   # variants, paired with Embree\n  rtbench run --engines all --scenes standard --threads 1,all --out out/all --resume")]
+    #[command(
+        after_help = "Examples:\n  rtbench run --engines embree,bvh8 --scenes gears --sf 2 --out out/gears\n  rtbench run --engines bvh4,bvh4:simd=off,embree --scenes standard --paired 5 --out out/simd   # variants, paired with Embree\n  rtbench run --engines all --scenes standard --threads 1,all --out out/all --resume"
+    )]
     Run(RunArgs),
     /// Raise each scene's SF until a run passes the time or memory limit.
-    #[command(after_help = "Examples:\n  rtbench sweep --engines grid,bvh4,embree --scenes balls,tetra --max-seconds 60 --out out/sweep")]
+    #[command(
+        after_help = "Examples:\n  rtbench sweep --engines grid,bvh4,embree --scenes balls,tetra --max-seconds 60 --out out/sweep"
+    )]
     Sweep(SweepArgs),
     /// Tables and plots from a results directory.
-    #[command(after_help = "Examples:\n  rtbench report out/gears                   # report.md, report.html, results.csv, summary.json, plots/\n  rtbench report out/gears --format md,csv")]
+    #[command(
+        after_help = "Examples:\n  rtbench report out/gears                   # report.md, report.html, results.csv, summary.json, plots/\n  rtbench report out/gears --format md,csv"
+    )]
     Report(ReportArgs),
     /// Compare two results directories; exit 1 on a regression.
-    #[command(after_help = "Examples:\n  rtbench compare out/yesterday out/today                         # exit 1 on a regression, naming it\n  rtbench compare out/yesterday out/today --threshold 10 --json")]
+    #[command(
+        after_help = "Examples:\n  rtbench compare out/yesterday out/today                         # exit 1 on a regression, naming it\n  rtbench compare out/yesterday out/today --threshold 10 --json"
+    )]
     Compare(CompareArgs),
     /// One measured run, printed as one JSON line (the child process of run and sweep).
     #[command(hide = true)]
     RunOne(RunOneArgs),
     /// Run a nightly suite, store every sample in the history, exit 1 on a detected regression.
-    #[command(after_help = "Examples:\n  rtbench nightly --suite suites/nightly.toml --db out/nightly/history.sqlite --out out/nightly/run1\n  rtbench nightly --suite suites/nightly.toml --shard 1/2 --out out/n1                                 # one shard; merge, then --from\n  rtbench nightly --suite suites/nightly.toml --from out/merged --db out/nightly/history.sqlite")]
+    #[command(
+        after_help = "Examples:\n  rtbench nightly --suite suites/nightly.toml --db out/nightly/history.sqlite --out out/nightly/run1\n  rtbench nightly --suite suites/nightly.toml --shard 1/2 --out out/n1                                 # one shard; merge, then --from\n  rtbench nightly --suite suites/nightly.toml --from out/merged --db out/nightly/history.sqlite"
+    )]
     Nightly(NightlyArgs),
     /// The nightly history: list, show, export (CSV, Bencher Metric Format), dashboard.
-    #[command(subcommand, after_help = "Examples:\n  rtbench history list --db out/nightly/history.sqlite\n  rtbench history export --db out/nightly/history.sqlite --format bmf\n  rtbench history dashboard --db out/nightly/history.sqlite --out out/dashboard")]
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  rtbench history list --db out/nightly/history.sqlite\n  rtbench history export --db out/nightly/history.sqlite --format bmf\n  rtbench history dashboard --db out/nightly/history.sqlite --out out/dashboard"
+    )]
     History(HistoryCommand),
     /// Join the results of a plan's shards (`--shard K/N`, `render --tile K/N`) into one set.
-    #[command(after_help = "Examples:\n  rtbench merge out/s1 out/s2 --out out/merged                # the shards of one plan (--shard 1/2, 2/2)\n  rtbench merge out/t1 out/t2 out/t3 out/t4 --out out/image   # the tiles of render --tile K/4")]
+    #[command(
+        after_help = "Examples:\n  rtbench merge out/s1 out/s2 --out out/merged                # the shards of one plan (--shard 1/2, 2/2)\n  rtbench merge out/t1 out/t2 out/t3 out/t4 --out out/image   # the tiles of render --tile K/4"
+    )]
     Merge(MergeArgs),
     /// A plan's jobs, groups and shards, without running them (for cluster job arrays).
-    #[command(after_help = "Examples:\n  rtbench plan run --engines all --scenes standard --out out/all --shards 4\n  rtbench plan --json nightly --suite suites/nightly.toml                     # jobs, groups and slices as JSON")]
+    #[command(
+        after_help = "Examples:\n  rtbench plan run --engines all --scenes standard --out out/all --shards 4\n  rtbench plan --json nightly --suite suites/nightly.toml                     # jobs, groups and slices as JSON"
+    )]
     Plan(PlanCmdArgs),
 }
 
@@ -342,6 +370,9 @@ pub struct ReproduceArgs {
     /// yamauchi-* only: SPD scenes, comma-separated (standard SFs).
     #[arg(long)]
     pub scenes: Option<String>,
+    /// With `list`: the paper→code map as Markdown (the README's copy is checked against it).
+    #[arg(long, conflicts_with = "json")]
+    pub markdown: bool,
     /// A table's option `key=value` (repeatable; `reproduce list --json` lists each table's keys).
     /// The flags above are the same keys by their own names.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -362,7 +393,9 @@ pub enum SceneCommand {
         json: bool,
     },
     /// Write a scene as NFF, as the SPD C program prints it.
-    #[command(after_help = "Examples:\n  rtbench scene gen balls --sf 2                          # NFF on stdout, as SPD's balls -s 2 -r 1\n  rtbench scene gen teapot --tessellate -o teapot12.nff")]
+    #[command(
+        after_help = "Examples:\n  rtbench scene gen balls --sf 2                          # NFF on stdout, as SPD's balls -s 2 -r 1\n  rtbench scene gen teapot --tessellate -o teapot12.nff"
+    )]
     Gen {
         #[command(flatten)]
         scene: SceneArg,
@@ -372,7 +405,9 @@ pub enum SceneCommand {
     },
     /// Write a scene store for the breadth-first engine (bounding-box and geometry files,
     /// header.json), streaming from the generator without holding the scene.
-    #[command(after_help = "Examples:\n  rtbench scene store mount --sf 10 -o mount10/\n  rtbench scene store mount --sf 12 --layout basic --compress gzip -o m12/")]
+    #[command(
+        after_help = "Examples:\n  rtbench scene store mount --sf 10 -o mount10/\n  rtbench scene store mount --sf 12 --layout basic --compress gzip -o m12/"
+    )]
     Store {
         #[command(flatten)]
         scene: SceneArg,
@@ -411,7 +446,9 @@ pub enum SceneCommand {
         json: bool,
     },
     /// Count a scene's primitives by streaming it.
-    #[command(after_help = "Examples:\n  rtbench scene stats balls --sf 4 --tessellate --json\n  rtbench scene stats rings --sf 36 --view data/views/rings368m.json")]
+    #[command(
+        after_help = "Examples:\n  rtbench scene stats balls --sf 4 --tessellate --json\n  rtbench scene stats rings --sf 36 --view data/views/rings368m.json"
+    )]
     Stats {
         #[command(flatten)]
         scene: SceneArg,

@@ -105,7 +105,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::History(c) => nightly::history_cmd(&c),
         Command::Merge(a) => commands::merge::run(&a),
         Command::Plan(a) => commands::plan::run(&a),
-        Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),
+        Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json, a.markdown),
         Command::Reproduce(a) => {
             let out = a
                 .out

@@ -47,8 +47,10 @@ pub fn list(as_json: bool) -> Result<()> {
                        "description": p.description()})
             })
             .collect();
-        v.push(json!({"name": "room", "standard_sf": null, "patches_per_metre": room_ppm,
-                      "objects_at_standard_sf": room_objects, "description": room_about}));
+        v.push(
+            json!({"name": "room", "standard_sf": null, "patches_per_metre": room_ppm,
+                      "objects_at_standard_sf": room_objects, "description": room_about}),
+        );
         // Still a list of scenes (the contract); the note on files is for people.
         print_json(&json!(v));
     } else {
