@@ -115,9 +115,7 @@ const PAPERS: &[(&str, &str, &str)] = &[
 /// The paper→code map as Markdown, generated from the registry (README.md holds a copy that a test
 /// compares with this): one row per seed, then one per table.
 pub fn markdown_map() -> String {
-    let mut s = String::from(
-        "| seed | paper | engines |\n|---|---|---|\n",
-    );
+    let mut s = String::from("| seed | paper | engines |\n|---|---|---|\n");
     for (seed, paper, engines) in PAPERS {
         s.push_str(&format!("| {seed} | {paper} | {engines} |\n"));
     }
@@ -255,20 +253,33 @@ mod tests {
     /// `rtbench reproduce list --markdown` when a table is added or its claims change.
     #[test]
     fn the_readme_map_is_the_registry() {
-        let readme = std::fs::read_to_string(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"),
-        )
-        .expect("README.md");
-        let (begin, end) = ("<!-- reproduce-map: rtbench reproduce list --markdown -->\n", "<!-- /reproduce-map -->");
-        let start = readme.find(begin).expect("README.md has no reproduce-map block") + begin.len();
-        let stop = start + readme[start..].find(end).expect("README.md's reproduce-map block is not closed");
+        let readme =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+                .expect("README.md");
+        let (begin, end) = (
+            "<!-- reproduce-map: rtbench reproduce list --markdown -->\n",
+            "<!-- /reproduce-map -->",
+        );
+        let start = readme
+            .find(begin)
+            .expect("README.md has no reproduce-map block")
+            + begin.len();
+        let stop = start
+            + readme[start..]
+                .find(end)
+                .expect("README.md's reproduce-map block is not closed");
         assert_eq!(
             readme[start..stop].trim(),
             markdown_map().trim(),
             "README.md's paper→code map differs from the registry: paste `rtbench reproduce list --markdown` between its markers"
         );
         for t in TABLES {
-            assert!(PAPERS.iter().any(|p| p.0 == t.seed), "{}: seed {} has no paper", t.id, t.seed);
+            assert!(
+                PAPERS.iter().any(|p| p.0 == t.seed),
+                "{}: seed {} has no paper",
+                t.id,
+                t.seed
+            );
         }
     }
 
