@@ -6,8 +6,8 @@
 //! The full disk is simulated with a file-size limit (`RLIMIT_FSIZE`) on the child process, with
 //! `SIGXFSZ` ignored: every write past the limit then fails with EFBIG, as a write on a full disk
 //! fails with ENOSPC, without a tmpfs or a loop mount (which need root). The code under test sees
-//! an I/O error from `write` in both cases; `docs/benchmarks.md` records the same run on a
-//! 3,600 KiB tmpfs (ENOSPC).
+//! an I/O error from `write` in both cases; the same run on a 3,600 KiB tmpfs gives
+//! ENOSPC instead.
 
 mod common;
 

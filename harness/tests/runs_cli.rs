@@ -296,8 +296,8 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
     // (queries are 75–90% of a trace here). A 20% plant (+13–16%) failed in 3 of 7 runs of this
     // test on a loaded machine, as did the same-commit check at the default 5% threshold: this
     // test checks that compare matches runs, names a large regression and spares Embree, with
-    // margins wide of this machine's noise. How small a change is caught is the nightly's benchmark
-    // (docs/benchmarks.md), not a test.
+    // margins wide of this machine's noise. How small a change is caught is measured by the
+    // nightly's planted regressions (RTBENCH_PLANT), not a test.
     quick_run(&c, Some("1.0"));
     let same = rtbench()
         .args(["compare", "--threshold", "30"])

@@ -98,7 +98,7 @@ impl Device {
     /// thread that then spun in `sched_yield` for the rest of the process (a whole CPU of system
     /// time, from the first Embree engine dropped on), and on two cores the scheduler stacked the
     /// two trace threads on the other CPU for a fifth to a third of a two-thread trace
-    /// (docs/benchmarks.md). One device per configuration for the process's life
+    /// (`RTBENCH_SCHED=1` shows it). One device per configuration for the process's life
     /// keeps the limit in place: no worker is ever started for `threads=1`.
     pub fn shared(config: &str) -> Result<&'static Device, String> {
         static DEVICES: OnceLock<Mutex<HashMap<String, &'static Device>>> = OnceLock::new();

@@ -33,7 +33,7 @@
 //! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
 //! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
 //! offsets). Or zstd-compressed: `objects.bin.zst`, `"compression": "zstd"` (zstd is offered
-//! beside the thesis's gzip: it compresses several times faster, docs/benchmarks.md).
+//! beside the thesis's gzip: it compresses several times faster).
 //! The compressed file's header carries no checksum of `header.json` (it is written before the
 //! header is known); the codec's own checksum (gzip's CRC-32; zstd's frame checksum) and the
 //! records' checksums guard its bytes.

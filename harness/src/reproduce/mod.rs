@@ -283,6 +283,45 @@ mod tests {
         }
     }
 
+    /// Every result of record in docs/results/ is a document `rtbench reproduce <id>` wrote, named
+    /// for its id, and says how to regenerate it: the command, commit, date and machine.
+    #[test]
+    fn every_result_of_record_names_its_command() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/results");
+        let mut seen = 0;
+        for e in std::fs::read_dir(&dir).expect("docs/results") {
+            let path = e.unwrap().path();
+            if path.extension().is_none_or(|x| x != "md") {
+                continue;
+            }
+            let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+            assert!(
+                TABLES.iter().any(|t| t.id == stem),
+                "{}: not named for a reproduce id",
+                path.display()
+            );
+            let text = std::fs::read_to_string(&path).unwrap();
+            let want = format!("Regenerate: `rtbench reproduce {stem} ");
+            assert!(
+                text.contains(&want),
+                "{}: does not say how to regenerate it ({want}…`)",
+                path.display()
+            );
+            assert!(
+                text.contains(", commit ") && text.contains("Measured on "),
+                "{}: no commit, date or machine",
+                path.display()
+            );
+            assert!(
+                !text.contains("../shared"),
+                "{}: cites a file outside the repository",
+                path.display()
+            );
+            seen += 1;
+        }
+        assert!(seen > 0, "no results of record in {}", dir.display());
+    }
+
     #[test]
     fn ids_are_unique_and_name_their_files() {
         let mut ids: Vec<_> = TABLES.iter().map(|t| t.id).collect();
