@@ -2,7 +2,7 @@
 """The tables of docs/benchmarks.md from the runs of scripts/benchmarks.sh: python3 scripts/benchmarks.py OUT.
 
 Intervals are distribution-free 95 % intervals of a median from the order statistics of its samples (the
-binomial ranks; with 9 samples, the 2nd and 8th smallest: 96 % coverage). Fewer than 6 samples give no
+binomial ranks; with 7 samples, the smallest and largest: 98 % coverage; with 9, the 2nd and 8th: 96 %). Fewer than 6 samples give no
 interval at 95 % and are shown as their range, marked "range"."""
 import json
 import math
