@@ -140,7 +140,7 @@ def build(d):
         row = [s]
         for e in engines:
             r = t[s].get(e)
-            row.append(f"{r['time_s']['build']['median'] * 1e3:.1f}" if r else "–")
+            row.append(fmt_ci(median_ci([x * 1e3 for x in r['time_s']['build']['samples']]), 1) if r else "–")
         rows.append(row)
     return md(["scene"] + [f"{e} ms" for e in engines], rows)
 
@@ -199,7 +199,7 @@ def ooc(d):
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/benchmarks"
-    parts = [("speed", speed), ("speed", memory), ("speed", build), ("threads", threads), ("grid", grid)]
+    parts = [("speed", speed), ("speed", memory), ("build", build), ("threads", threads), ("grid", grid)]
     for sub, f in parts:
         d = os.path.join(out, sub)
         if records(d):

@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # Regenerates every table of docs/benchmarks.md: runs the commands below into OUT (default out/benchmarks), then
 # prints the tables as Markdown (scripts/benchmarks.py) with the date, commit and machine of each.
-# Usage: bash scripts/benchmarks.sh [OUT] [TABLE…]     TABLE: grid ooc threads speed (default: all four)
-# The speed run also gives the memory and build-time tables.
+# Usage: bash scripts/benchmarks.sh [OUT] [TABLE…]     TABLE: grid ooc threads build speed (default: all five)
+# The speed run also gives the memory table.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 [ -x "$HOME/.cargo/bin/cargo" ] && export PATH="$HOME/.cargo/bin:$PATH"
 OUT="${1:-out/benchmarks}"
 shift || true
-TABLES="${*:-grid ooc threads speed}"
+TABLES="${*:-grid ooc threads build speed}"
 RT="${RTBENCH:-./target/release/rtbench}"
 if [ -z "${RTBENCH:-}" ]; then
     bash scripts/setup.sh
@@ -34,6 +34,13 @@ for t in $TABLES; do
             "$RT" run --engines embree,bvh8 --scenes balls,gears,tree --size 256 --threads 2 --paired-threads 7 \
                 --repeat 1 --no-check --out "$OUT/threads" --resume
             ;;
+        build)
+            # Build time: 7 builds of every structure, each in the run's own process, at an image of 16² so
+            # that tracing costs nothing.
+            say "build: $RT run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 16 --repeat 7 --no-check --out $OUT/build"
+            "$RT" run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 16 --repeat 7 --no-check \
+                --out "$OUT/build" --resume
+            ;;
         grid)
             # The grid's exact counters under the Rayshade-style presets (seed 000's rss and rss-r).
             say "grid: $RT run --engines grid:preset=rss,grid:preset=rss-r --scenes standard --size 256 --repeat 1 --no-check --out $OUT/grid"
@@ -53,7 +60,7 @@ for t in $TABLES; do
             "$RT" render --scene mount --sf 8 --engine breadth-first --threads 1 --size 256 --json > "$OUT/ooc/memory-bf.json"
             "$RT" render --scene mount --sf 8 --engine grid --threads 1 --size 256 --json > "$OUT/ooc/memory-grid.json"
             ;;
-        *) echo "benchmarks.sh: unknown table '$t' (speed, threads, grid, ooc)" >&2; exit 2 ;;
+        *) echo "benchmarks.sh: unknown table '$t' (speed, threads, build, grid, ooc)" >&2; exit 2 ;;
     esac
 done
 python3 scripts/benchmarks.py "$OUT"
