@@ -66,20 +66,24 @@ bool finite3(const float *v) {
     return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
 }
 
-/* The ray in tinybvh's form, from org + tmin*dir; false if it cannot hit anything. */
+/* The ray in tinybvh's form, from org + tmin*dir; false if it cannot hit anything. Only the
+ * fields the traversals read are set (no memset of the whole ray: it is per-ray cost that the
+ * comparison with the other engines would charge to tinybvh). */
 bool to_tiny(const rtb_ray &r, tinybvh::Ray &out) {
     if (!finite3(r.org) || !finite3(r.dir) || std::isnan(r.tmin) || std::isnan(r.tmax) ||
         !(r.tmin < r.tmax) || (r.dir[0] == 0.0f && r.dir[1] == 0.0f && r.dir[2] == 0.0f))
         return false;
-    const float t0 = r.tmin > 0.0f && std::isfinite(r.tmin) ? r.tmin : 0.0f;
-    std::memset(&out, 0, sizeof(out));
+    const float t0 = r.tmin > 0.0f ? r.tmin : 0.0f;
     out.O = tinybvh::bvhvec3(r.org[0] + t0 * r.dir[0], r.org[1] + t0 * r.dir[1],
                              r.org[2] + t0 * r.dir[2]);
     out.D = tinybvh::bvhvec3(r.dir[0], r.dir[1], r.dir[2]);
     out.rD = tinybvh::tinybvh_rcp(out.D);
     out.mask = RAY_MASK_INTERSECT_ALL;
+    out.instIdx = 0;
     const float span = r.tmax - t0;
-    out.hit.t = std::isfinite(span) ? span : BVH_FAR;
+    out.hit.t = span < BVH_FAR ? span : BVH_FAR;
+    out.hit.prim = RTB_MISS;
+    out.hit.u = out.hit.v = 0.0f;
     return true;
 }
 
@@ -213,7 +217,7 @@ void intersect(const void *engine, const rtb_ray *rays, rtb_hit *hits, size_t co
         const float start = r.hit.t;
         closest(e, r);
         if (!(r.hit.t < start) || r.hit.prim >= e.verts.size() / 3) continue;
-        const float t0 = q.tmin > 0.0f && std::isfinite(q.tmin) ? q.tmin : 0.0f;
+        const float t0 = q.tmin > 0.0f ? q.tmin : 0.0f;
         float t = t0 + r.hit.t;
         // The shift back may round onto an end of the open interval.
         if (!(t > q.tmin)) t = std::nextafter(q.tmin, INFINITY);
