@@ -147,7 +147,7 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
         ("floor".to_string(), floor.to_string()),
         ("count".to_string(), "objects".to_string()),
     ];
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let (e, build_s) = workload::build("grid", &prepared.input, set)?;
     let r = pool.install(|| trace::render(&prepared.input.scene, e.as_ref(), 512, None));
     let pre = prepared.prepare_s + build_s;
