@@ -175,3 +175,10 @@ if ! meshes_ok; then
         say "warning: could not fetch the example meshes; rtbench works without them"
     fi
 fi
+# The `tinybvh` engine's plugin: tinybvh's header (shipped by the tinybvh-rs crate) compiled with AVX2 for that
+# library alone. Without a C++ compiler or AVX2 the engine is listed as unavailable and the rest works.
+if grep -q avx2 /proc/cpuinfo 2>/dev/null && bash examples/tinybvh/build.sh; then
+    :
+else
+    say "warning: the tinybvh plugin was not built; the tinybvh engine is unavailable"
+fi
