@@ -92,8 +92,8 @@ pub struct Comparison {
     pub b_commit: Option<String>,
     /// What differs between the machines A and B were measured on (from their `env.json`): the
     /// CPU model, its flags, cores, memory, OS, Rust compiler, Embree. Ratios to Embree then
-    /// measure the machines as well as the code (issue 20, session 15: a host with AVX-512
-    /// replaced an AVX2 one between sessions, and every ratio moved).
+    /// measure the machines as well as the code (a host with AVX-512
+    /// replaced an AVX2 one between two runs, and every ratio moved).
     pub machine_differences: Vec<String>,
     pub threshold_pct: f64,
     /// Keys present in both sets.

@@ -1,4 +1,4 @@
-//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (../shared/CLI.md, "Runs and reports").
+//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (docs/concepts.md).
 
 use crate::cli::{CompareArgs, PlanArgs, ReportArgs, RunArgs, RunOneArgs, SweepArgs};
 use crate::error::{input, Failure, Result};

@@ -1,4 +1,4 @@
-//! The process's memory between the phases of a render (issue 20, acceptance 5: peak RSS ≤ 3 ×
+//! The process's memory between the phases of a render (peak RSS ≤ 3 ×
 //! structure bytes + 16 MiB): what is resident after each phase, on request, and handing the
 //! build's freed heap back to the system before the trace.
 
@@ -53,7 +53,7 @@ fn heap_kib() -> (u64, u64) {
 /// Called between the build and the trace: the build's scratch (primitive boxes, the binary
 /// build tree, bins) is freed into the main thread's heap, but the trace runs on the pool's
 /// threads, which allocate from their own arenas, so glibc kept those pages resident through
-/// the whole trace (session 10: gears4 bvh8 at 512², 24.31 MiB peak against 22.49 MiB with
+/// the whole trace (gears4 bvh8 at 512², 24.31 MiB peak against 22.49 MiB with
 /// `MALLOC_TRIM_THRESHOLD_=0`). Changes no answer; elsewhere a no-op.
 pub fn release_free_heap() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]

@@ -1,5 +1,4 @@
-//! The scheduler's accounting of one thread, read from `/proc/thread-self` (issue 20,
-//! acceptance 3: where the pool's threads are when they are not on a CPU).
+//! The scheduler's accounting of one thread, read from `/proc/thread-self` (where the pool's threads are when they are not on a CPU).
 //!
 //! `schedstat` gives the nanoseconds the thread ran, the nanoseconds it waited on a run queue
 //! while runnable (preempted, or woken and not yet run) and its timeslices; `status` its

@@ -109,9 +109,9 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .map_err(|e| input(format!("cannot start threads: {e}")))
 }
 
-// `RTBENCH_PIN_THREADS` (read once, in `measure::vars`) pins each thread of every pool [`pool`] makes to one CPU of those
-// the process may run on (thread i to the i-th, round robin): an experiment on where the
-// scheduler puts the pool's threads (issue 20, acceptance 3), not a default.
+// `RTBENCH_PIN_THREADS` (read once, in `measure::vars`) pins each thread of every pool [`pool`]
+// makes to one CPU of those the process may run on (thread i to the i-th, round robin): an
+// experiment on where the scheduler puts the pool's threads, not a default.
 
 /// The CPUs the calling thread may run on (empty where that cannot be read).
 pub fn allowed_cpus() -> Vec<usize> {

@@ -1,6 +1,6 @@
-//! Planted regressions, to measure whether the nightly detection finds them (docs/benchmarks.md,
-//! "Nightly regression runs"). Only the environment variable `RTBENCH_PLANT` turns one on; it is
-//! meant for that measurement alone.
+//! Planted regressions, to measure whether the nightly detection finds them
+//! (docs/guides/nightly.md). Only the environment variable `RTBENCH_PLANT` turns one on; it
+//! is meant for that measurement alone.
 //!
 //! - `RTBENCH_PLANT=work:ENGINE:SCENE:FRACTION`: the engine answers every query as before, then
 //!   answers FRACTION of them a second time (into scratch buffers, with scratch counters): real

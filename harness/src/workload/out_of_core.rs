@@ -58,10 +58,10 @@ pub fn shade_bytes_per_ray(lights: usize) -> usize {
 /// Rays shaded per group: Algorithm 3.6's "while memory not full of rays", the rays the engine
 /// holds in memory at once within its budget, as far as [`SHADE_BYTES`] holds them, and at least
 /// [`MIN_GROUP`]. The basic layout reads the store forward once per group up to the last object
-/// hit, so at 10^9 objects (rings368's 35 GB store: 284 s a read in session 13) the group's size
+/// hit, so at 10^9 objects (rings368's 35 GB store: 284 s a read, measured) the group's size
 /// sets the shading time: a fixed 16,384 makes the 263,169 eye rays of a 512² image 17 sweeps,
 /// rings368's 41,213 rays a pass 7. Without the byte cap, gears18's and rings94's peak RSS
-/// passed the 320 MiB bound (331.5 and 358.2 MiB in session 13).
+/// passed the 320 MiB bound (331.5 and 358.2 MiB, measured).
 pub fn shade_group(engine: &BreadthFirst, lights: usize) -> usize {
     engine
         .ray_capacity()

@@ -1,5 +1,5 @@
-//! The SPD workload, traced as wavefront generations (../shared/SPD.md, "The testing
-//! procedure"): all rays of one depth are answered as batches by the engine before shading makes
+//! The SPD workload, traced as wavefront generations (docs/concepts.md, "The SPD
+//! workload"): all rays of one depth are answered as batches by the engine before shading makes
 //! the next generation. One shading code path serves every engine, so images and ray statistics
 //! agree across engines.
 //!
@@ -332,9 +332,9 @@ pub fn render(
     render_chunked(scene, engine, size, DEFAULT_CHUNK, false, record)
 }
 
-// `RTBENCH_BANDS` (read once, in `measure::vars`) makes [`render_chunked`] print one line per band on stderr (its
-// rows, thread, rays, engine counters and the thread's CPU seconds): how the trace's work is
-// spread over bands and threads (issue 20, acceptance 3).
+// `RTBENCH_BANDS` (read once, in `measure::vars`) makes [`render_chunked`] print one line per
+// band on stderr (its rows, thread, rays, engine counters and the thread's CPU seconds): how the
+// trace's work is spread over bands and threads.
 
 /// The buffers of one chunk's generations, reused from chunk to chunk on a thread.
 #[derive(Default)]
@@ -445,7 +445,7 @@ pub fn render_chunked(
     // (the seam) is made from the last corner row of the band above and the first of the band
     // below by whichever of the two finishes second, so only the edge rows of bands whose
     // neighbour is not yet done are held (on one thread: one row; all bands' edge rows were
-    // 0.9 MiB at 512², session 11).
+    // 0.9 MiB at 512²).
     let mut pixels = vec![0u8; n * n * 3];
     let mut slices = Vec::new();
     let mut seams = Vec::new();
@@ -498,8 +498,8 @@ pub fn render_chunked(
         // take only pieces still queued, never bands of the piece being traced. The bands' work
         // is uneven (gears4 bvh8 at 512², one thread's CPU seconds per band: the first half of
         // the bands 39 % of the trace, one band up to 5.9 %): split in two halves, two threads
-        // are bound at 1.65×; bands taken one by one as threads free up, at 1.99× (session 11,
-        // a model from the per-band seconds). The order bands are traced in changes no answer.
+        // are bound at 1.65×; bands taken one by one as threads free up, at 1.99× (a
+        // model from the per-band seconds). The order bands are traced in changes no answer.
         .with_max_len(1)
         .map(|(k, j0, out)| {
             let slot = rayon::current_thread_index().unwrap_or(0) % threads;
@@ -672,7 +672,7 @@ fn print_sched(
 
 /// Traces the ray trees of the corners `first..first + count` to the end, their colours into
 /// `wf.corners`. Never inlined (once per band, so no cost): a profile then shows the bands'
-/// work apart from the serial rest of [`render_chunked`] (issue 20, acceptance 3).
+/// work apart from the serial rest of [`render_chunked`].
 #[inline(never)]
 fn trace_chunk(s: &Setup, first: u32, count: usize, wf: &mut Wavefront, recording: bool) -> Part {
     let t_chunk = Instant::now();
