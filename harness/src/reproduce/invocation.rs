@@ -88,10 +88,19 @@ impl Invocation {
                        "load_average_end": end, "resumed": resumed}),
             );
         }
-        o.doc.paragraph(format!(
-            "Regenerate: `{command}`. Measured on {}, commit {commit}, {machine}.",
-            self.started_at
-        ));
+        // A resumed run measured only what its saved steps lacked: the date, commit and machine
+        // are this invocation's, the loaded rows' are those of the invocations that saved them.
+        o.doc.paragraph(if resumed {
+            format!(
+                "Regenerate: `{command}`. Written on {}, commit {commit}, {machine}, from the steps saved in the output folder's `.partial/` (rows loaded from them were measured by earlier invocations).",
+                self.started_at
+            )
+        } else {
+            format!(
+                "Regenerate: `{command}`. Measured on {}, commit {commit}, {machine}.",
+                self.started_at
+            )
+        });
         o.doc.paragraph(format!(
             "This invocation: {wall_s:.1} s wall, {cpu_s:.1} s CPU over all threads (CPU / wall {}); load average {} at its start, {end} at its end{}.",
             cpu_share(cpu_s, wall_s),

@@ -309,7 +309,8 @@ mod tests {
                 path.display()
             );
             assert!(
-                text.contains(", commit ") && text.contains("Measured on "),
+                text.contains(", commit ")
+                    && (text.contains("Measured on ") || text.contains("Written on ")),
                 "{}: no commit, date or machine",
                 path.display()
             );
