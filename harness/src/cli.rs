@@ -44,6 +44,10 @@ pub enum Command {
     /// One measured run, printed as one JSON line (the child process of run and sweep).
     #[command(hide = true)]
     RunOne(RunOneArgs),
+    /// One trace on the calling thread, after an untimed one: the region the nightly's
+    /// instruction counts cover under valgrind (its child process).
+    #[command(hide = true)]
+    CountOne(CountOneArgs),
     /// Run a nightly suite, store every sample in the history, exit 1 on a detected regression.
     Nightly(NightlyArgs),
     /// The nightly history: list, show, export (CSV, Bencher Metric Format), dashboard.
@@ -265,6 +269,18 @@ pub struct RunOneArgs {
     /// at `--threads` (alternating which goes first) and record the speed-up of each pair.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub paired_threads: u32,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct CountOneArgs {
+    #[command(flatten)]
+    pub scene: SceneFlag,
+    #[arg(long)]
+    pub engine: String,
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    #[arg(long, default_value_t = 32)]
+    pub size: u32,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -128,3 +128,17 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
     }
     Ok(())
 }
+
+/// `rtbench count-one`: the nightly's counted region (run under valgrind).
+pub fn count_one(a: &crate::cli::CountOneArgs) -> Result<()> {
+    let source = crate::source::Source::resolve(
+        &a.scene.scene,
+        a.scene.opts.sf,
+        a.scene.opts.tessellate,
+        a.scene.opts.hash,
+    )?;
+    let settings = crate::workload::parse_settings(&a.set)?;
+    let rays = crate::nightly::count::count_one(&a.engine, settings, &source, a.size)?;
+    println!("{{\"rays\":{rays}}}");
+    Ok(())
+}

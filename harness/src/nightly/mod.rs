@@ -4,6 +4,7 @@
 //! same machine fingerprint (`history/detect.rs`), writes the whole night to the history in one
 //! transaction, and exits 1 only when a gated metric regressed, naming it.
 
+pub mod count;
 pub mod shard;
 pub mod suite;
 mod tools;
