@@ -34,8 +34,8 @@ fi
 command -v sbatch >/dev/null || die "sbatch not found: install Slurm's client and set SLURM_CONF to your cluster's slurm.conf (or start a one-node cluster here: bash scripts/slurm/local-cluster.sh start)"
 # A cluster must answer before anything is submitted (sbatch's own error would be a raw resolver
 # or socket message and exit 1).
-if ! ping_err="$(scontrol ping 2>&1)" || ! grep -q "is UP" <<<"$ping_err"; then
-    die "no Slurm controller answers (${SLURM_CONF:-the default slurm.conf}: $(head -n 1 <<<"$ping_err")): set SLURM_CONF to your cluster's slurm.conf, or start a one-node cluster here: bash scripts/slurm/local-cluster.sh start"
+if ! scontrol ping 2>/dev/null | grep -q "is UP"; then
+    die "no Slurm controller answers (${SLURM_CONF:-SLURM_CONF unset, the default slurm.conf}): set SLURM_CONF to your cluster's slurm.conf, or start a one-node cluster here: bash scripts/slurm/local-cluster.sh start"
 fi
 mkdir -p "$SHARED"
 SHARED="$(cd "$SHARED" && pwd)"
