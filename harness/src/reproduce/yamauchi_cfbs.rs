@@ -527,7 +527,7 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             Kind::Count,
             Verdict::of(agree),
         )
-        .with_note("the digest's arithmetic, not 003's: equal to 4 significant digits"),
+        .with_note("our arithmetic from eqs. 11-21, not 003's: equal to 4 significant digits"),
         Row::new(
             "sim-vs-theory",
             "4-ary 5-stage, P_M = 0.5",
@@ -684,7 +684,7 @@ fn model_section(doc: &mut Document, r: &Result_) {
             "m-ary n-stage",
             "P_M",
             "saturation λ_PE (per PE per clock)",
-            "digest's derived value",
+            "derived from eqs. 11-21",
         ],
     );
     for m in &r.model {

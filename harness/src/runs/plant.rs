@@ -1,6 +1,6 @@
-//! Planted regressions, to measure whether the nightly detection finds them (docs/benchmarks.md,
-//! "Nightly regression runs"). Only the environment variable `RTBENCH_PLANT` turns one on; it is
-//! meant for that measurement alone.
+//! Planted regressions, to measure whether the nightly detection finds them
+//! (docs/guides/nightly.md). Only the environment variable `RTBENCH_PLANT` turns one on; it
+//! is meant for that measurement alone.
 //!
 //! - `RTBENCH_PLANT=work:ENGINE:SCENE:FRACTION`: the engine answers every query as before, then
 //!   answers FRACTION of them a second time (into scratch buffers, with scratch counters): real
@@ -22,7 +22,27 @@ pub enum Plant {
 
 /// The plant for this engine and scene, if `RTBENCH_PLANT` asks for one.
 pub fn from_env(engine: &str, program: Option<&str>) -> Option<Plant> {
-    parse(&std::env::var("RTBENCH_PLANT").ok()?, engine, program)
+    parse(
+        crate::measure::vars::values().plant.as_deref()?,
+        engine,
+        program,
+    )
+}
+
+/// Whether every `;`-separated plant of `spec` is well formed (`RTBENCH_PLANT`'s check).
+pub fn valid(spec: &str) -> bool {
+    spec.split(';').all(|one| {
+        let parts: Vec<&str> = one.trim().split(':').collect();
+        match parts.as_slice() {
+            ["work", e, s, f] => {
+                !e.is_empty()
+                    && !s.is_empty()
+                    && f.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)
+            }
+            ["counter", e, s] => !e.is_empty() && !s.is_empty(),
+            _ => false,
+        }
+    })
 }
 
 fn parse(spec: &str, engine: &str, program: Option<&str>) -> Option<Plant> {
