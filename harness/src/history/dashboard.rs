@@ -222,7 +222,7 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
                     .push((label.to_string(), pts.clone()));
                 continue;
             }
-            Some("instructions") => (1, "instructions under cachegrind".to_string()),
+            Some("instructions") => (1, "instructions of the trace under callgrind".to_string()),
             Some("criterion") => (2, "criterion kernels, ns per call".to_string()),
             _ => (3, "other".to_string()),
         };

@@ -1,4 +1,4 @@
-//! The nightly suite's two outside tools: valgrind's cachegrind for instruction counts, and
+//! The nightly suite's two outside tools: valgrind's callgrind for instruction counts, and
 //! `cargo bench` for the criterion kernels.
 
 use super::suite::{Criterion, Variant};
