@@ -318,7 +318,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
             format!("sray/rss {pt:.2}"),
             format!("bf/rss {bf:.2} (bf/rss-r {:.2})", t.measured["bf/rss-r"]),
             Kind::Ratio,
-            Verdict::of(bf < pt),
+            // Being faster than the thesis's sray is a goal of ours, not a claim of the thesis's:
+            // shown here, the thesis's range judged in total-ratio.
+            Verdict::Shown,
         ));
         for (claim, phase, against) in [
             ("preprocess-ratio", "preprocess", "rss"),
@@ -404,4 +406,46 @@ fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -
     }
     doc.table(tests);
     doc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Table 3.1 fed through its own claims' checks: sray's figures as if measured.
+    #[test]
+    fn every_range_holds_on_the_thesis_table() {
+        let (p, _): (Published, _) = published::load("nakamaru-3.1", PUBLISHED);
+        let measured: Vec<Measured> = p
+            .rows
+            .iter()
+            .map(|r| {
+                let phases = PHASES
+                    .iter()
+                    .map(|&ph| {
+                        let [rss, rss_r, sray] = r.phases[ph];
+                        let published = BTreeMap::from([("sray/rss", sray / rss), ("sray/rss-r", sray / rss_r)]);
+                        let measured = BTreeMap::from([("bf/rss", sray / rss), ("bf/rss-r", sray / rss_r)]);
+                        (ph, PhaseFigures { published, measured })
+                    })
+                    .collect();
+                Measured {
+                    scene: r.scene.clone(),
+                    sf: r.sf,
+                    floor: "",
+                    phases,
+                    object_tests: BTreeMap::from([("rss-r", 100), ("breadth-first", 100)]),
+                    resolution: BTreeMap::new(),
+                    image_equal_to_rss_r: true,
+                    repeats: 1,
+                }
+            })
+            .collect();
+        assert_eq!(measured.len(), 6);
+        let rows = rows(&p, &measured);
+        for r in &rows {
+            assert_ne!(r.verdict, Verdict::Fails, "{} {}: {} vs {}", r.claim, r.subject, r.published, r.measured);
+        }
+        assert_eq!(rows.iter().filter(|r| r.kind == Kind::Range).count(), 24);
+    }
 }
