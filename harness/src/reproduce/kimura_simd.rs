@@ -33,8 +33,8 @@ pub const TABLE: Table = Table {
         },
         Claim {
             key: "speedup-larger-where-slower",
-            fidelity: Fidelity::Substituted,
-            why: "the three SPD scenes without cloister (the scene 001 names as the slow one)",
+            fidelity: Fidelity::NotReproducible,
+            why: "001 sets cloister, whose rays meet complex geometry, against SPD scenes dominated by their ground plate (§4.3); cloister has no source, and the meshes at hand (bunny, wuson, 2CylinderEngine) are not architectural, so the contrast the claim rests on is missing: the SPD scenes' speed-ups are shown, not judged",
         },
         Claim {
             key: "table-4.1-layout",
@@ -255,16 +255,10 @@ fn ablation_rows(speedups: &[Speedup], measured: &[Timed]) -> Vec<Row> {
         .filter_map(|s| measured.iter().find(|t| format!("{}{}", t.scene, t.sf) == s.scene && t.engine == JUDGED_BASELINE).map(|t| (t.cpu_s, s.speedup)))
         .collect();
     let shown: Vec<String> = speedups.iter().filter(|s| s.over == JUDGED_BASELINE).map(|s| format!("{} {:.2}", s.scene, s.speedup)).collect();
-    let verdict = if pairs.len() < 2 {
-        Verdict::NotMeasured
-    } else {
-        let mut by_time = pairs.clone();
-        by_time.sort_by(|a, b| a.0.total_cmp(&b.0));
-        Verdict::of(by_time.windows(2).all(|w| w[1].1 >= w[0].1))
-    };
+    let verdict = if pairs.len() < 2 { Verdict::NotMeasured } else { Verdict::Shown };
     rows.push(
         Row::new("speedup-larger-where-slower", format!("bvh4 SIMD over {JUDGED_BASELINE}, per scene"), "larger where rendering takes longer (§4.3)", if shown.is_empty() { "-".into() } else { format!("{} (scenes ordered by scalar time: {})", shown.join(", "), pairs.iter().map(|p| format!("{:.0} ms", p.0 * 1e3)).collect::<Vec<_>>().join(", ")) }, Kind::Ordering, verdict)
-            .with_note(if pairs.len() < 2 { "needs two scenes or more: run without --quick" } else { "holds when the speed-up rises with the scalar render time across scenes" }),
+            .with_note(if pairs.len() < 2 { "needs two scenes or more: run without --quick" } else { "the SPD scenes only: shown" }),
     );
     rows
 }

@@ -134,7 +134,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "sgb-ratio",
             fidelity: Fidelity::Substituted,
-            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; a basic method traced on a fraction of the rows makes the row a model",
+            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; codecs differ: the basic store is gzip level 1 (the codec of the thesis's Table 3.3, where gzip cost the basic method 2.5-3.4x), the split store zstd, so the basic time carries a decoding cost the others do not (not measured apart here); a row whose basic time is extrapolated is a model",
         },
         Claim {
             key: "sg-ratio",

@@ -528,7 +528,7 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             Kind::Count,
             Verdict::of(agree),
         )
-        .with_note("the digest's arithmetic, not 003's: equal to 4 significant digits"),
+        .with_note("checks our code against 003's own equations (11)-(21) with Table 3's values: the saturation points are derived from them (003 prints none), equal to 4 significant digits"),
         Row::new(
             "sim-vs-theory",
             "4-ary 5-stage, P_M = 0.5",

@@ -20,6 +20,7 @@ pub const TABLE: Table = lb::table(
     "yamauchi-static-lb",
     "§4.2.2, Figs. 31–34",
     "003 (Yamauchi 1997) §4.2.2: (Mπ)² speed-up/efficiency vs PEs, 3 allocations, 1D/2D/3D",
+    "about 4 CPU minutes",
     "about 1.5 CPU hours (66 room8 radiosity machines); resumable",
     &[
         Claim {
