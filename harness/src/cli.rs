@@ -406,6 +406,14 @@ pub struct SceneOpts {
     pub force: bool,
 }
 
+// Here rather than in source.rs, so that nothing below the command line imports cli.rs.
+impl crate::source::Source {
+    /// The scene of a command's `<scene> [--sf N] [--tessellate [RES]] [--hash …]` arguments.
+    pub fn from_args(scene: &str, o: &SceneOpts) -> crate::error::Result<Self> {
+        Self::resolve(scene, o.sf, o.tessellate, o.hash)
+    }
+}
+
 fn parse_hash(s: &str) -> Result<MountHash, String> {
     s.parse()
 }

@@ -22,11 +22,13 @@ mod cli;
 mod commands;
 mod error;
 mod history;
+mod measure;
 mod nightly;
 mod output;
 mod reproduce;
 mod runs;
 mod select;
+mod shard;
 mod source;
 mod suite;
 mod workload;
@@ -101,8 +103,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),
         Command::Report(a) => commands::runs::report(&a),
         Command::Compare(a) => commands::runs::compare(&a),
-        Command::Nightly(a) => nightly::run(&a),
-        Command::History(c) => nightly::history_cmd(&c),
+        Command::Nightly(a) => commands::nightly::run(&a),
+        Command::History(c) => commands::history::run(&c),
         Command::Merge(a) => commands::merge::run(&a),
         Command::Plan(a) => commands::plan::run(&a),
         Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),

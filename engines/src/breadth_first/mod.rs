@@ -70,12 +70,15 @@
 //! (`hr_subspace_side`, `hr_subspaces`, `hr_build_boxes_read`, `hr_build_nodes_culled`,
 //! `hr_build_objects_culled`, `hr_build_bytes_written`, `hr_build_s`).
 
+pub mod bytes;
 pub mod cap;
 pub mod config;
 pub mod hierarchy;
 pub mod hires;
 pub mod intersect;
+pub mod slot;
 pub mod spill;
+pub mod tree;
 pub mod voxels;
 
 #[cfg(test)]
@@ -229,7 +232,7 @@ impl BreadthFirst {
             bh_stats.insert("bh_m".into(), constants.m as f64);
             bh_stats.insert("bh_l".into(), constants.l as f64);
             bh_stats.insert("bh_t".into(), constants.t);
-            Some(hierarchy::Tree::open(info, config.buffer as usize).map_err(open_err)?)
+            Some(tree::Tree::open(info, config.buffer as usize).map_err(open_err)?)
         } else {
             None
         };
@@ -334,7 +337,7 @@ impl BreadthFirst {
                 .as_ref()
                 .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
-        let per_ray = intersect::slot_bytes()
+        let per_ray = slot::slot_bytes()
             + initial as u64 * reg_bytes
             + if plan.is_some() {
                 hires::walk_bytes()

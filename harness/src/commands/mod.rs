@@ -2,7 +2,9 @@
 
 pub mod check;
 pub mod engines;
+pub mod history;
 pub mod merge;
+pub mod nightly;
 pub mod plan;
 pub mod render;
 pub mod runs;

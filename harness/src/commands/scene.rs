@@ -5,20 +5,6 @@ use crate::output::{print_json, write_atomic};
 use crate::source::Source;
 use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
 
-/// `none`, `gzip`, `gzip:LEVEL` (1–9), `zstd` or `zstd:LEVEL` (1–19).
-pub fn parse_codec(s: &str) -> std::result::Result<Codec, String> {
-    let level = |p: &str| s.strip_prefix(p).map(str::parse::<u32>);
-    match s {
-        "none" => Ok(Codec::None),
-        "gzip" => Ok(Codec::Gzip(6)),
-        "zstd" => Ok(Codec::Zstd(3)),
-        _ => match (level("gzip:"), level("zstd:")) {
-            (Some(Ok(l)), _) if (1..=9).contains(&l) => Ok(Codec::Gzip(l)),
-            (_, Some(Ok(l))) if (1..=19).contains(&l) => Ok(Codec::Zstd(l as i32)),
-            _ => Err("expected none, gzip, gzip:LEVEL (1-9), zstd or zstd:LEVEL (1-19)".into()),
-        },
-    }
-}
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
@@ -85,7 +71,7 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
                 bytes as f64 / 1e6,
                 secs,
                 bytes as f64 / 1e6 / secs.max(1e-9),
-                crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+                crate::measure::rss::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
             );
         }
     }
@@ -106,7 +92,8 @@ pub fn store(
     let layout: Layout = layout
         .parse()
         .map_err(|e| input(format!("--layout {layout}: {e}")))?;
-    let codec = parse_codec(compress).map_err(|e| input(format!("--compress {compress}: {e}")))?;
+    let codec = crate::workload::out_of_core::parse_codec(compress)
+        .map_err(|e| input(format!("--compress {compress}: {e}")))?;
     if matches!(codec, Codec::Gzip(_)) && layout == Layout::Split {
         return Err(input(format!(
             "--compress {compress}: a split store is read with seeks, so it is compressed as zstd blocks: use --compress zstd[:LEVEL] or --layout basic"
@@ -193,7 +180,7 @@ pub fn store(
         "bytes_written": io.bytes_written,
         "write_calls": io.write_calls,
         "time_s": secs,
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if as_json {
         print_json(&v);
@@ -205,7 +192,7 @@ pub fn store(
             header.primitives,
             io.bytes_written as f64 / 1e6,
             secs,
-            crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+            crate::measure::rss::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
         );
     }
     Ok(())
@@ -234,7 +221,7 @@ pub fn stats(src: &Source, as_json: bool) -> Result<()> {
         "materials": c.materials,
         "bounds": bounds,
         // Shows that counting streamed: a materialised scene would show here.
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if as_json {
         print_json(&v);

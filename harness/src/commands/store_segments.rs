@@ -5,10 +5,10 @@
 //! place: until the last segment it holds `segments.json` and no `header.json`, which readers
 //! refuse, and `--resume` goes on from its last checkpoint.
 
-use super::scene::parse_codec;
 use crate::error::{input, Result};
 use crate::output::print_json;
 use crate::source::Source;
+use crate::workload::out_of_core::parse_codec;
 use rtbench_engines::store::{Layout, Outcome, SegmentLog, SegmentedWriter, StoreHeader};
 use serde_json::json;
 use std::path::Path;
@@ -114,7 +114,7 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
             "time_s": secs,
             "skipped_objects": objects_before,
         },
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if a.as_json {
         print_json(&v);

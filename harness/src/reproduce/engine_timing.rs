@@ -96,9 +96,9 @@ pub fn time_engines(
         for _ in 0..repeats {
             let mut c = Counters::default();
             let t = Instant::now();
-            let c0 = workload::thread_cpu_seconds();
+            let c0 = crate::measure::clock::thread_cpu_seconds();
             e.intersect(rays, &mut hits, &mut c);
-            cpu.push(workload::thread_cpu_seconds() - c0);
+            cpu.push(crate::measure::clock::thread_cpu_seconds() - c0);
             wall.push(t.elapsed().as_secs_f64());
         }
         out.push(Timed {

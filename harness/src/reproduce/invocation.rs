@@ -8,7 +8,6 @@
 
 use super::grid_runs::{cpu_share, load_average};
 use super::Output;
-use crate::workload;
 use serde_json::{json, Value};
 use std::time::Instant;
 
@@ -22,7 +21,7 @@ impl Invocation {
     pub fn start() -> Invocation {
         Invocation {
             t: Instant::now(),
-            cpu0: workload::process_cpu_seconds(),
+            cpu0: crate::measure::clock::process_cpu_seconds(),
             load: load_average(),
         }
     }
@@ -30,7 +29,7 @@ impl Invocation {
     /// Adds the figures to `o`'s JSON and a sentence to its document.
     pub fn stamp(self, o: &mut Output, resumed: bool) {
         let wall_s = self.t.elapsed().as_secs_f64();
-        let cpu_s = workload::process_cpu_seconds() - self.cpu0;
+        let cpu_s = crate::measure::clock::process_cpu_seconds() - self.cpu0;
         let end = load_average();
         if let Value::Object(m) = &mut o.result {
             m.insert(

@@ -170,9 +170,9 @@ fn run(ctx: &Ctx) -> Result<Output> {
         let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
         let camera = Camera::new(&prepared.input.scene.view);
-        let c0 = workload::thread_cpu_seconds();
+        let c0 = crate::measure::clock::thread_cpu_seconds();
         let rays = camera.pixel_centre_rays(IMAGE.0, IMAGE.1);
-        let generate_s = workload::thread_cpu_seconds() - c0;
+        let generate_s = crate::measure::clock::thread_cpu_seconds() - c0;
         let on = (scene, sf);
         let simd = engine_timing::time_engines(SIMD_ENGINES, &prepared.input, &rays, repeats, 1, on, ctx.id)?;
         ablation.extend(engine_timing::time_engines(ABLATION, &prepared.input, &rays, repeats, 1, on, ctx.id)?);
@@ -212,7 +212,7 @@ fn share(scene: &str, input: &rtbench_engines::BuildInput, rays: &[rtbench_engin
     e.intersect(rays, &mut hits, &mut rtbench_engines::Counters::default());
     // Stand-in for 001's dot(direction, normal): the hit point's direction from the origin as the
     // normal (one normalise and one dot per hit, as a triangle normal lookup and dot would cost).
-    let c0 = workload::thread_cpu_seconds();
+    let c0 = crate::measure::clock::thread_cpu_seconds();
     let mut image = vec![0u8; rays.len()];
     for ((r, h), px) in rays.iter().zip(&hits).zip(image.iter_mut()) {
         if h.t.is_finite() {
@@ -220,7 +220,7 @@ fn share(scene: &str, input: &rtbench_engines::BuildInput, rays: &[rtbench_engin
             *px = (r.dir.dot(n).abs() * 255.0) as u8;
         }
     }
-    let shade_s = workload::thread_cpu_seconds() - c0;
+    let shade_s = crate::measure::clock::thread_cpu_seconds() - c0;
     std::hint::black_box(&image);
     let get = |l: &str| simd.iter().find(|t| t.engine == l).map_or(f64::NAN, |t| t.cpu_s);
     Ok(Share { scene: scene.into(), generate_s, shade_s, traverse_scalar_s: get("bvh4 scalar"), traverse_simd_s: get("bvh4 SIMD") })

@@ -13,6 +13,7 @@
 mod checkpoint;
 mod claims;
 mod invocation;
+mod models;
 mod params;
 mod published;
 mod table;

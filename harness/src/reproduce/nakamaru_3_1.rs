@@ -154,7 +154,7 @@ fn grid_run(nff: &Path, preset: &str, floor: &str) -> Result<Timed> {
         ("floor".to_string(), floor.to_string()),
         ("count".to_string(), "objects".to_string()),
     ];
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let t = Instant::now();
     let prepared = workload::prepare(&SceneSource::File(nff.to_path_buf()))?;
     let (e, _) = workload::build("grid", &prepared.input, set)?;

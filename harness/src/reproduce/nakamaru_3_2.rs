@@ -29,9 +29,9 @@ use super::published::{self, PublishedClaim, Source};
 use super::{Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
 use crate::error::{input, Result};
 use crate::source::Source as SceneSource;
-use crate::workload::paging::Mattson;
-use crate::workload::rayshade_memory::{Account, RayshadeImage};
-use crate::workload::replacement::{Clock, Lru};
+use super::models::paging::Mattson;
+use super::models::rayshade_memory::{Account, RayshadeImage};
+use super::models::replacement::{Clock, Lru};
 use crate::workload::{self, trace};
 use rtbench_engines::breadth_first::config::BreadthFirstConfig;
 use rtbench_engines::breadth_first::BreadthFirst;
@@ -305,7 +305,7 @@ fn replay(
 }
 
 fn grid_point(prepared: &workload::Prepared, floor: &str, frames: u64) -> Result<Point> {
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let t = Instant::now();
     let grid = Grid::build(&prepared.input, grid_config(floor)?)?;
     let grid_build_s = t.elapsed().as_secs_f64();
@@ -370,7 +370,7 @@ fn account_point(prepared: &workload::Prepared, floor: &str) -> Result<Point> {
 }
 
 fn breadth_first_point(prepared: &workload::Prepared, floor: &str, p: &mut Point) -> Result<()> {
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let t = Instant::now();
     let config = BreadthFirstConfig::from_settings(Settings::new(
         "breadth-first",
@@ -406,7 +406,7 @@ fn validate(scene: &str, sf: u32) -> Result<Validation> {
     let prepared = workload::prepare(&src)?;
     let grid = Grid::build(&prepared.input, grid_config(floor(scene))?)?;
     let mut rec = trace::Recording::default();
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let r = pool.install(|| trace::render(&prepared.input.scene, &grid, 512, Some(&mut rec)));
     let image = RayshadeImage::new(&prepared.input.scene, &prepared.input.geometry, &grid);
     let mut stream: Vec<u32> = Vec::new();

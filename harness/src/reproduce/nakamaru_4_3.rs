@@ -34,9 +34,9 @@
 use super::per_ray::{self, SizePoint};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
-use crate::commands::render::hex;
+use crate::output::hex;
 use crate::error::{input, Result};
-use crate::runs::shard::ShardSpec;
+use crate::shard::ShardSpec;
 use crate::workload::frustum::Frustum;
 use crate::workload::view_file::ViewFile;
 use crate::workload::{self, out_of_core, tiles};
@@ -494,7 +494,7 @@ fn trace(
     extra: &[(&str, &str)],
     image: Option<&Path>,
 ) -> Result<Run> {
-    workload::reset_peak_rss();
+    crate::measure::rss::reset_peak_rss();
     let load_average = super::grid_runs::load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),
@@ -511,7 +511,7 @@ fn trace(
     }
     pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
-    let cpu0 = workload::process_cpu_seconds();
+    let cpu0 = crate::measure::clock::process_cpu_seconds();
     let t = Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let earlier_s = engine
@@ -534,7 +534,7 @@ fn trace(
         None => s.size + 1,
     };
     // A run the pass cap stopped has no image and no scale until a split run's passes are known.
-    let capped = crate::commands::render::pass_capped(&r.counters);
+    let capped = crate::workload::out_of_core::pass_capped(&r.counters);
     if let (Some(path), false, None) = (image, capped, tile) {
         if let Some(d) = path.parent() {
             std::fs::create_dir_all(d).map_err(|e| input(format!("{}: {e}", d.display())))?;
@@ -551,7 +551,7 @@ fn trace(
         } else {
             hex(&Sha256::digest(r.pixels()))
         },
-        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        peak_rss_bytes: crate::measure::rss::peak_rss_bytes().unwrap_or(0),
         rows_traced,
         scale: if capped {
             0.0
@@ -561,7 +561,7 @@ fn trace(
         load_average,
         capped,
         passes_total: 0,
-        cpu_s: workload::process_cpu_seconds() - cpu0,
+        cpu_s: crate::measure::clock::process_cpu_seconds() - cpu0,
         earlier_s,
         intersect_s: r.intersect_s,
         shade_s: r.shade_s,
@@ -891,7 +891,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
                 "nakamaru-4.3: split-compress={c}: a split store is compressed as zstd blocks (zstd, zstd:LEVEL) or not at all (none)"
             )))
         }
-        c => crate::commands::scene::parse_codec(c)
+        c => crate::workload::out_of_core::parse_codec(c)
             .map_err(|e| input(format!("nakamaru-4.3: split-compress={c}: {e}")))?,
     };
     let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;

@@ -132,7 +132,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             "no engine to run (see `rtbench engines`)",
         ));
     }
-    let pool = workload::pool(ctx.params.threads()?)?;
+    let pool = crate::measure::threads::pool(ctx.params.threads()?)?;
     let mut measured = Vec::new();
     let mut images = Vec::new();
     for row in &p.rows {

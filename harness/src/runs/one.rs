@@ -81,7 +81,7 @@ fn paired_thread_times(
     size: u32,
     pairs: u32,
 ) -> Result<Vec<(f64, f64, f64, f64)>> {
-    let one = workload::pool(Some(1))?;
+    let one = crate::measure::threads::pool(Some(1))?;
     let mut image: Option<Vec<u8>> = None;
     let mut time = |p: &rayon::ThreadPool| -> Result<(f64, f64)> {
         let r = p.install(|| trace::render(scene, engine, size, None));
@@ -135,7 +135,7 @@ pub(crate) fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String
     m
 }
 
-/// The engine with the regression `RTBENCH_PLANT` plants, if any (crate::nightly::plant).
+/// The engine with the regression `RTBENCH_PLANT` plants, if any (super::plant).
 fn plant(
     engine: Box<dyn rtbench_engines::Engine>,
     spec: &OneSpec,
@@ -144,8 +144,8 @@ fn plant(
         Source::Program(p, _) => Some(p.name()),
         Source::File(_) | Source::Room(_) => None,
     };
-    match crate::nightly::plant::from_env(&spec.engine, program) {
-        Some(p) => Box::new(crate::nightly::plant::Planted::new(engine, p)),
+    match super::plant::from_env(&spec.engine, program) {
+        Some(p) => Box::new(super::plant::Planted::new(engine, p)),
         None => engine,
     }
 }
@@ -165,7 +165,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             spec.paired_threads
         )));
     }
-    let pool = workload::pool(spec.threads)?;
+    let pool = crate::measure::threads::pool(spec.threads)?;
     let prepared = workload::prepare(&spec.source)?;
     let scene = &prepared.input.scene;
     let (mut build, mut tr, mut is, mut sh, mut cpu) =
@@ -195,7 +195,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     }
     let (engine, render) = last.expect("at least one repeat");
     // Before the cross-check builds Embree too.
-    let peak_rss_bytes = workload::peak_rss_bytes().unwrap_or(0);
+    let peak_rss_bytes = crate::measure::rss::peak_rss_bytes().unwrap_or(0);
     let wants_yardstick = (spec.check || spec.paired > 0) && spec.engine != "embree";
     let yardstick = if wants_yardstick && embree_available() {
         Some(workload::build("embree", &prepared.input, vec![])?.0)
@@ -289,9 +289,9 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         check,
         paired_ratio,
         thread_scaling,
-        image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(pixels))),
+        image_sha256: Some(crate::output::hex(&sha2::Sha256::digest(pixels))),
         wall_s: start.elapsed().as_secs_f64(),
-        finished_at: super::env::now_utc(),
+        finished_at: crate::measure::environment::now_utc(),
         machine: None,
     })
 }

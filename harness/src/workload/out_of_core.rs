@@ -246,7 +246,7 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
 pub fn render_tile(
     engine: &BreadthFirst,
     size: u32,
-    tile: Option<crate::runs::shard::ShardSpec>,
+    tile: Option<crate::shard::ShardSpec>,
 ) -> io::Result<OutOfCoreRender> {
     render_view(engine, size, tile, None)
 }
@@ -256,11 +256,11 @@ pub fn render_tile(
 pub fn render_view(
     engine: &BreadthFirst,
     size: u32,
-    tile: Option<crate::runs::shard::ShardSpec>,
+    tile: Option<crate::shard::ShardSpec>,
     view: Option<&rtbench_scenes::View>,
 ) -> io::Result<OutOfCoreRender> {
     let start = Instant::now();
-    let cpu_start = super::thread_cpu_seconds();
+    let cpu_start = crate::measure::clock::thread_cpu_seconds();
     let h = engine.header();
     let config = engine.config();
     let buffer = config.buffer as usize;
@@ -527,11 +527,35 @@ pub fn render_view(
             shade_s,
             trace_s: start.elapsed().as_secs_f64(),
             // One thread does all the work here.
-            trace_cpu_s: super::thread_cpu_seconds() - cpu_start,
+            trace_cpu_s: crate::measure::clock::thread_cpu_seconds() - cpu_start,
         },
         io: io_total,
         shade_group: group_len,
         shade_sweeps,
         shade_cap: SHADE_BYTES / shade_bytes_per_ray(lights.len()),
     })
+}
+
+/// Whether the breadth-first engine's pass cap stopped the run (`max_passes`).
+pub fn pass_capped(c: &rtbench_engines::Counters) -> bool {
+    c.extra
+        .get(rtbench_engines::breadth_first::cap::CAP_REACHED)
+        .is_some_and(|&n| n > 0)
+}
+
+/// `none`, `gzip`, `gzip:LEVEL` (1–9), `zstd` or `zstd:LEVEL` (1–19).
+pub fn parse_codec(s: &str) -> std::result::Result<rtbench_engines::store::Codec, String> {
+    let level = |p: &str| s.strip_prefix(p).map(str::parse::<u32>);
+    match s {
+        "none" => Ok(rtbench_engines::store::Codec::None),
+        "gzip" => Ok(rtbench_engines::store::Codec::Gzip(6)),
+        "zstd" => Ok(rtbench_engines::store::Codec::Zstd(3)),
+        _ => match (level("gzip:"), level("zstd:")) {
+            (Some(Ok(l)), _) if (1..=9).contains(&l) => Ok(rtbench_engines::store::Codec::Gzip(l)),
+            (_, Some(Ok(l))) if (1..=19).contains(&l) => {
+                Ok(rtbench_engines::store::Codec::Zstd(l as i32))
+            }
+            _ => Err("expected none, gzip, gzip:LEVEL (1-9), zstd or zstd:LEVEL (1-19)".into()),
+        },
+    }
 }

@@ -470,14 +470,14 @@ pub fn render_chunked(
     let seams = Mutex::new(seams);
     let recording = record.is_some();
     let bands = std::env::var_os(BANDS_VAR).is_some();
-    let sched = std::env::var_os(super::sched::SCHED_VAR);
+    let sched = std::env::var_os(crate::measure::sched::SCHED_VAR);
     let sched_on = sched.is_some();
     // With RTBENCH_SCHED: each pool thread's scheduler counts before the region, and every
     // band's (thread, start, end) seconds from the region's start.
     let sched_start = Instant::now();
-    let cpus_before = sched_on.then(super::sched::read_cpus);
-    let process_before = sched_on.then(super::sched::process_threads);
-    let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
+    let cpus_before = sched_on.then(crate::measure::sched::read_cpus);
+    let process_before = sched_on.then(crate::measure::sched::process_threads);
+    let sched_before = sched_on.then(|| rayon::broadcast(|_| crate::measure::sched::read_self()));
     // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
     // ended on, and its start and end.
     let sched_bands = sched.is_some_and(|v| v == "bands");
@@ -511,8 +511,8 @@ pub fn render_chunked(
                 None => own.insert(Wavefront::default()),
             };
             let rows = band_rows.min(w - j0);
-            let cpu = bands.then(super::thread_cpu_seconds);
-            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), super::sched::cpu()));
+            let cpu = bands.then(crate::measure::clock::thread_cpu_seconds);
+            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), crate::measure::sched::cpu()));
             let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
             if let Some((s, cpu0)) = band_start {
                 let e = t.elapsed().as_secs_f64();
@@ -520,7 +520,7 @@ pub fn render_chunked(
                 if sched_bands {
                     eprintln!(
                         "sched band {k} thread {i} cpu {cpu0} {} start_s {s:.6} end_s {e:.6}",
-                        super::sched::cpu()
+                        crate::measure::sched::cpu()
                     );
                 }
                 band_times
@@ -538,7 +538,7 @@ pub fn render_chunked(
                     c.box_tests,
                     c.primitive_tests,
                     c.cells_visited,
-                    super::thread_cpu_seconds() - cpu
+                    crate::measure::clock::thread_cpu_seconds() - cpu
                 );
             }
             for (j, row) in out.chunks_exact_mut(n * 3).take(rows - 1).enumerate() {
@@ -615,25 +615,29 @@ pub fn render_chunked(
     }
 }
 
-/// The `sched` lines of [`super::sched::SCHED_VAR`]: each pool thread's scheduler counts over
+/// The `sched` lines of [`crate::measure::sched::SCHED_VAR`]: each pool thread's scheduler counts over
 /// the parallel region (`before`: read by each thread at the region's start, in thread order,
 /// after `start`; the wall seconds are from `start` to when every thread has read its counts
 /// again) and its bands' wall seconds (`band_times`: thread, start, end).
 fn print_sched(
-    before: &[Option<super::sched::ThreadSched>],
+    before: &[Option<crate::measure::sched::ThreadSched>],
     cpus: &[(usize, [u64; 8])],
     process: &[(i64, u64)],
     start: Instant,
     band_times: &[(usize, f64, f64)],
 ) {
-    let after = rayon::broadcast(|_| super::sched::read_self());
+    let after = rayon::broadcast(|_| crate::measure::sched::read_self());
     let region_s = start.elapsed().as_secs_f64();
     let pool: Vec<i64> = after.iter().flatten().map(|t| t.tid).collect();
     eprintln!(
         "{}",
-        super::sched::process_line(process, &super::sched::process_threads(), &pool)
+        crate::measure::sched::process_line(
+            process,
+            &crate::measure::sched::process_threads(),
+            &pool
+        )
     );
-    for l in super::sched::cpu_lines(cpus, &super::sched::read_cpus()) {
+    for l in crate::measure::sched::cpu_lines(cpus, &crate::measure::sched::read_cpus()) {
         eprintln!("{l}");
     }
     for (i, (b, a)) in before.iter().zip(&after).enumerate() {
@@ -649,12 +653,12 @@ fn print_sched(
         let last = mine.iter().map(|x| x.1).fold(0.0, f64::max);
         eprintln!(
             "{}",
-            super::sched::line(
+            crate::measure::sched::line(
                 i,
                 region_s,
                 &a.since(b),
                 mine.len(),
-                super::sched::covered_seconds(&mine),
+                crate::measure::sched::covered_seconds(&mine),
                 last
             )
         );
@@ -667,11 +671,11 @@ fn print_sched(
 /// between runs. Called from outside any pool, the calling thread is counted with the global
 /// pool's.
 fn pool_cpu_seconds() -> f64 {
-    let pool: f64 = rayon::broadcast(|_| super::thread_cpu_seconds())
+    let pool: f64 = rayon::broadcast(|_| crate::measure::clock::thread_cpu_seconds())
         .into_iter()
         .sum();
     if rayon::current_thread_index().is_none() {
-        pool + super::thread_cpu_seconds()
+        pool + crate::measure::clock::thread_cpu_seconds()
     } else {
         pool
     }

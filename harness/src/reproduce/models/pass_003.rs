@@ -15,9 +15,9 @@
 //! fixed chunks, so the record is the same on any number of threads), and recorded as a
 //! [`Trace`] for the timing simulation, parents before children.
 
-use super::camera::Camera;
-use super::surface::Surfaces;
-use super::trace::offset_origin;
+use crate::workload::camera::Camera;
+use crate::workload::surface::Surfaces;
+use crate::workload::trace::offset_origin;
 use glam::Vec3;
 use rayon::prelude::*;
 use rtbench_engines::object_space::trace::{Segment, Trace, TracedRay, NO_PIXEL};
@@ -80,7 +80,7 @@ struct Path {
 pub fn trace_pass(os: &ObjectSpace, scene: &Scene, size: u32, diffuse: Option<&[Vec3]>) -> Pass {
     let camera = Camera::new(&scene.view);
     let surfaces = Surfaces::new(scene);
-    let lights = super::trace::scaled_lights(&scene.lights);
+    let lights = crate::workload::trace::scaled_lights(&scene.lights);
     let mut rays = camera.pixel_centre_rays(size, size);
     let mut paths: Vec<Path> = (0..rays.len() as u32)
         .map(|pixel| Path {

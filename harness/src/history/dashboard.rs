@@ -4,8 +4,8 @@
 //! (`rtbench_reports::plot`) as inline SVG; the trend charts are also written as PNG files.
 
 use super::detect;
+use super::{History, Metric};
 use crate::error::{input, Result};
-use crate::history::{History, Metric};
 use rtbench_reports::plot::{self, Chart, LegendAt, Panel, Point, Series, XyPanel};
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -10,7 +10,8 @@
 //!
 //! Each shard writes `shard.json` ([`Manifest`]) into its results directory before its first run:
 //! the plan's SHA-256, every job key of the plan and of the shard, the commit and the machine, so
-//! `merge` can refuse shards of different commits or plans, a missing shard or a shard given twice.
+//! `merge` can refuse shards of different commits or plans, a missing shard or a shard given twice
+//! (`runs/merge.rs`).
 
 use crate::error::{input, Result};
 use crate::output::write_atomic;
@@ -125,7 +126,7 @@ impl Manifest {
         plan_jobs: Vec<String>,
         jobs: Vec<String>,
     ) -> Manifest {
-        let env = super::env::capture();
+        let env = crate::measure::environment::capture();
         Manifest {
             kind: kind.to_string(),
             shard: spec.k,
@@ -136,7 +137,7 @@ impl Manifest {
             git_commit: env.git_commit,
             git_dirty: env.git_dirty,
             hostname: env.hostname,
-            started_at: super::env::now_utc(),
+            started_at: crate::measure::environment::now_utc(),
             finished_at: None,
             extra: Default::default(),
         }
@@ -192,8 +193,14 @@ impl Manifest {
     }
 }
 
+/// A shard's directory and manifest.
+pub struct Shard {
+    pub dir: std::path::PathBuf,
+    pub m: Manifest,
+}
+
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    crate::commands::render::hex(&Sha256::digest(bytes))
+    crate::output::hex(&Sha256::digest(bytes))
 }
 
 #[cfg(test)]

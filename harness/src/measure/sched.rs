@@ -8,13 +8,13 @@
 //! CPUs. Over an interval of wall time W, W − ran − waited is what the thread spent asleep or
 //! blocked (a futex, a page fault waiting for a lock or I/O, a `sched_yield` is not in it).
 //!
-//! With [`SCHED_VAR`] set, [`super::trace::render_chunked`] prints one line per pool thread of
+//! With [`SCHED_VAR`] set, [`crate::workload::trace::render_chunked`] prints one line per pool thread of
 //! each render on stderr: these counts over the render's parallel region, and the wall seconds
 //! the thread spent inside bands; one line per CPU with its seconds by state (user, system,
 //! idle, iowait, steal) over the same region; with `RTBENCH_SCHED=bands` also one line per band
 //! (thread, the CPU it started and ended on, start and end seconds).
 
-/// Environment variable that makes [`super::trace::render_chunked`] print the pool threads'
+/// Environment variable that makes [`crate::workload::trace::render_chunked`] print the pool threads'
 /// scheduler accounting (one `sched` line per thread) on stderr.
 pub const SCHED_VAR: &str = "RTBENCH_SCHED";
 
@@ -374,11 +374,11 @@ mod tests {
     #[test]
     fn a_pinned_thread_runs_on_its_cpu() {
         std::thread::spawn(|| {
-            let cpus = crate::workload::allowed_cpus();
+            let cpus = crate::measure::threads::allowed_cpus();
             assert!(!cpus.is_empty());
             let last = *cpus.last().unwrap();
-            crate::workload::pin_to_cpu(last);
-            assert_eq!(crate::workload::allowed_cpus(), vec![last]);
+            crate::measure::threads::pin_to_cpu(last);
+            assert_eq!(crate::measure::threads::allowed_cpus(), vec![last]);
             assert_eq!(cpu(), last as i32);
         })
         .join()

@@ -134,8 +134,8 @@ impl Clock {
 
 #[cfg(test)]
 mod tests {
+    use super::super::paging::Mattson;
     use super::*;
-    use crate::workload::paging::Mattson;
 
     #[test]
     fn direct_lru_counts_what_mattson_counts_and_clock_differs_by_little() {
