@@ -207,6 +207,19 @@ pub fn scenes(ctx: &Ctx, default: &[&str]) -> Result<Vec<String>> {
 /// an extra orientation, reported under its own label beside 003's.
 pub const Y_UP: &str = "-yup";
 
+/// Rows on the room in another orientation than 003's (`roomN-yup`): shown beside 003's, never
+/// judged, and saying which orientation they are.
+pub fn mark_extra_orientation(rows: &mut [super::Row]) {
+    for r in rows.iter_mut().filter(|r| r.subject.contains(Y_UP)) {
+        if matches!(r.verdict, super::Verdict::Holds | super::Verdict::Fails) {
+            r.verdict = super::Verdict::Shown;
+        }
+        r.note =
+            "an extra orientation, the room y up as generated (not 003's, z up): shown, not judged"
+                .into();
+    }
+}
+
 /// 003's orientation of its room: z up. §3.3.2 designs the skewed allocation for objects coherent
 /// along the vertical ("walls stand upright, as do pillars and trees") and shifts ownership along the
 /// axis that has no PE dimension, which on the 2D machine of eq. (10), PE = ((X + Z) mod N_x,

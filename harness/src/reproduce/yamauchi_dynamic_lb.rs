@@ -21,7 +21,7 @@ pub const TABLE: Table = lb::table(
     "yamauchi-dynamic-lb",
     "§4.2.2, Figs. 30, 35",
     "003 (Yamauchi 1997) §4.2.2: (Mπ)² efficiency vs RP blocks per PE (2D skewed)",
-    "about 2 CPU minutes",
+    "about 1.5 CPU minutes, 6 minutes on a shared 2-core machine",
     "about 45 CPU minutes (25 room8 radiosity machines); resumable",
     &[
         Claim {
@@ -173,7 +173,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .iter()
         .map(|m| findings(m, &pe_counts, &blocks))
         .collect();
-    let rows = findings.iter().flat_map(|f| rows(&p, f)).collect();
+    let mut rows: Vec<Row> = findings.iter().flat_map(|f| rows(&p, f)).collect();
+    osp::mark_extra_orientation(&mut rows);
     let doc = document(ctx, &p, &measured, &findings, size, &pe_counts, &blocks);
     let charts = measured
         .iter()
@@ -352,7 +353,7 @@ fn document(
         "yamauchi-dynamic-lb: (Mπ)² dynamic load balancing on the room (both passes) and SPD scenes",
     );
     doc.paragraph(osp::source_line(&p.source));
-    doc.paragraph(format!("Measured: `rtbench reproduce {}{}` — on the room (label `-radiosity`: the radiosity pass; else the ray-tracing pass) and on the SPD scenes (ray-tracing pass) at {size}×{size}, 32³ subspaces, 2D torus, skewed allocation, least-loaded dispatch to R RP blocks per PE, direct frame buffer. Efficiency = T(1 PE, 1 RP block) / (T × PEs × R) (003 eq. 25).", ctx.id, if ctx.quick { " --quick" } else { "" }));
+    doc.paragraph(format!("Measured: `rtbench reproduce {}{}` — on the room in 003's orientation, z up (§3.3.2: the skew spreads the vertical coherence of walls and pillars along the axis without PEs, Z in eq. (10); 003 does not name its axes, and with z up and the eye horizontal only the first PE axis of a 2D torus lies in the screen), rows on `roomN-yup` the room as generated, y up, an extra orientation shown and not judged; (label `-radiosity`: the radiosity pass; else the ray-tracing pass) and on the SPD scenes (ray-tracing pass) at {size}×{size}, 32³ subspaces, 2D torus, skewed allocation, least-loaded dispatch to R RP blocks per PE, direct frame buffer. Efficiency = T(1 PE, 1 RP block) / (T × PEs × R) (003 eq. 25).", ctx.id, if ctx.quick { " --quick" } else { "" }));
     for (m, f) in measured.iter().zip(findings) {
         doc.heading(format!(
             "{} (T(1 PE, 1 RP block) = {} clocks; {})",
