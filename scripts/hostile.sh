@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The hostile suite of issue 14, re-runnable: the issue's reproducers, absurd settings, stdout to
+# The hostile suite, re-runnable: the reproducers of hostile input, absurd settings, stdout to
 # /dev/full and to a closed pipe for every command, mutated NFF files through several engines,
 # and random bit flips in a scene store (scripts/store_bitflips.sh). Every invocation runs under
 # a time limit and an address-space limit. It counts invocations, refusals (exit 2), panics

@@ -1,5 +1,5 @@
 //! A seeded mutation fuzzer over rtbench's three readers of outside data: the NFF reader, the
-//! scene-store reader and the results reader (issue 14). Each input is a seed from the corpus in
+//! scene-store reader and the results reader. Each input is a seed from the corpus in
 //! `tests/fuzz/corpus/` (store seeds are written from the NFF seeds) with one to four mutations:
 //! bit flips, interesting bytes, tokens from a dictionary (`nan`, `1e308`, huge counts …),
 //! deleted, repeated or truncated spans. An input passes when the reader returns (a value or an

@@ -46,7 +46,7 @@
 //! | `block` | bytes | 1/8 of `memory` | one X-slab block of the on-disk grid (`two-level`) |
 //! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
 //! | `hrgrid` | `build`, `reuse`, `resume` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there; `resume`: make it keeping `hrgrid.progress.json` after each subspace, and take up an interrupted or finished build of the same grid (its subspaces and seconds from the record: `hr_build_resumed_subspaces`, `hr_build_prior_s`, both counted in `hr_build_s` and `preprocess_s`) |
-//! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than a session, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
+//! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than one sitting, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests

@@ -131,7 +131,7 @@ impl Slot {
     /// The ray against object `id`'s primitives, keeping the nearest hit (any hit: the first).
     /// Of two hits at the same t the object with the smaller id is kept, whichever is met
     /// first: which voxel and which pass a ray meets an object in depends on the grid, so
-    /// keeping the first would make the image depend on the grid (rings118, session 14: one
+    /// keeping the first would make the image depend on the grid (rings118: one
     /// pixel between the capped and the high-resolution grid).
     #[inline(never)]
     pub(super) fn intersect(

@@ -33,13 +33,13 @@
 //! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
 //! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
 //! offsets). Or zstd-compressed: `objects.bin.zst`, `"compression": "zstd"` (zstd is offered
-//! beside the thesis's gzip: it compresses several times faster, docs/benchmarks.md issue 15).
+//! beside the thesis's gzip: it compresses several times faster).
 //! The compressed file's header carries no checksum of `header.json` (it is written before the
 //! header is known); the codec's own checksum (gzip's CRC-32; zstd's frame checksum) and the
 //! records' checksums guard its bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
-//! A store too large to write in one session is written in segments ([`segments`]): while it
+//! A store too large to write in one sitting is written in segments ([`segments`]): while it
 //! is being written its directory holds `segments.json` and no `header.json`.
 //!
 //! A split store may carry a bounding-box hierarchy (`bbox-K.bin`, `hierarchy.json`; seed 000

@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod engines;
+pub mod env;
 pub mod history;
 pub mod merge;
 pub mod nightly;

@@ -26,7 +26,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     workload::check_scene_fits(&src, a.scene.opts.force)?;
-    let pool = crate::measure::threads::pool(a.threads)?;
+    let pool = crate::measure::threads::pool(a.threads.count())?;
     memory::phase("start");
     let prepared = workload::prepare(&src)?;
     memory::phase("scene");

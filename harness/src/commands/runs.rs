@@ -1,7 +1,8 @@
-//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (../shared/CLI.md, "Runs and reports").
+//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (docs/concepts.md).
 
 use crate::cli::{CompareArgs, PlanArgs, ReportArgs, RunArgs, RunOneArgs, SweepArgs};
 use crate::error::{input, Failure, Result};
+use crate::measure::threads::Threads;
 use crate::output::print_json;
 use crate::runs::one::{run_one, OneSpec};
 use crate::runs::plan::{self, plan_text, run_group, Common, Job, ResultsDir};
@@ -116,19 +117,19 @@ fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
 fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
     p.threads
         .split(',')
-        .map(|t| match t.trim() {
-            "all" => Ok(None),
-            n => match n.parse::<usize>() {
-                Ok(0) | Err(_) => Err(input(format!(
-                    "--threads '{}': expected counts ≥ 1 or 'all'",
-                    p.threads
-                ))),
-                Ok(n) if n > crate::measure::threads::thread_limit() => Err(input(format!(
+        .map(|t| match t.parse::<Threads>() {
+            Err(_) => Err(input(format!(
+                "--threads '{}': expected {}, comma-separated",
+                p.threads,
+                Threads::FORMS
+            ))),
+            Ok(Threads::Count(n)) if n > crate::measure::threads::thread_limit() => {
+                Err(input(format!(
                     "--threads {n}: more than the {} this machine runs at once",
                     crate::measure::threads::thread_limit()
-                ))),
-                Ok(n) => Ok(Some(n)),
-            },
+                )))
+            }
+            Ok(t) => Ok(t.count()),
         })
         .collect()
 }
@@ -341,7 +342,7 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
             a.scene.opts.tessellate,
             a.scene.opts.hash,
         )?,
-        threads: a.threads,
+        threads: a.threads.count(),
         repeats: a.repeat,
         size: a.size,
         check: !a.no_check,

@@ -1,4 +1,4 @@
-//! `rtbench scene list | gen | stats` (../shared/CLI.md, "Scenes").
+//! `rtbench scene list | gen | store | stats`.
 
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
@@ -12,8 +12,20 @@ use serde_json::json;
 use std::path::Path;
 
 pub fn list(as_json: bool) -> Result<()> {
+    // The room is seed 003's stand-in scene (`room` = room8, `roomN` at N patches per metre).
+    let room_ppm = rtbench_scenes::room::DEFAULT_PPM;
+    let room_objects = {
+        let mut c = CountingSink::default();
+        rtbench_scenes::room::generate(room_ppm, &mut c)
+            .map(|()| c.counts.sphere + c.counts.cone + c.counts.polygon + c.counts.patch)
+            .ok()
+    };
+    let room_about = "seed 003's room stand-in (Yamauchi 1997, Table 6): walls, furniture, two \
+                      light panels, mirror quadrics; roomN for N patches per metre";
+    let files = "OBJ, PLY, glTF/GLB and NFF files are scenes too: give their path wherever a \
+                 program name goes (--scene, --scenes, scene stats|gen|store)";
     if as_json {
-        let v: Vec<_> = Program::ALL
+        let mut v: Vec<_> = Program::ALL
             .iter()
             .map(|p| {
                 json!({"name": p.name(), "standard_sf": p.standard_sf(),
@@ -21,6 +33,11 @@ pub fn list(as_json: bool) -> Result<()> {
                        "description": p.description()})
             })
             .collect();
+        v.push(
+            json!({"name": "room", "standard_sf": null, "patches_per_metre": room_ppm,
+                      "objects_at_standard_sf": room_objects, "description": room_about}),
+        );
+        // Still a list of scenes (the contract); the note on files is for people.
         print_json(&json!(v));
     } else {
         println!(
@@ -40,6 +57,9 @@ pub fn list(as_json: bool) -> Result<()> {
                 p.description()
             );
         }
+        let n = room_objects.map_or_else(|| "?".into(), |n| n.to_string());
+        println!("{:<10} {:>4} {:>10}  {room_about}", "room", "-", n);
+        println!("\n{files}.");
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `rtbench scene store … --segment N [--resume] [--max-seconds S]`: a store written in segments
 //! of N objects, across processes (`rtbench_engines::store::segments`), for the 10^8–10^9-object
-//! scenes of seed 000 Table 4.3 that take longer to write than a session lasts. Unlike a store
+//! scenes of seed 000 Table 4.3 that take longer to write than one sitting. Unlike a store
 //! written in one go (a temporary directory renamed when complete), the directory is written in
 //! place: until the last segment it holds `segments.json` and no `header.json`, which readers
 //! refuse, and `--resume` goes on from its last checkpoint.

@@ -1,10 +1,9 @@
-//! The process's memory between the phases of a render (issue 20, acceptance 5: peak RSS ≤ 3 ×
+//! The process's memory between the phases of a render (peak RSS ≤ 3 ×
 //! structure bytes + 16 MiB): what is resident after each phase, on request, and handing the
 //! build's freed heap back to the system before the trace.
 
-/// Environment variable that makes [`phase`] print the process's memory after each phase of
-/// `rtbench render` on stderr (`RTBENCH_MEMORY_PHASES=1`); unset, [`phase`] costs one lookup.
-pub const PHASES_VAR: &str = "RTBENCH_MEMORY_PHASES";
+// `RTBENCH_MEMORY_PHASES=1` (read once, `measure::vars`) makes [`phase`] print the process's
+// memory after each phase of `rtbench render` on stderr.
 
 /// One line of kibibytes from `/proc/self/status` (`VmRSS`, `VmHWM`, `RssAnon`, `RssFile`).
 fn status_kib(status: &str, key: &str) -> u64 {
@@ -15,12 +14,12 @@ fn status_kib(status: &str, key: &str) -> u64 {
         .unwrap_or(0)
 }
 
-/// With [`PHASES_VAR`] set, prints on stderr the resident set after phase `name` (`VmRSS`, split
+/// With `RTBENCH_MEMORY_PHASES` set, prints on stderr the resident set after phase `name` (`VmRSS`, split
 /// into anonymous memory and mapped files), its peak so far (`VmHWM`), and what the allocator
 /// holds: bytes in use by the program and bytes it keeps from the system (glibc's `mallinfo2`:
 /// main heap + other threads' arenas + blocks mapped on their own).
 pub fn phase(name: &str) {
-    if std::env::var_os(PHASES_VAR).is_none() {
+    if !super::vars::values().memory_phases {
         return;
     }
     let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -54,7 +53,7 @@ fn heap_kib() -> (u64, u64) {
 /// Called between the build and the trace: the build's scratch (primitive boxes, the binary
 /// build tree, bins) is freed into the main thread's heap, but the trace runs on the pool's
 /// threads, which allocate from their own arenas, so glibc kept those pages resident through
-/// the whole trace (session 10: gears4 bvh8 at 512², 24.31 MiB peak against 22.49 MiB with
+/// the whole trace (gears4 bvh8 at 512², 24.31 MiB peak against 22.49 MiB with
 /// `MALLOC_TRIM_THRESHOLD_=0`). Changes no answer; elsewhere a no-op.
 pub fn release_free_heap() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]

@@ -1,5 +1,4 @@
-//! The scheduler's accounting of one thread, read from `/proc/thread-self` (issue 20,
-//! acceptance 3: where the pool's threads are when they are not on a CPU).
+//! The scheduler's accounting of one thread, read from `/proc/thread-self` (where the pool's threads are when they are not on a CPU).
 //!
 //! `schedstat` gives the nanoseconds the thread ran, the nanoseconds it waited on a run queue
 //! while runnable (preempted, or woken and not yet run) and its timeslices; `status` its
@@ -8,15 +7,14 @@
 //! CPUs. Over an interval of wall time W, W − ran − waited is what the thread spent asleep or
 //! blocked (a futex, a page fault waiting for a lock or I/O, a `sched_yield` is not in it).
 //!
-//! With [`SCHED_VAR`] set, [`crate::workload::trace::render_chunked`] prints one line per pool thread of
+//! With `RTBENCH_SCHED` set, [`crate::workload::trace::render_chunked`] prints one line per pool thread of
 //! each render on stderr: these counts over the render's parallel region, and the wall seconds
 //! the thread spent inside bands; one line per CPU with its seconds by state (user, system,
 //! idle, iowait, steal) over the same region; with `RTBENCH_SCHED=bands` also one line per band
 //! (thread, the CPU it started and ended on, start and end seconds).
 
-/// Environment variable that makes [`crate::workload::trace::render_chunked`] print the pool threads'
-/// scheduler accounting (one `sched` line per thread) on stderr.
-pub const SCHED_VAR: &str = "RTBENCH_SCHED";
+// `RTBENCH_SCHED` (read once, in `measure::vars`) makes [`crate::workload::trace::render_chunked`] print the pool threads'
+// scheduler accounting (one `sched` line per thread) on stderr.
 
 /// One thread's scheduler counts at one moment (all cumulative since the thread started).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -2,6 +2,67 @@
 //! on, and the rayon pool every parallel phase runs in.
 
 use crate::error::{input, Result};
+use std::fmt;
+use std::str::FromStr;
+
+/// How many threads a trace runs on: a count, or `all` the machine runs at once. One spelling
+/// wherever a thread count is given (`--threads`, a suite's `threads`, `--set threads=`), one
+/// default ([`Threads::DEFAULT`]), parsed by [`FromStr`] alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Threads {
+    Count(usize),
+    All,
+}
+
+impl Threads {
+    /// One thread: the steadiest figure on a shared machine, and the one every ratio to Embree
+    /// is compared at unless asked otherwise.
+    pub const DEFAULT: Threads = Threads::Count(1);
+    /// The accepted forms, as error messages name them.
+    pub const FORMS: &'static str = "a count of at least 1, or all";
+
+    /// The count a pool is made with (`None`: all cores).
+    pub fn count(self) -> Option<usize> {
+        match self {
+            Threads::Count(n) => Some(n),
+            Threads::All => None,
+        }
+    }
+}
+
+impl Default for Threads {
+    fn default() -> Threads {
+        Threads::DEFAULT
+    }
+}
+
+impl FromStr for Threads {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Threads, String> {
+        match s.trim() {
+            "all" => Ok(Threads::All),
+            t => match t.parse::<usize>() {
+                Ok(n) if n >= 1 => Ok(Threads::Count(n)),
+                _ => Err(format!("threads '{s}': expected {}", Threads::FORMS)),
+            },
+        }
+    }
+}
+
+impl fmt::Display for Threads {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Threads::Count(n) => write!(f, "{n}"),
+            Threads::All => f.write_str("all"),
+        }
+    }
+}
+
+/// `--threads` for clap: [`Threads`]'s one spelling.
+pub fn parse_threads(s: &str) -> std::result::Result<Threads, String> {
+    s.parse::<Threads>()
+        .map_err(|_| format!("expected {}", Threads::FORMS))
+}
 
 /// Threads this machine runs at once (`std::thread::available_parallelism`, 1 if unknown).
 pub fn available_threads() -> usize {
@@ -10,25 +71,23 @@ pub fn available_threads() -> usize {
         .unwrap_or(1)
 }
 
-/// Environment variable that raises the most threads `--threads` takes above the machine's
-/// (`RTBENCH_MAX_THREADS=2`): for instruction counts and tests of a two-thread trace on a
-/// process pinned to one core (`taskset -c 1`, where the machine's count reads 1). Threads
-/// beyond the cores time nothing but the scheduler: not for time figures.
-pub const MAX_THREADS_VAR: &str = "RTBENCH_MAX_THREADS";
+// `RTBENCH_MAX_THREADS` (read once, in `measure::vars`) raises the most threads `--threads` takes above the machine's
+// (`RTBENCH_MAX_THREADS=2`): for instruction counts and tests of a two-thread trace on a
+// process pinned to one core (`taskset -c 1`, where the machine's count reads 1). Threads
+// beyond the cores time nothing but the scheduler: not for time figures.
 
 /// The most threads `--threads` takes: the machine's ([`available_threads`]), or more with
-/// [`MAX_THREADS_VAR`] (at most 64).
+/// `RTBENCH_MAX_THREADS` (at most 64).
 pub fn thread_limit() -> usize {
     let most = available_threads();
-    std::env::var(MAX_THREADS_VAR)
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .map_or(most, |n| most.max(n.min(64)))
+    super::vars::values()
+        .max_threads
+        .map_or(most, |n| most.max(n.min(super::vars::MOST_THREADS)))
 }
 
 /// A rayon pool with `threads` threads (all cores when `None`). More threads than the machine
 /// runs at once are refused: they measure nothing but the scheduler (100,000 made a load
-/// average of 800 on two cores before failing); [`MAX_THREADS_VAR`] raises the limit.
+/// average of 800 on two cores before failing); `RTBENCH_MAX_THREADS` raises the limit.
 pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     if threads == Some(0) {
         return Err(input("--threads must be at least 1"));
@@ -40,7 +99,7 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         )));
     }
     let mut b = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0));
-    if std::env::var_os(PIN_THREADS_VAR).is_some() {
+    if super::vars::values().pin_threads {
         let cpus = allowed_cpus();
         if !cpus.is_empty() {
             b = b.start_handler(move |i| pin_to_cpu(cpus[i % cpus.len()]));
@@ -50,10 +109,9 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .map_err(|e| input(format!("cannot start threads: {e}")))
 }
 
-/// Environment variable that pins each thread of every pool [`pool`] makes to one CPU of those
-/// the process may run on (thread i to the i-th, round robin): an experiment on where the
-/// scheduler puts the pool's threads (issue 20, acceptance 3), not a default.
-pub const PIN_THREADS_VAR: &str = "RTBENCH_PIN_THREADS";
+// `RTBENCH_PIN_THREADS` (read once, in `measure::vars`) pins each thread of every pool [`pool`]
+// makes to one CPU of those the process may run on (thread i to the i-th, round robin): an
+// experiment on where the scheduler puts the pool's threads, not a default.
 
 /// The CPUs the calling thread may run on (empty where that cannot be read).
 pub fn allowed_cpus() -> Vec<usize> {

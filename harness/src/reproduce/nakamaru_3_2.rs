@@ -1,6 +1,6 @@
 //! `nakamaru-3.2`: Table 3.2 (memory used by rayshade-ss per SF) and Figs. 3.5–3.7 (time against
 //! scene data size: where the in-memory grid starts to thrash, and where the breadth-first method
-//! overtakes it), seed 000 §3.4; digest §2.2.
+//! overtakes it), seed 000 §3.5.
 //!
 //! Per scene and Table 3.2 size factor:
 //! - **memory account** ([`RayshadeImage`]): everything rayshade-ss allocates for the scene and
@@ -706,7 +706,7 @@ fn show(v: Option<u32>, last: Option<&u32>) -> String {
         .unwrap_or_else(|| format!("none ≤ {}", last.map(|l| l.to_string()).unwrap_or_default()))
 }
 
-/// The thesis's per-scene explanation (§3.4), as one testable statement per scene.
+/// The thesis's per-scene explanation (§3.5), as one testable statement per scene.
 fn scene_claim(scene: &str) -> &'static str {
     match scene {
         "balls" | "tree" => "many small objects in one place: page faults as soon as the data outgrows memory (time onset no later than the data-size onset)",
@@ -920,7 +920,7 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
             v.accesses, v.pages, v.frames, v.mattson_lru, v.direct_lru, v.clock, (v.clock as f64 / v.direct_lru.max(1) as f64 - 1.0) * 100.0));
     }
     let pattern = &published::claim(&p.claims, "pattern").claim;
-    doc.paragraph(format!("Published pattern (000 §3.4): {pattern}"));
+    doc.paragraph(format!("Published pattern (000 §3.5): {pattern}"));
     doc
 }
 

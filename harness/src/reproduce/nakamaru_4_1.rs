@@ -142,10 +142,10 @@ struct Run {
     /// `bh_level_K_skipped` per level K ≥ 1.
     bh_skipped: Vec<u64>,
     load_average: String,
-    /// Rays traced, every kind (0 in rows saved before session 7, which did not keep it).
+    /// Rays traced, every kind (0 in rows saved by older versions, which did not keep it).
     #[serde(default)]
     rays: u64,
-    /// CPU seconds of preprocessing and tracing (0 in rows saved before session 8): against
+    /// CPU seconds of preprocessing and tracing (0 in rows saved by older versions): against
     /// the total it shows a run that did not get its core (a shared machine's times).
     #[serde(default)]
     cpu_s: f64,
@@ -289,7 +289,7 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
 }
 
 /// One method's run, saved on its own (`{key}.{method}`) as soon as it finishes, so that a row of
-/// hours resumed in another session does not trace its finished methods again.
+/// hours resumed in another invocation does not trace its finished methods again.
 fn method(
     cp: &super::Checkpoint,
     key: &str,

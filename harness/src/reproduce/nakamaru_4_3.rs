@@ -6,7 +6,7 @@
 //! and B differ.
 //!
 //! A row is a chain of steps, each saved as it finishes (`--resume`), so a row of days is done
-//! in sessions: the basic store (gzip-compressed: the basic method reads it strictly forward,
+//! in sittings: the basic store (gzip-compressed: the basic method reads it strictly forward,
 //! §3.4) and the split store are written in segments (`rtbench_engines::store::segments`), each
 //! segment a checkpoint; `max-seconds=S` stops the run at the first checkpoint past S seconds
 //! (the report then says which steps are still to do). A scene's rows share its stores and run
@@ -99,7 +99,7 @@ const SUBSPACES: Param = Param {
 };
 const METHODS: Param = Param {
     key: "methods",
-    help: "the methods this invocation measures, of basic,sgb,sg (default all three); the others keep what earlier invocations saved, so a 10^9-object row can be measured one method a session (e.g. methods=sgb first: the split store and S+G+B only)",
+    help: "the methods this invocation measures, of basic,sgb,sg (default all three); the others keep what earlier invocations saved, so a 10^9-object row can be measured one method an invocation (e.g. methods=sgb first: the split store and S+G+B only)",
 };
 const FRACTION: Param = Param {
     key: "basic-fraction",
@@ -221,7 +221,7 @@ struct Run {
     cpu_s: f64,
     /// Seconds of the on-disk grid's build spent by earlier invocations that were stopped
     /// (`hrgrid=resume`: rings368's basic preprocessing sweeps its 35 GB store 27 times, ~4 h,
-    /// more than a session), counted in `preprocess_s` but not in `cpu_s`.
+    /// more than one sitting), counted in `preprocess_s` but not in `cpu_s`.
     #[serde(default)]
     earlier_s: f64,
     /// The tracing split: the engine's passes (`intersect_s`) and shading (`shade_s`, whose
@@ -361,7 +361,7 @@ fn sweeps(generation_rays: &[u64], group: u64) -> u64 {
         .sum()
 }
 
-/// A store written in segments: its seconds summed over sessions, its size.
+/// A store written in segments: its seconds summed over invocations, its size.
 #[derive(Serialize, Deserialize, Clone, Default)]
 struct StoreStep {
     objects: u64,
@@ -637,7 +637,7 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
             None => return Ok(false),
         }
         save(m)?;
-        // A budget spent on the store stops here, so that the next session starts the run.
+        // A budget spent on the store stops here, so that the next invocation starts the run.
         if past(s) {
             return Ok(false);
         }
@@ -996,7 +996,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
 }
 
 /// The rows with S+G+B measured, as points of the time-per-ray benchmark, each method's seconds
-/// NaN where it is not measured yet (a 10^9-object row is measured one method a session); the
+/// NaN where it is not measured yet (a 10^9-object row is measured one method an invocation); the
 /// rings368m view is a series of its own ("rings-view-m"): other eye rays.
 fn size_points(measured: &[Measured]) -> Vec<SizePoint> {
     let nan = f64::NAN;
@@ -1085,7 +1085,7 @@ impl ThesisSgb {
     }
 }
 
-/// Issue 19's goal per scene: S+G+B's time per eye ray from the point nearest 10^6 objects to
+/// Our goal per scene (not the thesis's): S+G+B's time per eye ray from the point nearest 10^6 objects to
 /// the largest, judged when those are within 3× of 10^6 and at least 5·10^8. Beside it, where
 /// the thesis has both rows, the thesis's own growth between them, and ours judged against it
 /// (within 2× either way): the goal asks for less growth than the thesis's own tables show.
@@ -1217,7 +1217,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         };
         let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
         // Each claim as soon as the runs it compares are saved: a 10^9-object row is measured
-        // one method a session (`methods`).
+        // one method an invocation (`methods`).
         if let Some(b) = &m.basic {
             let model = b.is_model();
             let tag = if model { " (basic: model)" } else { "" };

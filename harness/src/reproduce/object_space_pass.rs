@@ -467,7 +467,7 @@ fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
 
 /// 64-bit FNV-1a of `bytes`: fixed by its definition, unlike std's `DefaultHasher` (whose
 /// algorithm may change between Rust versions, which would orphan every saved step). Keys made
-/// with it are marked `-f` where the `DefaultHasher` ones (session 6) were marked `-c`.
+/// with it are marked `-f` where the `DefaultHasher` ones were marked `-c`.
 pub fn stable_hash(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)

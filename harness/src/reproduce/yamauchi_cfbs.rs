@@ -702,7 +702,7 @@ fn model_section(doc: &mut Document, r: &Result_) {
             "m-ary n-stage",
             "P_M",
             "saturation λ_PE (per PE per clock)",
-            "digest's derived value",
+            "derived from eqs. 11-21",
         ],
     );
     for m in &r.model {

@@ -136,6 +136,7 @@ impl ResultsDir {
     pub fn put(&mut self, rec: RunRecord) -> Result<()> {
         self.records.retain(|r| r.key != rec.key);
         self.records.push(rec);
+        rtbench_reports::attach_ratios(&mut self.records);
         let mut text = String::new();
         for r in &self.records {
             text.push_str(&serde_json::to_string(r).expect("records serialise"));
@@ -211,8 +212,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     for (k, v) in &job.settings {
         cmd.args(["--set", &format!("{k}={v}")]);
     }
-    if let Some(t) = job.threads {
-        cmd.args(["--threads", &t.to_string()]);
+    {
+        let t = job.threads.map_or("all".to_string(), |t| t.to_string());
+        cmd.args(["--threads", &t]);
     }
     cmd.args([
         "--repeat",

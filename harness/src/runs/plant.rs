@@ -1,6 +1,6 @@
-//! Planted regressions, to measure whether the nightly detection finds them (docs/benchmarks.md,
-//! "Nightly regression runs"). Only the environment variable `RTBENCH_PLANT` turns one on; it is
-//! meant for that measurement alone.
+//! Planted regressions, to measure whether the nightly detection finds them
+//! (docs/guides/nightly.md). Only the environment variable `RTBENCH_PLANT` turns one on; it
+//! is meant for that measurement alone.
 //!
 //! - `RTBENCH_PLANT=work:ENGINE:SCENE:FRACTION`: the engine answers every query as before, then
 //!   answers FRACTION of them a second time (into scratch buffers, with scratch counters): real
@@ -22,7 +22,11 @@ pub enum Plant {
 
 /// The plant for this engine and scene, if `RTBENCH_PLANT` asks for one.
 pub fn from_env(engine: &str, program: Option<&str>) -> Option<Plant> {
-    parse(&std::env::var("RTBENCH_PLANT").ok()?, engine, program)
+    parse(
+        crate::measure::vars::values().plant.as_deref()?,
+        engine,
+        program,
+    )
 }
 
 fn parse(spec: &str, engine: &str, program: Option<&str>) -> Option<Plant> {
