@@ -107,7 +107,9 @@ pub enum Command {
     )]
     Plan(PlanCmdArgs),
     /// The RTBENCH_* environment variables: each one's value here, accepted forms and effect.
+    #[command(after_help = "Examples:\n  rtbench env\n  RTBENCH_MAX_THREADS=2 rtbench env --json")]
     Env {
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
