@@ -39,9 +39,14 @@ use source::Source;
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
-        Command::Scene(SceneCommand::Gen { scene, output }) => commands::scene::gen(
+        Command::Scene(SceneCommand::Gen {
+            scene,
+            output,
+            max_bytes,
+        }) => commands::scene::gen(
             &Source::from_args(&scene.scene, &scene.opts)?,
             output.as_deref(),
+            commands::scene::max_bytes(&max_bytes)?,
         ),
         Command::Scene(SceneCommand::Store {
             scene,
@@ -52,6 +57,7 @@ fn run(cli: Cli) -> Result<()> {
             segment,
             resume,
             max_seconds,
+            max_bytes,
             json,
         }) => match segment {
             Some(segment) if hierarchy => Err(error::input(format!(
@@ -66,6 +72,7 @@ fn run(cli: Cli) -> Result<()> {
                     segment,
                     resume,
                     max_seconds,
+                    max_bytes: commands::scene::max_bytes(&max_bytes)?,
                     as_json: json,
                 },
             ),
@@ -75,6 +82,7 @@ fn run(cli: Cli) -> Result<()> {
                 &layout,
                 &compress,
                 hierarchy,
+                commands::scene::max_bytes(&max_bytes)?,
                 json,
             ),
         },

@@ -223,6 +223,11 @@ impl StoreWriter {
         self.objects
     }
 
+    /// Bytes of records written so far (uncompressed streams, file headers included).
+    pub fn written(&self) -> u64 {
+        self.bbox.as_ref().map_or(0, |b| b.written()) + self.geometry.written()
+    }
+
     /// Makes the store written so far durable and complete up to the last object
     /// ([`IoFile::checkpoint`] on every binary file: a gzip member ends) and returns where it
     /// stands, for [`StoreWriter::resume`] in another process. The first error of the stream is

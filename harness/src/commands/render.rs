@@ -24,7 +24,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         )));
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
-    workload::check_scene_fits(&src, a.scene.opts.force)?;
+    workload::check_scene_fits(&src, &[&a.engine], a.scene.opts.force)?;
     let pool = workload::pool(a.threads)?;
     memory::phase("start");
     let prepared = workload::prepare(&src)?;

@@ -900,6 +900,10 @@ fn run(ctx: &Ctx) -> Result<Output> {
             .map_err(|e| input(format!("nakamaru-4.3: split-compress={c}: {e}")))?,
     };
     let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;
+    // A budget longer than an Instant reaches (1e308, inf) is no deadline.
+    let deadline = max_seconds
+        .and_then(|x| Duration::try_from_secs_f64(x).ok())
+        .and_then(|d| Instant::now().checked_add(d));
     let segment = ctx
         .params
         .number::<u64>(SEGMENT.key, 1)?
@@ -917,7 +921,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         spill: ctx.params.raw(SPILL.key).map(str::to_string),
         stores: out_stores,
         segment,
-        deadline: max_seconds.map(|x| Instant::now() + Duration::from_secs_f64(x)),
+        deadline,
         fraction,
         passes,
         subspaces,

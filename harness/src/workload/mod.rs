@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod footprint;
 pub mod frustum;
 pub mod memory;
 pub mod out_of_core;
@@ -181,25 +182,16 @@ pub fn pin_to_cpu(cpu: usize) {
 /// (breadth-first) at --size 2048 (corners, rays, hits, paths, shading records), rounded up.
 pub const BYTES_PER_CORNER: u64 = 256;
 
-/// Bytes an in-memory run holds per scene object, at least: measured 330 (embree, spheres) to
-/// 1,640 (bvh8, gears' polygons) at 0.1 to 1 million objects; the lower figure, rounded down.
-pub const BYTES_PER_OBJECT: u64 = 300;
-
 /// Memory this process can still have: the smaller of the machine's available memory
-/// (`MemAvailable`) and the address-space limit (`ulimit -v`). None when neither is known.
+/// (`MemAvailable`) and the address space left under its limit (`ulimit -v`, less what is
+/// mapped already). None when neither is known.
 pub fn memory_available() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
         let line = t.lines().find(|l| l.starts_with("MemAvailable:"))?;
         line.split_whitespace().nth(1)?.parse::<u64>().ok()
     });
     let mem = meminfo.map(|kb| kb.saturating_mul(1024));
-    let mut lim = libc::rlimit {
-        rlim_cur: 0,
-        rlim_max: 0,
-    };
-    // SAFETY: getrlimit writes only into `lim`, which we own.
-    let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) };
-    let limit = (rc == 0 && lim.rlim_cur != libc::RLIM_INFINITY).then_some(lim.rlim_cur);
+    let limit = rtbench_engines::usage::address_space_left();
     match (mem, limit) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
@@ -228,23 +220,28 @@ pub fn check_size(size: u32) -> Result<()> {
     Ok(())
 }
 
-/// A generated scene about to be held in memory fits in the memory available, by the estimate
-/// [`BYTES_PER_OBJECT`] (`--sf 40` of tree ran the machine out of memory); `force` skips this.
-pub fn check_scene_fits(src: &Source, force: bool) -> Result<()> {
+/// A generated scene about to be held in memory, and the structures of `engines` over it, fit in
+/// the memory available (RAM and the address-space limit), by the estimate of [`footprint`];
+/// `force` skips this (`--sf 40` of tree ran the machine out of memory, `--tessellate 1000`
+/// and an address-space limit aborted).
+pub fn check_scene_fits(src: &Source, engines: &[&str], force: bool) -> Result<()> {
     let Source::Program(p, o) = src else {
         return Ok(());
     };
     if force {
         return Ok(());
     }
-    let objects = p.object_count(o.size_factor).unwrap_or(u64::MAX);
-    let need = objects.saturating_mul(BYTES_PER_OBJECT);
+    let f = footprint::Census::of(*p, o);
+    let need = f.bytes(engines);
     if let Some(have) = memory_available().filter(|&have| need > have) {
         return Err(input(format!(
-            "{}: {objects} objects need at least {} in memory, {} is available (--force to \
-             try anyway)",
+            "{}: {} objects ({} primitives to build over) need about {} in memory with {}, {} is \
+             available (--force to try anyway)",
             src.label(),
+            f.objects,
+            f.primitives(),
             gib(need),
+            engines.join(" and "),
             gib(have)
         )));
     }
