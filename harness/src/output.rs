@@ -5,6 +5,12 @@ use crate::error::{input, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The first `n` characters of `s`: text read from files and databases is cut at a character,
+/// never at a byte index (which panics inside a multi-byte character).
+pub fn head(s: &str, n: usize) -> &str {
+    s.char_indices().nth(n).map_or(s, |(i, _)| &s[..i])
+}
+
 /// Runs `write` on a temp file next to `path`, then renames it over `path`. On any error the
 /// temp file is removed and the error names `path`.
 pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>

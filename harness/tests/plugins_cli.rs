@@ -273,7 +273,7 @@ fn plugin_answers_output_and_messages_are_held_to_the_abi() {
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     assert!(v["hit_agreement"].as_f64().unwrap() > 0.99, "{v}");
-    assert!(v["primitive_agreement"].as_f64().unwrap() < 0.5, "{v}");
+    assert!(v["primitive_agreement"].as_f64().unwrap() < 0.99, "{v}");
     assert_eq!(v["pass"], false);
     let v = stdout_json(&[
         "check",

@@ -44,4 +44,4 @@ pub use results::{
     SceneInfo, Spread, Timings,
 };
 pub use scaling::ThreadScaling;
-pub use summary::{engine_label, Failure, Row, Summary};
+pub use summary::{check_records, duplicate, engine_label, latest_per_key, Failure, Row, Summary};

@@ -518,9 +518,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "equal",
                 format!(
                     "{}… / {}… / {}…",
-                    &m.basic.sha256[..12],
-                    &m.sg.sha256[..12],
-                    &m.sgb.sha256[..12]
+                    crate::output::head(&m.basic.sha256, 12),
+                    crate::output::head(&m.sg.sha256, 12),
+                    crate::output::head(&m.sgb.sha256, 12)
                 ),
                 Kind::Count,
                 Verdict::of(same),

@@ -301,9 +301,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "equal",
                 format!(
                     "{}… / {}… / {}…",
-                    &m.single.sha256[..12],
-                    &m.half.sha256[..12],
-                    &m.quarter.sha256[..12]
+                    crate::output::head(&m.single.sha256, 12),
+                    crate::output::head(&m.half.sha256, 12),
+                    crate::output::head(&m.quarter.sha256, 12)
                 ),
                 Kind::Count,
                 Verdict::of(same),

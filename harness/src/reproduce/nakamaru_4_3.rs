@@ -1283,9 +1283,9 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     format!(
                         "{}{} / {} / {}",
                         if model { "(basic: a model, not compared) " } else { "" },
-                        &b.sha256[..12.min(b.sha256.len())],
-                        &sg.sha256[..12.min(sg.sha256.len())],
-                        &sgb.sha256[..12.min(sgb.sha256.len())]
+                        crate::output::head(&b.sha256, 12),
+                        crate::output::head(&sg.sha256, 12),
+                        crate::output::head(&sgb.sha256, 12)
                     ),
                     Kind::Count,
                     Verdict::of(same),
@@ -1489,7 +1489,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                     format!("{} of {}", r.rows_traced, s.size + 1),
                     format!("{:.2}", r.scale),
                     r.rays.to_string(),
-                    format!("{}…", &r.sha256[..12.min(r.sha256.len())]),
+                    format!("{}…", crate::output::head(&r.sha256, 12)),
                     // A run that waited for a core or for the disk shows well under 100%.
                     super::grid_runs::cpu_share(r.cpu_s, r.preprocess_s - r.earlier_s + r.trace_s),
                     r.load_average.clone(),

@@ -342,7 +342,7 @@ fn rows(p: &Published, measured: &[Point_], slopes: &[Slopes]) -> Vec<Row> {
             "image-equal",
             format!("{}{}", m.scene, m.sf),
             "equal",
-            format!("{}… / {}…", &m.capped.sha256[..12], &m.high_res.sha256[..12]),
+            format!("{}… / {}…", crate::output::head(&m.capped.sha256, 12), crate::output::head(&m.high_res.sha256, 12)),
             Kind::Count,
             Verdict::of(m.capped.sha256 == m.high_res.sha256),
         ));
