@@ -92,7 +92,9 @@ impl Source {
                     .iter()
                     .any(|f| path.join(f).exists())
                 {
-                    format!("a scene store without its {store} (unfinished or damaged: write it again)")
+                    format!(
+                        "a scene store without its {store} (unfinished or damaged: write it again)"
+                    )
                 } else {
                     format!("a directory, neither a scene file nor a scene store (no {store})")
                 };

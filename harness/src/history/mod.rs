@@ -144,7 +144,11 @@ fn file_uri(path: &Path, immutable: bool) -> String {
             uri.push_str(&format!("%{b:02X}"));
         }
     }
-    uri.push_str(if immutable { "?mode=ro&immutable=1" } else { "?mode=ro" });
+    uri.push_str(if immutable {
+        "?mode=ro&immutable=1"
+    } else {
+        "?mode=ro"
+    });
     uri
 }
 
@@ -328,7 +332,10 @@ impl History {
             .query_row("PRAGMA integrity_check", [], |r| r.get(0))
             .map_err(|e| self.err(e))?;
         if verdict != "ok" {
-            out.push(format!("integrity_check: {}", crate::output::head(&verdict, 200)));
+            out.push(format!(
+                "integrity_check: {}",
+                crate::output::head(&verdict, 200)
+            ));
         }
         let version = q("PRAGMA user_version")?;
         if version != SCHEMA {
@@ -607,7 +614,7 @@ impl History {
         rows.collect::<std::result::Result<Vec<_>, _>>()
             .map_err(|e| self.err(e))
     }
-
+}
 
 #[cfg(test)]
 mod tests {
@@ -712,7 +719,10 @@ mod tests {
         assert!(e.contains("no history"), "{e}");
         assert_eq!(std::fs::metadata(&p).unwrap().len(), 0);
         std::fs::remove_file(&p).unwrap();
-        History::open(&p, true).unwrap().append(&night("a")).unwrap();
+        History::open(&p, true)
+            .unwrap()
+            .append(&night("a"))
+            .unwrap();
         let dir = p.parent().unwrap();
         use std::os::unix::fs::PermissionsExt;
         std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).unwrap();
@@ -746,11 +756,22 @@ mod tests {
             c.execute_batch(sql).unwrap();
             drop(c);
             let problems = History::open_read(&p).unwrap().problems().unwrap();
-            assert!(problems.iter().any(|l| l.contains(needle)), "{tag}: {problems:?}");
+            assert!(
+                problems.iter().any(|l| l.contains(needle)),
+                "{tag}: {problems:?}"
+            );
         };
         damage("short", "", "night 2 holds 1 of its suite's 2 metrics");
         damage("drop", "DROP TABLE samples;", "table samples is missing");
-        damage("rename", "ALTER TABLE findings RENAME COLUMN message TO msg;", "table findings has columns");
-        damage("text", "UPDATE metrics SET value = 'fast' WHERE run_id = 1;", "metrics.value");
+        damage(
+            "rename",
+            "ALTER TABLE findings RENAME COLUMN message TO msg;",
+            "table findings has columns",
+        );
+        damage(
+            "text",
+            "UPDATE metrics SET value = 'fast' WHERE run_id = 1;",
+            "metrics.value",
+        );
     }
 }
