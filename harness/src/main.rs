@@ -31,6 +31,9 @@ mod source;
 mod suite;
 mod workload;
 
+#[cfg(test)]
+mod fuzz;
+
 use clap::Parser;
 use cli::{Cli, Command, SceneCommand};
 use error::Result;

@@ -204,7 +204,7 @@ fn jsonl(records: &[RunRecord]) -> Vec<u8> {
 }
 
 /// The shards' records, each checked against its slice and marked with its machine, in plan order.
-fn merged_records(shards: &[Shard]) -> Result<Vec<RunRecord>> {
+pub(crate) fn merged_records(shards: &[Shard]) -> Result<Vec<RunRecord>> {
     let kind = shards[0].m.kind.as_str();
     let plan = &shards[0].m.plan_jobs;
     let order: BTreeMap<&str, usize> = plan
