@@ -45,6 +45,9 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     workload::check_scene_fits(&src, &[engine, against], a.opts.force)?;
     let pool = workload::pool(a.threads)?;
     let prepared = workload::prepare(&src)?;
+    if let Some(w) = workload::precision_warning(&prepared.input.scene) {
+        eprintln!("rtbench: warning: {w}");
+    }
     let (tested, _) = workload::build(engine, &prepared.input, settings)?;
     let (yardstick, _) = workload::build(against, &prepared.input, vec![])?;
     let c = pool.install(|| {

@@ -28,6 +28,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let pool = workload::pool(a.threads)?;
     memory::phase("start");
     let prepared = workload::prepare(&src)?;
+    if let Some(w) = workload::precision_warning(&prepared.input.scene) {
+        eprintln!("rtbench: warning: {w}");
+    }
     memory::phase("scene");
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
     memory::phase("build");
