@@ -16,8 +16,6 @@ use gltf::json::Root;
 use std::borrow::Cow;
 use std::path::Path;
 
-/// Nodes visited through the scene graph before it is taken for a cycle.
-const MAX_NODES_VISITED: usize = 1_000_000;
 /// Triangles a file may instance through its node graph: a few kilobytes of JSON could
 /// otherwise instance one mesh a million times.
 const MAX_TRIANGLES: usize = 1 << 27;
@@ -455,18 +453,21 @@ pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<Mesh, String> {
                 .iter()
                 .map(|n| (n.value(), DMat4::IDENTITY))
                 .collect();
-            let mut visited = 0usize;
+            // The spec's node graph is a forest: a node reached twice is a cycle or a node with
+            // two parents, either of which would instance its subtree again and again.
+            let mut seen = vec![false; root.nodes.len()];
             while let Some((index, parent)) = stack.pop() {
-                visited += 1;
-                if visited > MAX_NODES_VISITED {
-                    return Err("glTF: the node graph does not end (a cycle?)".into());
-                }
                 let node = root.nodes.get(index).ok_or_else(|| {
                     format!(
                         "glTF: node {index} named; the file has {}",
                         root.nodes.len()
                     )
                 })?;
+                if std::mem::replace(&mut seen[index], true) {
+                    return Err(format!(
+                        "glTF: node {index} is reached twice (a cycle, or two parents)"
+                    ));
+                }
                 let xf = parent * local_transform(node).map_err(g)?;
                 if let Some(m) = node.mesh {
                     add_mesh(&root, &buffers, m.value(), xf, &mut mesh).map_err(g)?;

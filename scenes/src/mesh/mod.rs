@@ -405,6 +405,7 @@ mod tests {
             ("no-view", gltf_doc(&buf, "", &format!("{POS},{IDX}")), "bufferView 0"),
             ("bad-node", ok.replace(r#""nodes":[0]"#, r#""nodes":[7]"#), "node 7"),
             ("bad-mesh", ok.replace(r#""mesh":0"#, r#""mesh":3"#), "mesh 3"),
+            ("cycle", ok.replace(r#""nodes":[{"mesh":0}]"#, r#""nodes":[{"mesh":0,"children":[0]}]"#), "reached twice"),
         ];
         for (name, doc, want) in cases {
             let e = read_mesh(&tmp(&format!("{name}.gltf"), doc.as_bytes()))
@@ -526,6 +527,14 @@ mod tests {
                 .expect_err(name)
                 .to_string();
             assert_eq!(e.lines().count(), 1, "{name}: {e}");
+        }
+        // Counts no data could hold: refused before the parser makes a single element.
+        for (name, body) in [
+            ("empty-elements.ply", &b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nend_header\n"[..]),
+            ("huge.ply", &b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n0\n"[..]),
+        ] {
+            let e = read_mesh(&tmp(name, body)).expect_err(name).to_string();
+            assert!(e.contains("no properties") || e.contains("at least"), "{name}: {e}");
         }
         let mut trailing = bin_ply(4);
         trailing.extend_from_slice(&[0u8; 13]);

@@ -8,6 +8,48 @@ use glam::DVec3;
 use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
 use std::io::BufRead;
 
+/// The header's counts against the bytes of data that follow it, before anything is read: an
+/// element of no properties, or more elements than the data could hold even at their smallest
+/// (a scalar's bytes, a list's count; a line each in ASCII), would have the parser make billions
+/// of empty elements out of a few bytes.
+fn check_counts(h: &ply_rs_bw::ply::Header, data: usize) -> Result<(), String> {
+    use ply_rs_bw::ply::{PropertyType, ScalarType};
+    let size = |t: &ScalarType| match t {
+        ScalarType::Char | ScalarType::UChar => 1u64,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    };
+    let mut need = 0u64;
+    for e in h.elements.values() {
+        if e.count > 0 && e.properties.is_empty() {
+            return Err(format!(
+                "PLY: element '{}' has {} entries and no properties",
+                e.name, e.count
+            ));
+        }
+        let least = match h.encoding {
+            // A value and its separator, or the line's end.
+            Encoding::Ascii => 2 * e.properties.len() as u64,
+            _ => e
+                .properties
+                .values()
+                .map(|p| match &p.data_type {
+                    PropertyType::Scalar(t) => size(t),
+                    PropertyType::List(count, _) => size(count),
+                })
+                .sum(),
+        };
+        need = need.saturating_add((e.count as u64).saturating_mul(least));
+    }
+    if need > data as u64 {
+        return Err(format!(
+            "PLY: the header's counts need at least {need} bytes of data, the file has {data}"
+        ));
+    }
+    Ok(())
+}
+
 fn first_line(e: impl std::fmt::Display) -> String {
     let s = e.to_string();
     format!("PLY: {}", s.lines().next().unwrap_or("unreadable"))
@@ -17,6 +59,7 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, String> {
     let mut r = ply_rs_bw::parser::Reader::new(bytes);
     let parser = ply_rs_bw::parser::Parser::<DefaultElement>::new();
     let header = parser.read_header(&mut r).map_err(first_line)?;
+    check_counts(&header, r.get_ref().len())?;
     let payload = parser.read_payload(&mut r, &header).map_err(first_line)?;
     let rest = r.get_mut().fill_buf().map_err(|e| format!("PLY: {e}"))?;
     let trailing = match header.encoding {
