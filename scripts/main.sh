@@ -13,7 +13,8 @@ cd "$ROOT"
 command -v cargo >/dev/null || { echo "main.sh: error: cargo not found (install Rust with rustup)" >&2; exit 1; }
 OUT="${1:-out/quick}"
 bash scripts/setup.sh
-cargo build --release -p rtbench --quiet
+echo "main.sh: building rtbench (cargo's progress below; a first build takes minutes)"
+cargo build --release -p rtbench
 RT=./target/release/rtbench
 $RT engines
 $RT run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --repeat 3 --threads 1 --out "$OUT" --resume

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """List import cycles between the module files of a crate's src/ directory.
 
-Usage: python3 scripts/module_cycles.py [-v] SRC_DIR [SRC_DIR ...]
+Usage: python3 scripts/module_cycles.py [-v] [--leaves DIR] SRC_DIR [SRC_DIR ...]
        e.g. python3 scripts/module_cycles.py engines/src harness/src scenes/src
 
 Each SRC_DIR is one crate (its root is lib.rs, else main.rs). A file depends on another when it
@@ -10,10 +10,14 @@ names an item the other file DEFINES: through `use crate::…`, `use super::…`
 an inline path such as `crate::x::y`, `super::x`, `self::x` or `alias::x` after `use …::alias`.
 A path that lands on a re-exported name (`pub use child::X;` in a parent) resolves to the file
 that defines X. A parent's `mod child;` and its re-export lines are the module tree, not
-dependencies. Comments and string literals are ignored (intra-doc links are not imports).
+dependencies. Comments and string literals are ignored (intra-doc links are not imports). A
+file's own `macro_rules!` whose body declares modules (`$(mod $name;)*`) is expanded where it is
+invoked with a list of names, so the modules a registry macro declares are checked too.
 
 Prints each elementary cycle as `a.rs -> b.rs -> a.rs` (paths under SRC_DIR, at most 20 per
-strongly connected group) and exits 1 if there is any, 0 if none, 2 on bad input. `-v` also
+strongly connected group) and exits 1 if there is any, 0 if none, 2 on bad input. With
+`--leaves DIR` (a folder under each SRC_DIR that has it, e.g. `commands`), a file outside DIR that
+imports one inside it is reported too: DIR holds leaves that only the crate root dispatches to. `-v` also
 prints, for each edge of a cycle, the lines that make it.
 """
 
@@ -90,6 +94,52 @@ def tokens(text):
     return toks
 
 
+def expand_mod_macros(toks):
+    """Rewrites invocations of a file's own `macro_rules!` that declare modules (`$(mod $x;)*` in
+    the body, as `registry!` does) into plain `mod x;` lines, so the modules they declare are in the
+    tree. The arguments must be a comma-separated list of identifiers."""
+    names = set()
+    for i, (t, _) in enumerate(toks):
+        if t == "macro_rules" and i + 3 < len(toks) and toks[i + 1][0] == "!":
+            depth, j = 0, i + 3
+            while j < len(toks):
+                if toks[j][0] in "{([":
+                    depth += 1
+                elif toks[j][0] in "})]":
+                    depth -= 1
+                    if depth == 0:
+                        break
+                elif toks[j][0] == "mod" and j + 1 < len(toks) and toks[j + 1][0] == "$":
+                    names.add(toks[i + 2][0])
+                j += 1
+    if not names:
+        return toks
+    out, i = [], 0
+    while i < len(toks):
+        t, line = toks[i]
+        if (
+            t in names
+            and i + 2 < len(toks)
+            and toks[i + 1][0] == "!"
+            and toks[i + 2][0] in "{("
+            and (i == 0 or toks[i - 1][0] != "macro_rules")
+        ):
+            close = "}" if toks[i + 2][0] == "{" else ")"
+            j = i + 3
+            while j < len(toks) and toks[j][0] != close:
+                name, nline = toks[j]
+                if re.match(r"[A-Za-z_]", name):
+                    out.extend([("mod", nline), (name, nline), (";", nline)])
+                j += 1
+            i = j + 1
+            if i < len(toks) and toks[i][0] == ";":
+                i += 1
+            continue
+        out.append((t, line))
+        i += 1
+    return out
+
+
 def parse_use_tree(toks, i, prefix, out):
     """Parses one use tree at toks[i]; appends (path, name) with name '*' for globs. Returns next i."""
     path = list(prefix)
@@ -152,7 +202,7 @@ class Crate:
     def load(self, rel, module):
         full = os.path.join(self.src, rel)
         with open(full, encoding="utf-8") as f:
-            toks = tokens(strip(f.read()))
+            toks = expand_mod_macros(tokens(strip(f.read())))
         self.files[rel] = toks
         self.inline_paths[rel] = []
         self.idents[rel] = []
@@ -423,9 +473,18 @@ def cycles_in(comp, adj, limit=20):
 
 def main(argv):
     verbose = "-v" in argv
-    dirs = [a for a in argv if a != "-v"]
+    leaves, dirs, args = [], [], [a for a in argv if a != "-v"]
+    while args:
+        a = args.pop(0)
+        if a == "--leaves":
+            if not args:
+                print("module_cycles: --leaves needs a folder", file=sys.stderr)
+                return 2
+            leaves.append(args.pop(0).strip("/") + "/")
+        else:
+            dirs.append(a)
     if not dirs:
-        print("usage: module_cycles.py [-v] SRC_DIR [SRC_DIR ...]", file=sys.stderr)
+        print("usage: module_cycles.py [-v] [--leaves DIR] SRC_DIR [SRC_DIR ...]", file=sys.stderr)
         return 2
     total = 0
     for d in dirs:
@@ -439,6 +498,15 @@ def main(argv):
         for a, b in edges:
             adj.setdefault(a, set()).add(b)
         nodes = set(crate.files) | {m.file for m in crate.modules()}
+        for leaf in leaves:
+            for (a, b), why in sorted(edges.items()):
+                inside = a.startswith(leaf) or a == crate.root.file
+                if b.startswith(leaf) and not inside:
+                    total += 1
+                    print(f"{os.path.join(d, a)} imports {os.path.join(d, b)}: only the crate root imports {leaf}")
+                    if verbose:
+                        for w in why[:3]:
+                            print(f"    {w}")
         for comp in sccs(nodes, adj):
             if len(comp) < 2:
                 continue

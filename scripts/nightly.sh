@@ -19,7 +19,12 @@ if ! command -v valgrind >/dev/null; then
     $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq >/dev/null
     $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends valgrind >/dev/null
 fi
-cargo build --release -p rtbench --quiet
+# Build with cargo's progress on the terminal (a first build takes minutes): the binary, then the suite's
+# criterion benches, which `rtbench nightly` would otherwise build behind its own quiet `cargo bench`.
+echo "nightly.sh: building rtbench and the criterion benches (cargo's progress below)"
+cargo build --release -p rtbench
+cargo bench -p rtbench-engines --no-run
+echo "nightly.sh: running suites/nightly.toml (each run's progress below)"
 mkdir -p "$OUT" "$(dirname "$DB")"
 RUN="$OUT/run-$(date -u +%Y%m%dT%H%M%SZ)"
 rc=0

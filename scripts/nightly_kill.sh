@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The nightly history survives kill -9 and concurrent writers (issue 16, acceptance 5).
+# The nightly history survives kill -9 and concurrent writers.
 #
 # 1. Until KILLS kills have landed: start `rtbench nightly` of a tiny suite on one history and
 #    kill -9 it after a random delay spread over a whole night (the measuring, the comparison and

@@ -123,7 +123,7 @@ EOF
     say "Embree 4 ready in .embree/lib ($(basename "$embree"))"
 fi
 
-# --- Meshes for the examples and docs (issue 21) -----------------------------------------------------------------
+# --- Meshes for the examples and docs -----------------------------------------------------------------
 # Real meshes from Debian packages, into .meshes/ (git-ignored, never committed):
 #   bunny.ply            the Stanford bunny (75,408 triangles, a range scan), from libcgal-demo's
 #                        data/meshes/bunny00.off, converted to ASCII PLY here
@@ -174,4 +174,11 @@ if ! meshes_ok; then
     else
         say "warning: could not fetch the example meshes; rtbench works without them"
     fi
+fi
+# The `tinybvh` engine's plugin: tinybvh's header (shipped by the tinybvh-rs crate) compiled with AVX2 for that
+# library alone. Without a C++ compiler or AVX2 the engine is listed as unavailable and the rest works.
+if grep -q avx2 /proc/cpuinfo 2>/dev/null && bash examples/tinybvh/build.sh; then
+    :
+else
+    say "warning: the tinybvh plugin was not built; the tinybvh engine is unavailable"
 fi

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Random bit flips in a scene store's files (issue 14, acceptance 3): each flip is made in a fresh
+# Random bit flips in a scene store's files: each flip is made in a fresh
 # copy of the store, which is then rendered out of core. Every flip must be refused (exit 2); none
 # may render a different image with exit 0.
 # Usage: bash scripts/store_bitflips.sh [FLIPS=200] [SEED=14] [RTBENCH=target/release/rtbench]

@@ -1,4 +1,4 @@
-//! criterion micro-benchmarks of the BVH build changed in issue 20: `cargo bench -p
+//! criterion micro-benchmarks of the parts of the BVH build: `cargo bench -p
 //! rtbench-engines --bench build`. One binary SAH tree over the 36,610 triangles of gears4 (the
 //! scene whose tree the change was made for), with 001's count (`block 1`, built to single
 //! primitives, as the tree collapsed by default before) and with Embree's leaf rule (SAH in

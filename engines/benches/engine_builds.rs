@@ -1,9 +1,9 @@
-//! Build times against Embree's, side by side (issue 20, acceptance 4):
+//! Build times against Embree's, side by side:
 //! `cargo bench -p rtbench-engines --bench engine_builds -- [SCENE[:SF] ...] [--rounds R]`.
 //!
 //! Each round builds every engine below once, each build in a child process of its own (Embree
 //! keeps one device per thread setting for the process's life, and a live `threads=2` device lets
-//! a `threads=1` build use two threads: 1.6–1.8 CPUs in one process, issue 20, session 15), in an
+//! a `threads=1` build use two threads: 1.6–1.8 CPUs in one process), in an
 //! order that rotates from round to round, so that load from other processes falls on all of
 //! them. Each line also prints the build's CPU time over its wall time. Each
 //! build's wall time is the engine's whole build (`build_engine`: Embree's device, scene and

@@ -1,4 +1,4 @@
-//! Packets against Embree's packets on coherent generations (issue 20, acceptance 2):
+//! Packets against Embree's packets on coherent generations:
 //! `cargo bench -p rtbench-engines --bench packets -- [SCENE[:SF] ...] [--size N] [--pairs P]
 //! [--engines LABEL,...] [--tessellate RES] [--set KEY=VALUE ...]` (`--engines`: only the engines
 //! whose label starts with one of these, e.g. `"embree single,bvh4 single"`; bvh8 single is always
@@ -144,7 +144,7 @@ fn main() {
     // `--set KEY=VALUE`: added to the settings of bvh8's packet engines.
     let mut extra: Vec<(String, String)> = Vec::new();
     // `--set-single KEY=VALUE`: added to the settings of bvh4 single and bvh8 single (a tree
-    // setting tried on both widths, issue 20 session 12).
+    // setting tried on both widths).
     let mut single: Vec<(String, String)> = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {

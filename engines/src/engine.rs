@@ -1,6 +1,6 @@
-//! The one interface every accelerator implements (../shared/ARCHITECTURE.md, "The engine
-//! interface"): build from a scene with a typed configuration, answer batches of closest-hit
-//! and any-hit queries, report exact counters and structure memory.
+//! The one interface every accelerator implements (docs/concepts.md, "Engines"): build from a
+//! scene with a typed configuration, answer batches of closest-hit and any-hit queries, report
+//! exact counters and structure memory.
 //!
 //! Engines are registered in [`crate::registry`]; each parses its own typed configuration from
 //! the command line's `key=value` strings with [`Settings`], rejecting keys it does not know.

@@ -29,6 +29,7 @@ pub mod store;
 #[cfg(test)]
 mod test_support;
 pub mod testing;
+pub mod tinybvh;
 pub mod usage;
 
 pub use engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
@@ -46,6 +47,7 @@ pub fn registry() -> Vec<EngineInfo> {
         bvh::info4(),
         bvh::info8(),
         obvhs_engine::info(),
+        tinybvh::info(),
         object_space::info(),
         plugin::info(),
     ];

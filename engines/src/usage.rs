@@ -1,5 +1,5 @@
 //! What the process has used so far: CPU seconds of every thread and minor page faults. For the
-//! build diagnostics (`RTBENCH_BUILD_PHASES`) and the build bench (issue 20): how many threads a
+//! build diagnostics (`RTBENCH_BUILD_PHASES`) and the build bench: how many threads a
 //! build kept busy, and how much of it went to faulting in fresh pages.
 
 /// CPU seconds of every thread of the process (`CLOCK_PROCESS_CPUTIME_ID`) and its minor page

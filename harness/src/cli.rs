@@ -1,4 +1,5 @@
-//! The command line (../shared/CLI.md). Names here are a contract: extend, never rename.
+//! The command line. Its names and JSON shapes are a contract that scripts and nightly jobs rely on
+//! (docs/concepts.md): extend, never rename.
 
 use clap::{Args, Parser, Subcommand};
 use rtbench_scenes::spd::MountHash;
@@ -8,51 +9,104 @@ use std::path::PathBuf;
 #[command(
     name = "rtbench",
     version,
-    about = "Benchmark and reproducibility harness for ray-tracing acceleration structures"
+    about = "Benchmark and reproducibility harness for ray-tracing acceleration structures",
+    after_help = ENV_HELP
 )]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
 }
 
+/// The environment variables rtbench reads, as `--help` names them (`rtbench env` says more).
+pub const ENV_HELP: &str = "Environment (read once at the start; a malformed value is exit 2; \
+`rtbench env` lists the accepted forms): RTBENCH_MAX_THREADS, RTBENCH_PIN_THREADS, RTBENCH_SCHED, \
+RTBENCH_BANDS, RTBENCH_MEMORY_PHASES, RTBENCH_PLANT, RTBENCH_BUILD_PHASES, RTBENCH_PLUGIN_DIR, \
+RTBENCH_TEST_ENGINES, RTBENCH_TEST_SLOWDOWN.";
+
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Generate SPD scenes, show their statistics.
-    #[command(subcommand)]
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  rtbench scene list\n  rtbench scene gen mount --sf 8 --hash jenkins -o mount8.nff\n  rtbench scene stats bunny.ply --json"
+    )]
     Scene(SceneCommand),
     /// List the engines and whether each can run here.
+    #[command(after_help = "Examples:\n  rtbench engines\n  rtbench engines --json")]
     Engines {
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// Trace the SPD workload for one scene with one engine.
+    #[command(
+        after_help = "Examples:\n  rtbench render --scene gears --engine bvh8 --png gears.png                  # trace gears4, save the image\n  rtbench render --scene balls --sf 2 --engine embree --size 128 --json       # ray counts, times, memory as JSON\n  rtbench render --scene mount10/ --engine breadth-first --set memory=32MiB   # out of core, from a scene store"
+    )]
     Render(RenderArgs),
     /// Cross-check an engine's hits against Embree or the reference engine on the same rays.
+    #[command(
+        after_help = "Examples:\n  rtbench check --scene balls --sf 2 --engine bvh8                       # hits against Embree on the same rays\n  rtbench check --scene tetra --engine grid --against reference --json\n  rtbench check --suite hard --engine bvh4,embree --out out/hard         # hard cases, acne, speed against error"
+    )]
     Check(CheckArgs),
     /// 001's statistics of a BVH of any width 2–16 (even), built but not traced.
+    #[command(
+        after_help = "Examples:\n  rtbench tree-stats --scene tree --sf 10 --tessellate --width 16"
+    )]
     TreeStats(TreeStatsArgs),
     /// Remeasure a published table: `reproduce list`, `reproduce <id> --out DIR`.
+    #[command(
+        after_help = "Examples:\n  rtbench reproduce list                                         # every table, its seed, fidelity counts and run time\n  rtbench reproduce spd-stats --engines embree --out out/repro   # writes out/repro/spd-stats.md, .json, .html\n  rtbench reproduce nakamaru-3.1 --quick --out out/repro         # a scaled-down run"
+    )]
     Reproduce(ReproduceArgs),
     /// Many engines × scenes × SFs, each run in its own process, results to DIR/results.jsonl.
+    #[command(
+        after_help = "Examples:\n  rtbench run --engines embree,bvh8 --scenes gears --sf 2 --out out/gears\n  rtbench run --engines bvh4,bvh4:simd=off,embree --scenes standard --paired 5 --out out/simd   # variants, paired with Embree\n  rtbench run --engines all --scenes standard --threads 1,all --out out/all --resume"
+    )]
     Run(RunArgs),
     /// Raise each scene's SF until a run passes the time or memory limit.
+    #[command(
+        after_help = "Examples:\n  rtbench sweep --engines grid,bvh4,embree --scenes balls,tetra --max-seconds 60 --out out/sweep"
+    )]
     Sweep(SweepArgs),
     /// Tables and plots from a results directory.
+    #[command(
+        after_help = "Examples:\n  rtbench report out/gears                   # report.md, report.html, results.csv, summary.json, plots/\n  rtbench report out/gears --format md,csv"
+    )]
     Report(ReportArgs),
     /// Compare two results directories; exit 1 on a regression.
+    #[command(
+        after_help = "Examples:\n  rtbench compare out/yesterday out/today                         # exit 1 on a regression, naming it\n  rtbench compare out/yesterday out/today --threshold 10 --json"
+    )]
     Compare(CompareArgs),
     /// One measured run, printed as one JSON line (the child process of run and sweep).
     #[command(hide = true)]
     RunOne(RunOneArgs),
     /// Run a nightly suite, store every sample in the history, exit 1 on a detected regression.
+    #[command(
+        after_help = "Examples:\n  rtbench nightly --suite suites/nightly.toml --db out/nightly/history.sqlite --out out/nightly/run1\n  rtbench nightly --suite suites/nightly.toml --shard 1/2 --out out/n1                                 # one shard; merge, then --from\n  rtbench nightly --suite suites/nightly.toml --from out/merged --db out/nightly/history.sqlite"
+    )]
     Nightly(NightlyArgs),
     /// The nightly history: list, show, export (CSV, Bencher Metric Format), dashboard.
-    #[command(subcommand)]
+    #[command(
+        subcommand,
+        after_help = "Examples:\n  rtbench history list --db out/nightly/history.sqlite\n  rtbench history export --db out/nightly/history.sqlite --format bmf\n  rtbench history dashboard --db out/nightly/history.sqlite --out out/dashboard"
+    )]
     History(HistoryCommand),
     /// Join the results of a plan's shards (`--shard K/N`, `render --tile K/N`) into one set.
+    #[command(
+        after_help = "Examples:\n  rtbench merge out/s1 out/s2 --out out/merged                # the shards of one plan (--shard 1/2, 2/2)\n  rtbench merge out/t1 out/t2 out/t3 out/t4 --out out/image   # the tiles of render --tile K/4"
+    )]
     Merge(MergeArgs),
     /// A plan's jobs, groups and shards, without running them (for cluster job arrays).
+    #[command(
+        after_help = "Examples:\n  rtbench plan run --engines all --scenes standard --out out/all --shards 4\n  rtbench plan --json nightly --suite suites/nightly.toml                     # jobs, groups and slices as JSON"
+    )]
     Plan(PlanCmdArgs),
+    /// The RTBENCH_* environment variables: each one's value here, accepted forms and effect.
+    Env {
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Args, Debug, Clone)]
@@ -84,6 +138,7 @@ pub struct NightlyArgs {
     /// measuring here.
     #[arg(long, value_name = "DIR")]
     pub from: Option<PathBuf>,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
 }
@@ -92,51 +147,62 @@ pub struct NightlyArgs {
 pub enum HistoryCommand {
     /// Every night of the history.
     List {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// One night (default: the latest): its findings and gated metrics.
     Show {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
         /// A night's id, or `latest`.
         #[arg(long)]
         run: Option<String>,
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// Every metric of every night as CSV, or one night (default: the latest) as Bencher Metric Format JSON.
     Export {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
         /// `csv` or `bmf`.
         #[arg(long, default_value = "csv")]
         format: String,
+        /// A night's id, or `latest` (the default).
         #[arg(long)]
         run: Option<String>,
     },
     /// The detection run again over a suite's nights in the history, each night against the
     /// nights before it, with the suite file's settings: which nights report a regression.
     Replay {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
         /// The suite file (its name selects the nights; its settings drive the detection).
         #[arg(long)]
         suite: PathBuf,
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// `PRAGMA integrity_check` of the history, and its nights (exit 1 when not whole).
     Check {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
     },
     /// The static HTML dashboard (DIR/index.html) of the history.
     Dashboard {
+        /// The history (SQLite file).
         #[arg(long)]
         db: PathBuf,
+        /// The folder the dashboard (index.html) is written to.
         #[arg(long)]
         out: PathBuf,
     },
@@ -162,6 +228,7 @@ pub struct PlanArgs {
     /// parallelism is refused).
     #[arg(long, default_value = "1")]
     pub threads: String,
+    /// Image size in pixels (rays go through the (size+1)² pixel corners).
     #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
     pub size: u32,
     /// Skip the cross-check against Embree.
@@ -188,6 +255,7 @@ pub struct PlanArgs {
     /// Skip runs the results directory already holds.
     #[arg(long)]
     pub resume: bool,
+    /// The results directory (results.jsonl, env.json; created if missing).
     #[arg(long)]
     pub out: PathBuf,
     /// Run only the K-th of N deterministic slices of the plan (a scene's Embree run stays with the
@@ -223,6 +291,7 @@ pub struct SweepArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct ReportArgs {
+    /// A results directory written by run, sweep, merge or nightly --out.
     pub dir: PathBuf,
     /// Formats, comma-separated: md, csv, json, svg, png, html (default: all).
     #[arg(long, default_value = "md,csv,json,svg,png,html")]
@@ -231,11 +300,14 @@ pub struct ReportArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct CompareArgs {
+    /// The baseline results directory.
     pub a: PathBuf,
+    /// The results directory judged against it.
     pub b: PathBuf,
     /// Slowdown (percent of the ratio to Embree) below which a change is noise.
     #[arg(long, default_value_t = 5.0)]
     pub threshold: f64,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
 }
@@ -244,17 +316,22 @@ pub struct CompareArgs {
 pub struct RunOneArgs {
     #[command(flatten)]
     pub scene: SceneFlag,
+    /// The engine (see `rtbench engines`), e.g. `bvh8`, `embree`, `plugin:PATH`.
     #[arg(long)]
     pub engine: String,
+    /// Engine settings, `key=value` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
+    /// Repeats of the run (min, median, max are reported).
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
+    /// Image size in pixels (rays go through the (size+1)² pixel corners).
     #[arg(long, default_value_t = 512)]
     pub size: u32,
+    /// Skip the cross-check against Embree.
     #[arg(long)]
     pub no_check: bool,
     /// Also time N back-to-back pairs of this engine and Embree in this process (alternating
@@ -293,9 +370,9 @@ pub struct ReproduceArgs {
     /// (beside the HDD-like 8 ms and the SSD-like 0.1 ms).
     #[arg(long)]
     pub fault_ms: Option<f64>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, value_parser = crate::measure::threads::parse_threads)]
+    pub threads: Option<crate::measure::threads::Threads>,
     /// yamauchi-* only: image size of 003's pass (default 512, 128 with --quick).
     #[arg(long)]
     pub size: Option<u32>,
@@ -305,22 +382,32 @@ pub struct ReproduceArgs {
     /// yamauchi-* only: SPD scenes, comma-separated (standard SFs).
     #[arg(long)]
     pub scenes: Option<String>,
+    /// With `list`: the paper→code map as Markdown (the README's copy is checked against it).
+    #[arg(long, conflicts_with = "json")]
+    pub markdown: bool,
     /// A table's option `key=value` (repeatable; `reproduce list --json` lists each table's keys).
     /// The flags above are the same keys by their own names.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
 }
 
 #[derive(Subcommand, Debug)]
 pub enum SceneCommand {
-    /// The SPD programs, their standard size factors and object counts.
+    /// The SPD programs and the room, their standard size factors and object counts; mesh files
+    /// (OBJ, PLY, glTF) are accepted wherever a program name is.
+    #[command(after_help = "Examples:\n  rtbench scene list\n  rtbench scene list --json")]
     List {
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// Write a scene as NFF, as the SPD C program prints it.
+    #[command(
+        after_help = "Examples:\n  rtbench scene gen balls --sf 2                          # NFF on stdout, as SPD's balls -s 2 -r 1\n  rtbench scene gen teapot --tessellate -o teapot12.nff"
+    )]
     Gen {
         #[command(flatten)]
         scene: SceneArg,
@@ -334,6 +421,9 @@ pub enum SceneCommand {
     },
     /// Write a scene store for the breadth-first engine (bounding-box and geometry files,
     /// header.json), streaming from the generator without holding the scene.
+    #[command(
+        after_help = "Examples:\n  rtbench scene store mount --sf 10 -o mount10/\n  rtbench scene store mount --sf 12 --layout basic --compress gzip -o m12/"
+    )]
     Store {
         #[command(flatten)]
         scene: SceneArg,
@@ -358,7 +448,7 @@ pub enum SceneCommand {
         hierarchy: bool,
         /// Write in segments of N objects, each made durable with a checkpoint
         /// (`segments.json`; compressed: one gzip member, zstd frame or zstd block ends per segment), in place: a store too
-        /// large for one session (seed 000 Table 4.3). Not with --hierarchy.
+        /// large to write in one sitting (seed 000 Table 4.3). Not with --hierarchy.
         #[arg(long, value_name = "N")]
         segment: Option<u64>,
         /// Go on with the store being written in the directory (with --segment).
@@ -371,10 +461,14 @@ pub enum SceneCommand {
         /// before writing and held while writing: 1234, 512M, 8GiB …
         #[arg(long, value_name = "BYTES", default_value = "16GiB")]
         max_bytes: String,
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
     /// Count a scene's primitives by streaming it.
+    #[command(
+        after_help = "Examples:\n  rtbench scene stats balls --sf 4 --tessellate --json\n  rtbench scene stats rings --sf 36 --view data/views/rings368m.json"
+    )]
     Stats {
         #[command(flatten)]
         scene: SceneArg,
@@ -382,6 +476,7 @@ pub enum SceneCommand {
         /// as data/views/rings368m.json; 512×512 eye rays), in place of the scene's own camera.
         #[arg(long, value_name = "FILE")]
         view: Option<PathBuf>,
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
@@ -414,6 +509,14 @@ pub struct SceneOpts {
     pub force: bool,
 }
 
+// Here rather than in source.rs, so that nothing below the command line imports cli.rs.
+impl crate::source::Source {
+    /// The scene of a command's `<scene> [--sf N] [--tessellate [RES]] [--hash …]` arguments.
+    pub fn from_args(scene: &str, o: &SceneOpts) -> crate::error::Result<Self> {
+        Self::resolve(scene, o.sf, o.tessellate, o.hash)
+    }
+}
+
 fn parse_hash(s: &str) -> Result<MountHash, String> {
     s.parse()
 }
@@ -421,6 +524,7 @@ fn parse_hash(s: &str) -> Result<MountHash, String> {
 /// `--scene <program|FILE.nff> [--sf N] …` for render and check.
 #[derive(Args, Debug, Clone)]
 pub struct SceneFlag {
+    /// An SPD program (balls, gears, mount, …), an NFF, OBJ, PLY or glTF file, or a scene store folder.
     #[arg(long)]
     pub scene: String,
     #[command(flatten)]
@@ -431,6 +535,7 @@ pub struct SceneFlag {
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneFlag,
+    /// The engine (see `rtbench engines`), e.g. `bvh8`, `embree`, `plugin:PATH`.
     #[arg(long)]
     pub engine: String,
     /// Engine settings, `key=value` (repeatable).
@@ -439,11 +544,13 @@ pub struct RenderArgs {
     /// Image size in pixels (rays go through the (size+1)² pixel corners).
     #[arg(long, default_value_t = 512, allow_hyphen_values = true)]
     pub size: u32,
-    /// Threads for tracing (default: all cores; more than the machine runs at once is refused).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
+    /// Also write the image as a PNG file.
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
     /// Pixel corners whose ray trees are traced to the end before the next chunk starts (in-memory
@@ -467,16 +574,19 @@ pub struct MergeArgs {
     /// The merged results set (a new or empty directory).
     #[arg(long)]
     pub out: PathBuf,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
 }
 
 #[derive(Args, Debug, Clone)]
 pub struct PlanCmdArgs {
-    /// How many shards the plan would be split into (default: one per group).
-    #[arg(long)]
+    /// How many shards the plan would be split into, the N of `--shard K/N` (default: one per
+    /// group); before or after the subcommand.
+    #[arg(long, global = true, value_name = "N")]
     pub shards: Option<u32>,
-    #[arg(long)]
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
+    #[arg(long, global = true)]
     pub json: bool,
     #[command(subcommand)]
     pub what: PlanWhat,
@@ -502,6 +612,7 @@ pub struct TreeStatsArgs {
     /// BVH settings, `key=value` (builder, wide, leaf, bins, split_leaves; see `rtbench engines`).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
 }
@@ -516,6 +627,7 @@ pub struct CheckArgs {
     /// The engine to check; with --suite, engines comma-separated (default: every available one).
     #[arg(long)]
     pub engine: Option<String>,
+    /// Engine settings, `key=value` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// The engine to check against: embree (default) or reference.
@@ -527,9 +639,10 @@ pub struct CheckArgs {
     /// Minimum hit agreement (fraction of rays) for the check to pass (default 0.9999).
     #[arg(long)]
     pub threshold: Option<f64>,
-    /// Threads (at most the available parallelism; more is refused with exit 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    /// Threads: a count, or all the machine runs at once (default 1; more is refused with exit 2).
+    #[arg(long, default_value = "1", value_parser = crate::measure::threads::parse_threads)]
+    pub threads: crate::measure::threads::Threads,
+    /// Print one JSON document on stdout (progress and logs stay on stderr).
     #[arg(long)]
     pub json: bool,
     /// Run a suite instead of one scene: `hard` (hard cases, acne, speed against error) or

@@ -1,5 +1,5 @@
 //! How rtbench fails: every error is one line on stderr and an exit status
-//! (../shared/CLI.md): 1 for a failed check, 2 for bad usage or bad input.
+//! (docs/concepts.md): 1 for a failed check, 2 for bad usage or bad input.
 
 use std::fmt;
 

@@ -134,8 +134,8 @@ fn feed(r: Reader, files: &[(String, Vec<u8>)], dir: &Path) -> bool {
             for (n, b) in files {
                 std::fs::write(dir.join(n), b).unwrap();
             }
-            crate::commands::merge::load_shards(&[dir.to_path_buf()])
-                .and_then(|s| crate::commands::merge::merged_records(&s))
+            crate::runs::merge::load_shards(&[dir.to_path_buf()])
+                .and_then(|s| crate::runs::merge::merged_records(&s))
                 .is_ok()
         }
     }

@@ -1,4 +1,4 @@
-//! `rtbench`: the command-line harness. See ../shared/CLI.md for the contract.
+//! `rtbench`: the command-line harness. `rtbench --help` lists the commands; docs/ explains them.
 
 // Every `print!`/`println!` of this crate goes through these: a failed write to stdout (`> /dev/full`)
 // is kept and reported once at the end (exit 2) instead of std's panic. Defined before the
@@ -22,11 +22,13 @@ mod cli;
 mod commands;
 mod error;
 mod history;
+mod measure;
 mod nightly;
 mod output;
 mod reproduce;
 mod runs;
 mod select;
+mod shard;
 mod source;
 mod suite;
 mod workload;
@@ -40,6 +42,10 @@ use error::Result;
 use source::Source;
 
 fn run(cli: Cli) -> Result<()> {
+    // `rtbench env` shows the variables as they are, malformed ones too.
+    if !matches!(cli.command, Command::Env { .. }) {
+        measure::vars::load()?;
+    }
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
         Command::Scene(SceneCommand::Gen {
@@ -104,6 +110,7 @@ fn run(cli: Cli) -> Result<()> {
             json,
         }) => commands::scene::stats(&Source::from_args(&scene.scene, &scene.opts)?, json),
         Command::Engines { json } => commands::engines::list(json),
+        Command::Env { json } => commands::env::list(json),
         Command::Render(a) => commands::render::run(&a),
         Command::Check(a) => commands::check::run(&a),
         Command::TreeStats(a) => commands::tree_stats::run(&a),
@@ -112,11 +119,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),
         Command::Report(a) => commands::runs::report(&a),
         Command::Compare(a) => commands::runs::compare(&a),
-        Command::Nightly(a) => nightly::run(&a),
-        Command::History(c) => nightly::history_cmd(&c),
+        Command::Nightly(a) => commands::nightly::run(&a),
+        Command::History(c) => commands::history::run(&c),
         Command::Merge(a) => commands::merge::run(&a),
         Command::Plan(a) => commands::plan::run(&a),
-        Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json),
+        Command::Reproduce(a) if a.id == "list" => reproduce::list(a.json, a.markdown),
         Command::Reproduce(a) => {
             let out = a
                 .out
@@ -146,6 +153,42 @@ fn reproduce_pairs(a: &cli::ReproduceArgs) -> Result<Vec<(String, String)>> {
     Ok(pairs)
 }
 
+/// clap's whole message on one line: the problem, the arguments it names (a missing argument is
+/// on the lines after "were not provided:") and its tip ("a similar argument exists"), without
+/// the usage and "For more information" lines that follow.
+fn one_line(text: &str) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if line.is_empty() {
+            continue;
+        }
+        let line = line.trim_start_matches("error: ");
+        match parts.last_mut() {
+            Some(last) if last.ends_with(':') => {
+                last.push(' ');
+                last.push_str(line);
+            }
+            _ => parts.push(line.to_string()),
+        }
+    }
+    if parts.is_empty() {
+        return "bad usage".to_string();
+    }
+    let mut out = parts.remove(0);
+    for p in parts {
+        if p.starts_with("tip:") {
+            out.push_str(&format!(" ({p})"));
+        } else {
+            out.push_str(&format!(", {p}"));
+        }
+    }
+    out
+}
+
 fn main() {
     // Rust ignores SIGPIPE, so `rtbench … | head` would panic in println!. Restore the default:
     // the process ends quietly when its reader goes away, as other Unix tools do.
@@ -172,19 +215,36 @@ fn main() {
                     },
                 );
             }
-            // One line: clap's first line names the problem and the argument.
-            let text = e.render().to_string();
-            let first = text
-                .lines()
-                .next()
-                .unwrap_or("bad usage")
-                .trim_start_matches("error: ");
-            eprintln!("rtbench: {first}");
+            eprintln!("rtbench: {}", one_line(&e.render().to_string()));
             std::process::exit(2);
         }
     };
     if let Err(e) = run(cli).and_then(|()| output::stdout_status()) {
         eprintln!("rtbench: {e}");
         std::process::exit(e.exit_code());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[test]
+    fn a_usage_error_keeps_the_argument_and_the_tip() {
+        let missing = "error: the following required arguments were not provided:\n  --scenes <SCENES>\n\nUsage: rtbench run --engines <ENGINES> --scenes <SCENES> --out <OUT>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            one_line(missing),
+            "the following required arguments were not provided: --scenes <SCENES>"
+        );
+        let two = "error: the following required arguments were not provided:\n  --scenes <SCENES>\n  --out <OUT>\n\nUsage: x\n";
+        assert_eq!(
+            one_line(two),
+            "the following required arguments were not provided: --scenes <SCENES>, --out <OUT>"
+        );
+        let tip = "error: unexpected argument '--shards' found\n\n  tip: a similar argument exists: '--shard'\n\nUsage: rtbench run --shard <K/N>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            one_line(tip),
+            "unexpected argument '--shards' found (tip: a similar argument exists: '--shard')"
+        );
     }
 }

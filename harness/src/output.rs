@@ -158,3 +158,8 @@ pub mod interrupt {
         Guard(c)
     }
 }
+
+/// Bytes as lowercase hexadecimal (digests in results and manifests).
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}

@@ -18,11 +18,6 @@ pub enum Source {
 }
 
 impl Source {
-    /// The scene of a command's `<scene> [--sf N] [--tessellate [RES]] [--hash …]` arguments.
-    pub fn from_args(scene: &str, o: &crate::cli::SceneOpts) -> Result<Source> {
-        Source::resolve(scene, o.sf, o.tessellate, o.hash)
-    }
-
     pub fn resolve(
         scene: &str,
         sf: Option<u32>,

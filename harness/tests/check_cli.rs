@@ -15,7 +15,7 @@ fn embree_available() -> bool {
         .any(|e| e["name"] == "embree" && e["available"] == true)
 }
 
-/// Issue 3, acceptance 2: hit agreement ≥ 99.99%, relative t error p99 ≤ 1e-5, on the standard
+/// The engines' cross-check bound: hit agreement ≥ 99.99%, relative t error p99 ≤ 1e-5, on the standard
 /// 512×512 workload. (At 128×128 rings2 falls to 99.98%: its leftmost column of eye rays grazes
 /// the backdrop's edge, where f32 triangles and the f64 polygon may differ; that column is 1/129
 /// of the rays there and 1/513 here.)
@@ -128,7 +128,7 @@ fn same_image_from_two_engines_when_hits_agree() {
     assert_eq!(a["image"]["sha256"], b["image"]["sha256"]);
 }
 
-/// Issue 5's bad BVH settings: an unknown builder, leaf size 0, width 3 (and a SAH width that is
+/// Bad BVH settings: an unknown builder, leaf size 0, width 3 (and a SAH width that is
 /// not a power of two) exit 2 with one line; `tree-stats` builds 001's wider trees.
 #[test]
 fn bad_bvh_settings_exit_2() {

@@ -1,4 +1,4 @@
-//! Faults of the out-of-core method from the command line (issue 19, acceptance 6): a hierarchy
+//! Faults of the out-of-core method from the command line: a hierarchy
 //! file that disagrees with its level below, and a full disk during preprocessing. Each must end
 //! in exit status 2 with one line on stderr, and leave nothing half-written behind. (A truncated
 //! on-disk grid is `hires_cli`'s `every_grid_renders_the_same_image_and_a_truncated_grid_exits_2`.)
@@ -6,8 +6,8 @@
 //! The full disk is simulated with a file-size limit (`RLIMIT_FSIZE`) on the child process, with
 //! `SIGXFSZ` ignored: every write past the limit then fails with EFBIG, as a write on a full disk
 //! fails with ENOSPC, without a tmpfs or a loop mount (which need root). The code under test sees
-//! an I/O error from `write` in both cases; `docs/benchmarks.md` records the same run on a
-//! 3,600 KiB tmpfs (ENOSPC).
+//! an I/O error from `write` in both cases; the same run on a 3,600 KiB tmpfs gives
+//! ENOSPC instead.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! The bounding-box hierarchy from the command line (issue 19, seed 000 §4.2.2 "B"):
+//! The bounding-box hierarchy from the command line (seed 000 §4.2.2 "B"):
 //! `scene store --hierarchy`, `hierarchy=on` giving the image without it (and the in-memory scene's), a damaged
 //! hierarchy refused (exit 2, one line), and `reproduce nakamaru-4.1` on one tiny row.
 

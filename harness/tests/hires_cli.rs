@@ -1,4 +1,4 @@
-//! The high-resolution grid from the command line (issue 19, seed 000 §4.3): `grid=single` and
+//! The high-resolution grid from the command line (seed 000 §4.3): `grid=single` and
 //! `grid=two-level` give the image of the basic grid, a truncated on-disk grid is refused (exit 2,
 //! one line, no temporary left), and `reproduce nakamaru-4.2` / `nakamaru-fig4.4` on tiny rows.
 

@@ -1,4 +1,4 @@
-//! The reproducers of issue 14 (hostile inputs): each is refused with exit 2 and one line naming
+//! Hostile inputs: each is refused with exit 2 and one line naming
 //! the input, or gives the correct result where the input is valid. Never a panic (101), an
 //! abort, or a run that does not end.
 
@@ -33,7 +33,7 @@ impl Drop for Dir {
     }
 }
 
-/// The issue's scene: a view, and two spheres; `view` and `spheres` replace their parts.
+/// The reported scene: a view, and two spheres; `view` and `spheres` replace their parts.
 fn scene(view: &str, spheres: &str) -> String {
     format!("v\nfrom 0 0 -5\nat 0 0 0\n{view}\nhither 1\nresolution 8 8\n{spheres}")
 }

@@ -1,4 +1,4 @@
-//! The `object-space` engine from the command line (issue 8): bad machine settings are one-line
+//! The `object-space` engine from the command line: bad machine settings are one-line
 //! input errors, and the simulated clocks of a render are the same on 1 and 2 threads.
 
 mod common;

@@ -83,7 +83,7 @@ fn kimura_trees_quick_four_ary_is_shallower() {
             depth(2)
         );
     }
-    // Issue 17: both memory readings and the render timings of Fig. 3.17 are there, each row labelled.
+    // Both memory readings and the render timings of Fig. 3.17 are there, each row labelled.
     let claims: Vec<(&str, &str)> = v["rows"]
         .as_array()
         .unwrap()
@@ -192,7 +192,7 @@ fn unknown_engines_are_refused() {
     );
 }
 
-/// Issue 14's reproducer: options that leave nothing to run, or name what does not exist, are refused
+/// Options that leave nothing to run, or name what does not exist, are refused
 /// before anything is measured (they used to give an empty table and exit 0).
 #[test]
 fn options_that_leave_nothing_to_run_are_refused() {

@@ -1,4 +1,4 @@
-//! `rtbench run`, `sweep`, `report`, `compare` (issue 6): results survive a kill, `--resume`
+//! `rtbench run`, `sweep`, `report`, `compare`: results survive a kill, `--resume`
 //! completes them, crashing and memory-hungry runs are recorded as failed without stopping the
 //! sweep, and `compare` tells noise from a planted slowdown.
 //!
@@ -296,8 +296,8 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
     // (queries are 75–90% of a trace here). A 20% plant (+13–16%) failed in 3 of 7 runs of this
     // test on a loaded machine, as did the same-commit check at the default 5% threshold: this
     // test checks that compare matches runs, names a large regression and spares Embree, with
-    // margins wide of this machine's noise. How small a change is caught is issue 16's benchmark
-    // (docs/benchmarks.md), not a test.
+    // margins wide of this machine's noise. How small a change is caught is measured by the
+    // nightly's planted regressions (RTBENCH_PLANT), not a test.
     quick_run(&c, Some("1.0"));
     let same = rtbench()
         .args(["compare", "--threshold", "30"])
@@ -344,7 +344,7 @@ fn compare_passes_noise_and_names_a_planted_slowdown() {
     }
 }
 
-/// `--paired-threads N` (issue 20, acceptance 3): a two-thread run records N pairs of one- and
+/// `--paired-threads N`: a two-thread run records N pairs of one- and
 /// two-thread traces, each pair's speed-up its own two wall times' ratio; the one-thread run of
 /// the same plan records none; `report` shows the speed-up table. `RTBENCH_MAX_THREADS=2` lets
 /// the two-thread run start on a machine (or a `taskset`) with one core: only the record's
@@ -444,7 +444,7 @@ fn paired_threads_above_the_limit_is_refused() {
     assert!(err.contains("--paired-threads 1001"), "{err}");
 }
 
-/// `RTBENCH_SCHED=bands` (issue 20, acceptance 3): a two-thread render prints one `sched thread`
+/// `RTBENCH_SCHED=bands`: a two-thread render prints one `sched thread`
 /// line per pool thread (run + run-queue wait + off-CPU seconds make its wall seconds, the bands
 /// it counts are its band lines), one `sched cpu` line per CPU and one `sched band` line per
 /// band, and the image is the one rendered without it.
@@ -521,7 +521,7 @@ fn sched_lines_account_each_pool_thread() {
     );
 }
 
-/// Session 14 (issue 20, acceptance 3): a run-one of Embree drops its untimed engine before the
+/// A run-one of Embree drops its untimed engine before the
 /// timed ones; releasing that engine's Embree device lifted TBB's one-thread limit and oneTBB
 /// started a worker thread that spun in `sched_yield` beside every later trace. Now the process
 /// has no thread beyond its own: the main thread, the two-thread pool and the one-thread pool of

@@ -1,4 +1,4 @@
-//! `rtbench scene …` as scripts use it (../shared/CLI.md): counts against the SPD formulas,
+//! `rtbench scene …` as scripts use it (docs/concepts.md): counts against the SPD formulas,
 //! computed here independently of the generators, by streaming; bad input → exit 2, one line.
 
 mod common;
@@ -19,7 +19,7 @@ fn stats(program: &str, sf: u32, extra: &[&str]) -> Value {
     serde_json::from_slice(&out.stdout).expect("one JSON document on stdout")
 }
 
-/// The SPD count formulas (../shared/SPD.md), as u128 so nothing here can overflow.
+/// The SPD count formulas (docs/concepts.md), as u128 so nothing here can overflow.
 fn formula(program: &str, sf: u32) -> u128 {
     let s = sf as u128;
     match program {

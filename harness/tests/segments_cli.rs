@@ -1,4 +1,4 @@
-//! Seed 000 Table 4.3's groundwork from the command line (issue 19): a store written in segments
+//! Seed 000 Table 4.3's groundwork from the command line: a store written in segments
 //! across runs (`scene store --segment N --max-seconds S`, then `--resume`) renders as the store
 //! written at once; the rings368m view file counts objects in view; and `reproduce nakamaru-4.3`
 //! stops at a checkpoint under a time budget and finishes when resumed.
@@ -227,7 +227,7 @@ fn nakamaru_4_3_runs_a_scenes_basic_rows_before_its_split_store() {
 }
 
 /// `methods` measures a row one method an invocation (a 10^9-object row takes more than a
-/// session per method): S+G+B first with no basic store written, then the capped basic run,
+/// invocation per method): S+G+B first with no basic store written, then the capped basic run,
 /// whose pass model takes its totals from the S+G+B run saved before, then S+G (its split store
 /// written again when the disk no longer holds it), which finishes the rows and removes their
 /// stores.

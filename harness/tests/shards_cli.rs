@@ -1,4 +1,4 @@
-//! Beyond one machine (issue 22): a run split with `--shard K/N` and joined with `rtbench merge`
+//! Beyond one machine: a run split with `--shard K/N` and joined with `rtbench merge`
 //! equals the unsharded run (times aside); a tiled out-of-core render merges to the one-machine
 //! image; `merge` refuses mixed, missing and doubled shards with one line and writes nothing; and,
 //! where `scripts/slurm/local-cluster.sh` can start a one-node Slurm cluster, a 4-task job array of

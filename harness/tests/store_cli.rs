@@ -1,4 +1,4 @@
-//! `rtbench scene store` and the out-of-core render (issue 7): a store traced by the
+//! `rtbench scene store` and the out-of-core render: a store traced by the
 //! breadth-first engine gives Embree's in-memory image; bad stores, engines and spill
 //! directories are input errors (exit 2, one line) that leave nothing behind.
 

@@ -49,18 +49,26 @@ impl<'a> Anchors<'a> {
         let a = self.anchor(run)?;
         Some(run.time_s.trace.median / a.time_s.trace.median)
     }
+}
 
-    /// The same over the times `compare` uses (CPU time when recorded, see
-    /// [`crate::results::Timings::trace_for_compare`]).
-    pub fn compare_ratio(&self, run: &RunRecord) -> Option<f64> {
-        if !run.ok() {
-            return None;
-        }
-        let a = self.anchor(run)?;
-        let (x, y) = (
-            run.time_s.trace_for_compare().median,
-            a.time_s.trace_for_compare().median,
-        );
-        (y > 0.0).then(|| x / y)
+/// Sets every ok run's [`RunRecord::ratio_to_embree`] from its Embree run in `records` (trace CPU
+/// time when recorded, else wall time; the quotient of geometric means with its Welch interval);
+/// clears it where there is no Embree run or too few repeats.
+pub fn attach_ratios(records: &mut [RunRecord]) {
+    let ratios: Vec<Option<crate::interval::Interval>> = {
+        let anchors = Anchors::of(records);
+        records
+            .iter()
+            .map(|r| {
+                let a = anchors.anchor(r).filter(|_| r.ok() && r.engine != EMBREE)?;
+                crate::interval::of_quotient(
+                    &r.time_s.trace_for_compare().samples,
+                    &a.time_s.trace_for_compare().samples,
+                )
+            })
+            .collect()
+    };
+    for (r, q) in records.iter_mut().zip(ratios) {
+        r.ratio_to_embree = q;
     }
 }

@@ -3,16 +3,20 @@
 //! Runs are matched by key. Two signals, following the measurement rules (docs: ARCHITECTURE.md):
 //! - exact counters (nodes visited, primitive tests …) are free of noise, so any change is a finding;
 //! - times are compared as each engine's trace time over Embree's *within its own set*, so whatever slowed
-//!   or sped up the whole machine between A and B cancels. A ratio that grew by more than
-//!   max(threshold, 2 × the runs' own noise) is a regression, where a ratio's noise combines the
-//!   engine's and Embree's (σ ≈ 1.4826 × median absolute deviation of the repeats, relative), the
-//!   larger of set A's and set B's. Embree's own times are the yardstick (ratio 1)
-//!   and are not compared; its counters are;
-//! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), a
-//!   median speed-up that fell by more than max(threshold, 2 × the pairs' noise) is a regression
-//!   (Embree's too: it measures how the harness splits the trace as much as Embree).
+//!   or sped up the whole machine between A and B cancels. The change of that ratio from A to B is judged
+//!   on its 95 % interval ([`crate::interval`]): on the log scale, B's ratio minus A's, each the mean log
+//!   of the engine's repeats minus the mean log of Embree's (or the mean log of the paired ratios where
+//!   both sets timed pairs, `run --paired N`), with Welch–Satterthwaite degrees of freedom. A regression
+//!   needs the whole interval above +threshold, an improvement the whole interval below −threshold; a
+//!   change whose estimate passes the threshold while its interval reaches back inside is reported as
+//!   "too few samples to decide", and so is a run with fewer than two samples on a side. Embree's own
+//!   times are the yardstick (ratio 1) and are not compared; its counters are;
+//! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), the
+//!   speed-up's change is judged the same way on its pairs (Embree's too: it measures how the harness
+//!   splits the trace as much as Embree).
 
 use crate::anchor::{Anchors, EMBREE};
+use crate::interval::{self, LogMean};
 use crate::number;
 use crate::results::{read_environment, read_results, Environment, RunRecord};
 use crate::summary::latest_per_key;
@@ -46,6 +50,9 @@ pub enum FindingKind {
     /// The speed-up over one thread (`run --paired-threads N`, in both sets) moved past the
     /// tolerance: a fall is a regression, a rise an improvement.
     ThreadSpeedup,
+    /// A time ratio or speed-up whose change could not be decided: fewer than two samples on a
+    /// side, or an estimate past the threshold with an interval that reaches back inside it.
+    Undecided,
 }
 
 /// One difference between the two sets, about one run.
@@ -61,8 +68,15 @@ pub struct Finding {
     pub new: Value,
     /// (new − old) / old, in percent, where that means something.
     pub change_pct: Option<f64>,
-    /// The change a time had to pass to count: max(threshold, the runs' own spread), in percent.
+    /// The change a time had to pass to count (the threshold), in percent.
     pub tolerance_pct: Option<f64>,
+    /// The 95 % interval of `change_pct`, in percent, for times and speed-ups.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_pct: Option<[f64; 2]>,
+    /// The samples behind a time or speed-up finding: A's and B's (repeats of the run and of
+    /// Embree's run, or pairs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub samples: Option<[usize; 2]>,
     /// One line for people.
     pub message: String,
 }
@@ -78,14 +92,16 @@ pub struct Comparison {
     pub b_commit: Option<String>,
     /// What differs between the machines A and B were measured on (from their `env.json`): the
     /// CPU model, its flags, cores, memory, OS, Rust compiler, Embree. Ratios to Embree then
-    /// measure the machines as well as the code (issue 20, session 15: a host with AVX-512
-    /// replaced an AVX2 one between sessions, and every ratio moved).
+    /// measure the machines as well as the code (a host with AVX-512
+    /// replaced an AVX2 one between two runs, and every ratio moved).
     pub machine_differences: Vec<String>,
     pub threshold_pct: f64,
     /// Keys present in both sets.
     pub matched: usize,
     /// Ratios to Embree compared.
     pub times_compared: usize,
+    /// Ratios and speed-ups whose change could not be decided (see [`FindingKind::Undecided`]).
+    pub undecided: usize,
     /// Counter values compared.
     pub counters_compared: usize,
     pub regressions: Vec<Finding>,
@@ -127,11 +143,12 @@ impl Comparison {
         }
         let _ = writeln!(
             s,
-            "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%\n",
+            "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%, judged on 95 % intervals ({} too few samples to decide)\n",
             self.matched,
             self.times_compared,
             self.counters_compared,
-            number::short(self.threshold_pct, 3)
+            number::short(self.threshold_pct, 3),
+            self.undecided
         );
         let verdict = if self.is_regression() {
             format!(
@@ -160,16 +177,27 @@ impl Comparison {
                 continue;
             }
             let _ = writeln!(s, "## {title}\n");
-            let _ = writeln!(s, "| run | what | A | B | change | tolerance |");
-            let _ = writeln!(s, "|---|---|---:|---:|---:|---:|");
+            let _ = writeln!(
+                s,
+                "| run | what | A | B | change | 95 % CI | samples A/B | tolerance |"
+            );
+            let _ = writeln!(s, "|---|---|---:|---:|---:|---:|---:|---:|");
             for f in list {
                 let pct = |p: Option<f64>| {
                     p.map(|p| format!("{}%", signed(p)))
                         .unwrap_or_else(|| "–".to_string())
                 };
+                let ci = f
+                    .interval_pct
+                    .map(|[lo, hi]| format!("[{}%, {}%]", signed(lo), signed(hi)))
+                    .unwrap_or_else(|| "–".to_string());
+                let n = f
+                    .samples
+                    .map(|[a, b]| format!("{a}/{b}"))
+                    .unwrap_or_else(|| "–".to_string());
                 let _ = writeln!(
                     s,
-                    "| `{}` | {} | {} | {} | {} | {} |",
+                    "| `{}` | {} | {} | {} | {} | {ci} | {n} | {} |",
                     f.key.replace('|', "\\|"),
                     f.what.replace('|', "\\|"),
                     cell(&f.old),
@@ -300,6 +328,7 @@ pub fn compare(a: &Path, b: &Path, threshold_pct: f64) -> Result<Comparison, Rep
         threshold_pct,
         matched: 0,
         times_compared: 0,
+        undecided: 0,
         counters_compared: 0,
         regressions: Vec::new(),
         improvements: Vec::new(),
@@ -410,6 +439,8 @@ fn finding(
         new,
         change_pct: None,
         tolerance_pct: None,
+        interval_pct: None,
+        samples: None,
         message: format!("{}: {message}", r.key),
     }
 }
@@ -442,6 +473,8 @@ fn compare_counters(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
             new: new.map(Value::from).unwrap_or(Value::Null),
             change_pct,
             tolerance_pct: Some(0.0),
+            interval_pct: None,
+            samples: None,
             message: format!("{}: counter {name}: {} → {}", ra.key, show(old), show(new)),
         });
     }
@@ -456,15 +489,29 @@ fn compare_times(
     c: &mut Comparison,
 ) {
     // Both runs timed in pairs with Embree in their own processes (`run --paired N`): those
-    // ratios, with their own spread.
+    // ratios, each set's mean log of its pairs.
     if let (Some(pa), Some(pb)) = (paired(ra), paired(rb)) {
         c.times_compared += 1;
-        let change_pct = (pb.median / pa.median - 1.0) * 100.0;
-        let spread_pct = 2.0 * pa.rel_noise().max(pb.rel_noise()) * 100.0;
-        time_finding(ra, pa.median, pb.median, change_pct, spread_pct, c);
+        let change = LogMean::of(&pb.samples)
+            .zip(LogMean::of(&pa.samples))
+            .map(|(b, a)| b.minus(&a));
+        let (qa, qb) = (geo(&pa.samples), geo(&pb.samples));
+        judge(
+            ra,
+            Judged {
+                kind: FindingKind::TimeRatio,
+                what: "trace time / Embree (paired)",
+                old: qa,
+                new: qb,
+                change,
+                samples: [pa.samples.len(), pb.samples.len()],
+                higher_is_worse: true,
+            },
+            c,
+        );
         return;
     }
-    let (Some(q_a), Some(q_b)) = (anchors_a.compare_ratio(ra), anchors_b.compare_ratio(rb)) else {
+    let (Some(ya), Some(yb)) = (anchors_a.anchor(ra), anchors_b.anchor(rb)) else {
         let missing = match (
             anchors_a.anchor(ra).is_none(),
             anchors_b.anchor(rb).is_none(),
@@ -487,58 +534,69 @@ fn compare_times(
         return;
     };
     c.times_compared += 1;
-    let change_pct = (q_b / q_a - 1.0) * 100.0;
-    // The ratio's noise: engine and Embree repeats, independent, in each set.
-    let noise = |r: &RunRecord, anchor: Option<&RunRecord>| {
-        let e = r.time_s.trace_for_compare().rel_noise();
-        let y = anchor
-            .map(|a| a.time_s.trace_for_compare().rel_noise())
-            .unwrap_or(0.0);
-        (e * e + y * y).sqrt()
+    let t = |r: &RunRecord| r.time_s.trace_for_compare().samples.clone();
+    let (ea, eb, sa, sb) = (t(ra), t(rb), t(ya), t(yb));
+    let change = match (
+        LogMean::of(&eb),
+        LogMean::of(&sb),
+        LogMean::of(&ea),
+        LogMean::of(&sa),
+    ) {
+        (Some(eb), Some(sb), Some(ea), Some(sa)) => Some(interval::combine(&[
+            (1.0, eb),
+            (-1.0, sb),
+            (-1.0, ea),
+            (1.0, sa),
+        ])),
+        _ => None,
     };
-    let spread_pct =
-        2.0 * noise(ra, anchors_a.anchor(ra)).max(noise(rb, anchors_b.anchor(rb))) * 100.0;
-    time_finding(ra, q_a, q_b, change_pct, spread_pct, c);
+    judge(
+        ra,
+        Judged {
+            kind: FindingKind::TimeRatio,
+            what: "trace time / Embree",
+            old: geo(&ea) / geo(&sa),
+            new: geo(&eb) / geo(&sb),
+            change,
+            samples: [ea.len() + sa.len(), eb.len() + sb.len()],
+            higher_is_worse: true,
+        },
+        c,
+    );
 }
 
-/// The speed-up over one thread in A against B's, when both timed it in pairs: each set's
-/// median of its pairs' ratios; the tolerance is max(threshold, 2 × the pairs' own noise), as
-/// for the ratios to Embree. Embree's own speed-up is compared too: it is a figure of the
+/// The speed-up over one thread in A against B's, when both timed it in pairs: each set's mean
+/// log of its pairs' speed-ups. Embree's own speed-up is compared too: it is a figure of the
 /// harness (how it splits the trace), not only of Embree.
 fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
     let (Some(sa), Some(sb)) = (&ra.thread_scaling, &rb.thread_scaling) else {
         return;
     };
     let (pa, pb) = (&sa.speedup, &sb.speedup);
-    let change_pct = (pb.median / pa.median.max(1e-12) - 1.0) * 100.0;
-    let tolerance_pct = c
-        .threshold_pct
-        .max(2.0 * pa.rel_noise().max(pb.rel_noise()) * 100.0);
-    if change_pct.abs() <= tolerance_pct {
-        return;
+    let change = LogMean::of(&pb.samples)
+        .zip(LogMean::of(&pa.samples))
+        .map(|(b, a)| b.minus(&a));
+    judge(
+        ra,
+        Judged {
+            kind: FindingKind::ThreadSpeedup,
+            what: "speed-up over 1 thread",
+            old: geo(&pa.samples),
+            new: geo(&pb.samples),
+            change,
+            samples: [pa.samples.len(), pb.samples.len()],
+            higher_is_worse: false,
+        },
+        c,
+    );
+}
+
+/// Geometric mean (0 for no sample).
+fn geo(x: &[f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
     }
-    let (list, word) = if change_pct < 0.0 {
-        (&mut c.regressions, "fell")
-    } else {
-        (&mut c.improvements, "rose")
-    };
-    list.push(Finding {
-        key: ra.key.clone(),
-        kind: FindingKind::ThreadSpeedup,
-        what: "speed-up over 1 thread".to_string(),
-        old: Value::from(pa.median),
-        new: Value::from(pb.median),
-        change_pct: Some(change_pct),
-        tolerance_pct: Some(tolerance_pct),
-        message: format!(
-            "{}: speed-up over 1 thread {} → {} ({}% {word}; tolerance {}%)",
-            ra.key,
-            number::ratio(pa.median),
-            number::ratio(pb.median),
-            number::short(change_pct.abs(), 3),
-            number::short(tolerance_pct, 3)
-        ),
-    });
+    (x.iter().map(|v| v.max(1e-300).ln()).sum::<f64>() / x.len() as f64).exp()
 }
 
 /// A run's paired ratios to Embree, when it has some.
@@ -548,39 +606,114 @@ fn paired(r: &RunRecord) -> Option<&crate::results::Spread> {
         .filter(|p| r.ok() && !p.samples.is_empty())
 }
 
-/// A time-ratio finding when the change passes the threshold and the ratios' own spread.
-fn time_finding(
-    ra: &RunRecord,
-    q_a: f64,
-    q_b: f64,
-    change_pct: f64,
-    spread_pct: f64,
-    c: &mut Comparison,
-) {
-    let tolerance_pct = c.threshold_pct.max(spread_pct);
-    if change_pct.abs() <= tolerance_pct {
+/// A figure of A and B and the log-scale change between them.
+struct Judged<'a> {
+    kind: FindingKind,
+    what: &'a str,
+    old: f64,
+    new: f64,
+    /// B's mean log minus A's; `None` when a side has fewer than two samples.
+    change: Option<LogMean>,
+    samples: [usize; 2],
+    /// A rise is a regression (a time ratio), else a fall is (a speed-up).
+    higher_is_worse: bool,
+}
+
+/// Decides on the interval of the change: a regression or improvement only when the whole 95 %
+/// interval lies past ±threshold; "too few samples to decide" when a side has fewer than two
+/// samples, or when the estimate passes the threshold but the interval reaches back inside.
+fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
+    let thr = c.threshold_pct;
+    let [na, nb] = j.samples;
+    let Some(change) = j.change else {
+        c.undecided += 1;
+        c.notes.push(Finding {
+            key: ra.key.clone(),
+            kind: FindingKind::Undecided,
+            what: j.what.to_string(),
+            old: Value::from(j.old),
+            new: Value::from(j.new),
+            change_pct: (j.old > 0.0).then(|| (j.new / j.old - 1.0) * 100.0),
+            tolerance_pct: Some(thr),
+            interval_pct: None,
+            samples: Some(j.samples),
+            message: format!(
+                "{}: {} {} → {}: too few samples to decide ({na} in A, {nb} in B; at least 2 a side)",
+                ra.key,
+                j.what,
+                number::ratio(j.old),
+                number::ratio(j.new)
+            ),
+        });
         return;
-    }
-    let (list, word) = if change_pct > 0.0 {
-        (&mut c.regressions, "slower")
-    } else {
-        (&mut c.improvements, "faster")
     };
-    list.push(Finding {
+    let ci = change.interval();
+    let pct = |x: f64| (x - 1.0) * 100.0;
+    let (est, lo, hi) = (pct(ci.estimate), pct(ci.lo), pct(ci.hi));
+    let worse = |x: f64| if j.higher_is_worse { x } else { -x };
+    // Past the threshold towards worse, towards better, or neither, for the whole interval.
+    let (w_lo, w_hi) = {
+        let (a, b) = (worse(lo), worse(hi));
+        (a.min(b), a.max(b))
+    };
+    let verdict = if w_lo > thr {
+        Some(true)
+    } else if w_hi < -thr {
+        Some(false)
+    } else {
+        None
+    };
+    let interval_text = format!("95 % CI [{}%, {}%]", signed(lo), signed(hi));
+    let n_text = format!("{na} samples in A, {nb} in B");
+    let mut f = Finding {
         key: ra.key.clone(),
-        kind: FindingKind::TimeRatio,
-        what: "trace time / Embree".to_string(),
-        old: Value::from(q_a),
-        new: Value::from(q_b),
-        change_pct: Some(change_pct),
-        tolerance_pct: Some(tolerance_pct),
-        message: format!(
-            "{}: trace time / Embree {} → {} ({}% {word} relative to Embree; tolerance {}%)",
-            ra.key,
-            number::ratio(q_a),
-            number::ratio(q_b),
-            number::short(change_pct.abs(), 3),
-            number::short(tolerance_pct, 3)
-        ),
-    });
+        kind: j.kind,
+        what: j.what.to_string(),
+        old: Value::from(j.old),
+        new: Value::from(j.new),
+        change_pct: Some(est),
+        tolerance_pct: Some(thr),
+        interval_pct: Some([lo, hi]),
+        samples: Some(j.samples),
+        message: String::new(),
+    };
+    match verdict {
+        Some(regressed) => {
+            let word = match (j.higher_is_worse, est > 0.0) {
+                (true, true) => "slower relative to Embree",
+                (true, false) => "faster relative to Embree",
+                (false, true) => "rose",
+                (false, false) => "fell",
+            };
+            f.message = format!(
+                "{}: {} {} → {} ({}% {word}; {interval_text}, beyond the threshold {}%; {n_text})",
+                ra.key,
+                j.what,
+                number::ratio(j.old),
+                number::ratio(j.new),
+                signed(est),
+                number::short(thr, 3)
+            );
+            if regressed {
+                c.regressions.push(f);
+            } else {
+                c.improvements.push(f);
+            }
+        }
+        None if est.abs() > thr => {
+            c.undecided += 1;
+            f.kind = FindingKind::Undecided;
+            f.message = format!(
+                "{}: {} {} → {} ({}%; {interval_text} reaches inside the threshold {}%): too few samples to decide ({n_text})",
+                ra.key,
+                j.what,
+                number::ratio(j.old),
+                number::ratio(j.new),
+                signed(est),
+                number::short(thr, 3)
+            );
+            c.notes.push(f);
+        }
+        None => {}
+    }
 }

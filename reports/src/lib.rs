@@ -25,6 +25,7 @@ mod csv;
 mod document;
 mod error;
 mod html;
+pub mod interval;
 mod markdown;
 pub mod number;
 pub mod plot;
@@ -34,14 +35,15 @@ mod scaling;
 mod summary;
 mod table;
 
-pub use anchor::EMBREE;
+pub use anchor::{attach_ratios, EMBREE};
 pub use compare::{compare, machine_differences, Comparison, Finding, FindingKind};
 pub use document::{Block, Document, Table};
 pub use error::ReportError;
+pub use interval::Interval;
 pub use report::{write_report, Format};
 pub use results::{
     read_environment, read_results, run_key, CheckResult, Environment, ReadError, RunRecord,
-    SceneInfo, Spread, Timings,
+    Sample, SceneInfo, Spread, Timings,
 };
 pub use scaling::ThreadScaling;
 pub use summary::{check_records, duplicate, engine_label, latest_per_key, Failure, Row, Summary};

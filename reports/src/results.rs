@@ -35,6 +35,31 @@ pub struct Spread {
     pub median: f64,
     pub max: f64,
     pub samples: Vec<f64>,
+    /// For ratios measured in pairs (a paired ratio to Embree, a speed-up): their geometric mean
+    /// with its 95 % interval and the number of pairs ([`crate::interval::of_ratios`]). Absent
+    /// for times, and with fewer than two pairs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interval: Option<crate::interval::Interval>,
+}
+
+/// What one timed span measured ([`Sample`]s of a run's repeats are kept whole, so that every
+/// statistic can be recomputed from the results).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Sample {
+    /// Wall seconds.
+    pub wall_s: f64,
+    /// CPU seconds of the threads that did the work (the pool's threads, summed): not Embree's
+    /// TBB workers, which spin on after a build.
+    pub thread_cpu_s: f64,
+    /// CPU seconds of the whole process.
+    pub process_cpu_s: f64,
+    /// Page faults of the process during the span: minor (no I/O) and major (I/O).
+    pub minor_faults: u64,
+    pub major_faults: u64,
+    /// Context switches of the process during the span, voluntary (it blocked or slept) and
+    /// involuntary (it was preempted): how much the machine's other load took the CPUs away.
+    #[serde(default)]
+    pub context_switches: u64,
 }
 
 impl Spread {
@@ -54,6 +79,15 @@ impl Spread {
             median,
             max: s[s.len() - 1],
             samples: samples.to_vec(),
+            interval: None,
+        }
+    }
+
+    /// [`Spread::of`] ratios measured in pairs, with the interval of their geometric mean.
+    pub fn of_ratios(samples: &[f64]) -> Spread {
+        Spread {
+            interval: crate::interval::of_ratios(samples),
+            ..Spread::of(samples)
         }
     }
 
@@ -176,6 +210,16 @@ pub struct RunRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thread_scaling: Option<crate::scaling::ThreadScaling>,
     pub image_sha256: Option<String>,
+    /// Every timed repeat of the trace, as measured (wall, CPU, page faults); `time_s.trace` and
+    /// `time_s.trace_cpu` are read from these. Empty in older results.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub samples: Vec<Sample>,
+    /// Trace CPU time over Embree's on the same scene and threads in this results set: the
+    /// quotient of the two runs' geometric means with its 95 % interval (Welch, repeats of both
+    /// runs). Set by `rtbench run` and `sweep` once Embree's run is in; absent for Embree and
+    /// where Embree did not run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio_to_embree: Option<crate::interval::Interval>,
     /// Wall seconds of the whole child process.
     pub wall_s: f64,
     pub finished_at: String,

@@ -1,7 +1,7 @@
 //! Speed-up over one thread, measured in pairs in one process (`rtbench run --paired-threads N`).
 //!
 //! On a shared machine two separate runs (one at one thread, one at two) minutes apart gave
-//! speed-ups from 1.47× to 2.48× for the same engine and scene (issue 20, session 12): a burst of
+//! speed-ups from 1.47× to 2.48× for the same engine and scene: a burst of
 //! other load falls on one side of the ratio only. Timing the same trace at one thread and at the
 //! run's thread count back to back, N times, alternating which goes first, puts a burst on both
 //! sides of most pairs; the median of the N ratios is the figure, their range its spread.
@@ -38,7 +38,7 @@ impl ThreadScaling {
             threads,
             one_thread_s: Spread::of(&col(|p| p.0)),
             threads_s: Spread::of(&col(|p| p.1)),
-            speedup: Spread::of(&col(|p| p.0 / p.1.max(1e-12))),
+            speedup: Spread::of_ratios(&col(|p| p.0 / p.1.max(1e-12))),
             one_thread_cpu_s: Spread::of(&col(|p| p.2)),
             threads_cpu_s: Spread::of(&col(|p| p.3)),
         }

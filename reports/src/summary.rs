@@ -2,6 +2,7 @@
 //! ways): the environment, one [`Row`] per run that finished, and the runs that failed.
 
 use crate::anchor::{Anchors, EMBREE};
+use crate::interval::Interval;
 use crate::results::{CheckResult, Environment, RunRecord, SceneInfo, Spread};
 use crate::scaling::ThreadScaling;
 use serde::Serialize;
@@ -44,6 +45,14 @@ pub struct Row {
     pub mrays_per_s: f64,
     /// Trace time over Embree's on the same scene and threads, from the same results set.
     pub ratio_to_embree: Option<f64>,
+    /// The same as the quotient of the geometric means of the two runs' repeats (trace CPU time
+    /// when recorded), with its 95 % interval and the repeats behind it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio_interval: Option<Interval>,
+    /// Trace CPU time over Embree's timed in pairs in the run's process (`run --paired N`), with
+    /// the interval of the pairs' geometric mean.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paired_ratio: Option<Spread>,
     pub structure_bytes: u64,
     pub peak_rss_bytes: u64,
     pub check: Option<CheckResult>,
@@ -187,6 +196,14 @@ impl Summary {
                 trace_s: r.time_s.trace.clone(),
                 mrays_per_s: r.mrays_per_s,
                 ratio_to_embree: anchors.ratio(r),
+                ratio_interval: r.ratio_to_embree.clone().or_else(|| {
+                    let a = anchors.anchor(r).filter(|_| r.engine != EMBREE)?;
+                    crate::interval::of_quotient(
+                        &r.time_s.trace_for_compare().samples,
+                        &a.time_s.trace_for_compare().samples,
+                    )
+                }),
+                paired_ratio: r.paired_ratio.clone(),
                 structure_bytes: r.structure_bytes,
                 peak_rss_bytes: r.peak_rss_bytes,
                 check: r.check.clone(),

@@ -5,13 +5,14 @@ use crate::number;
 use crate::results::Environment;
 use crate::summary::{Row, Summary};
 
-const HEADER: [(&str, bool); 11] = [
+const HEADER: [(&str, bool); 12] = [
     ("scene", false),
     ("engine", false),
     ("build s", true),
     ("trace s (min–max)", true),
     ("Mrays/s", true),
-    ("× Embree", true),
+    ("× Embree [95 % CI] (n)", true),
+    ("paired × Embree [95 % CI] (n)", true),
     ("structure MB", true),
     ("B/prim", true),
     ("peak RSS MB", true),
@@ -73,9 +74,18 @@ fn cells(r: &Row) -> Vec<String> {
             number::seconds(t.max)
         ),
         number::sig(r.mrays_per_s, 3),
-        r.ratio_to_embree
-            .map(number::ratio)
-            .unwrap_or_else(|| "–".to_string()),
+        match (&r.ratio_interval, r.ratio_to_embree) {
+            (Some(i), _) => format!("{} ({})", i.text(), i.n),
+            (None, Some(q)) => format!("{} (too few repeats for an interval)", number::ratio(q)),
+            _ => "–".to_string(),
+        },
+        match r.paired_ratio.as_ref().and_then(|p| p.interval.as_ref()) {
+            Some(i) => format!("{} ({})", i.text(), i.n),
+            None => match &r.paired_ratio {
+                Some(p) => format!("{} ({})", number::ratio(p.median), p.samples.len()),
+                None => "–".to_string(),
+            },
+        },
         number::megabytes(r.structure_bytes),
         bytes_per_primitive(r),
         number::megabytes(r.peak_rss_bytes),
@@ -120,12 +130,20 @@ pub fn scaling_table(summary: &Summary) -> Option<Table> {
                 r.scene.clone(),
                 r.label.clone(),
                 s.threads.to_string(),
-                format!(
-                    "{} ({}–{})",
-                    number::ratio(p.median),
-                    number::ratio(p.min),
-                    number::ratio(p.max)
-                ),
+                match &p.interval {
+                    Some(i) => format!(
+                        "{} ({}–{})",
+                        i.text(),
+                        number::ratio(p.min),
+                        number::ratio(p.max)
+                    ),
+                    None => format!(
+                        "{} ({}–{})",
+                        number::ratio(p.median),
+                        number::ratio(p.min),
+                        number::ratio(p.max)
+                    ),
+                },
                 p.samples.len().to_string(),
                 number::seconds(s.one_thread_s.median),
                 number::seconds(s.threads_s.median),
@@ -141,7 +159,7 @@ pub fn scaling_table(summary: &Summary) -> Option<Table> {
         ("scene", false),
         ("engine", false),
         ("threads", true),
-        ("speed-up, paired (min–max)", true),
+        ("speed-up, paired [95 % CI] (min–max)", true),
         ("pairs", true),
         ("1 thread s", true),
         ("N threads s", true),
@@ -159,8 +177,8 @@ pub fn scaling_table(summary: &Summary) -> Option<Table> {
 /// What the scaling table's columns mean.
 pub const SCALING_NOTES: &str = "Each pair traces the same built structure at one thread and at N threads back to \
 back in one process, alternating which goes first (`rtbench run --paired-threads`); the speed-up is each pair's \
-one-thread wall time over its N-thread wall time, median and range over the pairs, and both traces must give the \
-same image. 1 thread s and N threads s are the pairs' median wall times; CPU s × 1 thread is the CPU time of the \
+one-thread wall time over its N-thread wall time: the pairs' geometric mean with its 95 % interval (Student's t on \
+the logs), and their range; both traces must give the same image. 1 thread s and N threads s are the pairs' median wall times; CPU s × 1 thread is the CPU time of the \
 pool's threads at N threads over that at one (1.00: splitting cost no extra CPU time). Speed-up, separate runs: \
 this set's one-thread run's median trace time over this run's, for comparison.";
 
@@ -205,7 +223,10 @@ pub fn environment_lines(env: &Environment) -> Vec<(&'static str, String)> {
 }
 
 /// What the columns mean, printed under the tables.
-pub const NOTES: &str = "Times are medians over the repeats, with min–max. × Embree is the trace time over Embree's on \
-the same scene and threads in this results set (– without an Embree run). MB are 10^6 bytes; B/prim is the \
+pub const NOTES: &str = "Times are medians over the repeats, with min–max. × Embree is the trace time (CPU time of the \
+pool's threads where recorded) over Embree's on the same scene and threads in this results set: the quotient of the two \
+runs' geometric means over their repeats, with its 95 % interval (Welch, on the logs) and the repeats behind it (– \
+without an Embree run). Paired × Embree: the ratios timed back to back in the run's own process (`run --paired N`), \
+their geometric mean with its 95 % interval and the number of pairs. MB are 10^6 bytes; B/prim is the \
 structure's bytes per primitive (Embree: what its memory monitor reports, BVH and its copies of the geometry). Hit agreement and PSNR \
 compare each engine's hits and image with Embree's (`rtbench check`); ∞ dB means identical images.";

@@ -1,4 +1,4 @@
-//! The scene model: exactly the records of NFF, nothing more (../shared/SPD.md, "Output format").
+//! The scene model: exactly the records of NFF, nothing more (docs/concepts.md).
 //!
 //! Primitives stay what the SPD says they are: sphere, open cone/cylinder, polygon (convex or
 //! concave), triangle patch with vertex normals. Coordinates are `f64`, as the C generators

@@ -46,7 +46,7 @@ impl Sink for SceneCollector {
     }
 }
 
-/// Primitive counts, as `rtbench scene stats` reports them (../shared/CLI.md).
+/// Primitive counts, as `rtbench scene stats` reports them (docs/concepts.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct Counts {
     pub sphere: u64,

@@ -2,7 +2,7 @@
 //!
 //! Ear clipping in the plane of the polygon (the projection that drops the largest axis of its
 //! Newell normal). Concave polygons are common in the SPD: gears' faces are 144-gons whose gaps
-//! between the teeth a fan from vertex 0 would fill (../shared/EMBREE.md). An n-gon gives n − 2
+//! between the teeth a fan from vertex 0 would fill (docs/concepts.md). An n-gon gives n − 2
 //! triangles, wound as the polygon is.
 
 use glam::{DVec2, DVec3};

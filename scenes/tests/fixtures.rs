@@ -1,6 +1,6 @@
 //! Every fixture in tests/fixtures/spd/ (output of the SPD 3.14 C programs; provenance in its README) against our
 //! generators, record by record and number by number: numbers equal within 1e-5 relative or
-//! 1e-6 absolute (../shared/CLI.md, `scene gen`).
+//! 1e-6 absolute (docs/concepts.md).
 //!
 //! `SPD_FIXTURE=balls` limits the run to fixtures whose name contains that text.
 

@@ -1,7 +1,8 @@
 //! A seeded mutation fuzzer over rtbench's readers of outside data: the NFF reader, the
 //! scene-store reader, the results reader and the mesh readers (glTF and GLB, PLY ASCII and
 //! binary, OBJ). The harness's own readers (history database, suite TOML, shard manifests) are
-//! fuzzed by the harness's tests with the same mutations (`mutate`). Each input is a seed from the corpus in
+//! fuzzed by the harness's tests with the same mutations (`mutate`). Each input is a seed from
+//! the corpus in
 //! `tests/fuzz/corpus/` (store seeds are written from the NFF seeds) with one to four mutations:
 //! bit flips, interesting bytes, tokens from a dictionary (`nan`, `1e308`, huge counts …),
 //! deleted, repeated or truncated spans. An input passes when the reader returns (a value or an

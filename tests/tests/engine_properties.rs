@@ -1,4 +1,4 @@
-//! Properties every engine must have, on random scenes and random rays (issue 9, item 5): a hit
+//! Properties every engine must have, on random scenes and random rays: a hit
 //! has a finite t inside (tmin, tmax) and names an object of the scene; an any-hit answer agrees
 //! with the closest-hit answer; and the engines agree with the f64 reference.
 
@@ -127,7 +127,7 @@ fn every_available_engine_is_tested() {
 
 /// A ray with a NaN or infinite origin or direction (a zero-radius sphere's NaN normal made
 /// one) is a miss and not occluded in every engine: bvh4 and bvh8 used an empty slot's
-/// sentinel as an index and panicked (issue 14).
+/// sentinel as an index and panicked.
 #[test]
 fn untraceable_rays_are_misses_everywhere() {
     let mut scene = Scene::default();

@@ -2,7 +2,7 @@
 //! with `progress=on`), and the pass cap (`max_passes=N`) stops the run: the run stops after its first N passes (over all its trace
 //! calls), every counter and time of those passes kept, and says so (`bf_pass_cap_reached`).
 //!
-//! Why: seed 000's basic method cannot finish 10^9 objects within a session (Table 4.3: 27 to
+//! Why: seed 000's basic method cannot finish 10^9 objects in one sitting (Table 4.3: 27 to
 //! 110 hours on the thesis's machine), and each of its passes sweeps the whole store, so the
 //! time of a few passes and the pass count bound its total (`nakamaru-4.3`'s `basic-passes=N`
 //! model). The image of a capped run is not an answer: the rays left are answered MISS without

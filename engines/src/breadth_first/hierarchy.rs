@@ -14,72 +14,15 @@
 //! Reading checks that each box read lies in its parent's and that siblings' children follow one
 //! another: a hierarchy that disagrees with its level below is an error, not a silent miss.
 
-use super::intersect::{BoxRay, Tally, Work};
+use super::intersect::Work;
+use super::slot::{BoxRay, Tally};
+use super::tree::{LevelTally, Tree};
 use crate::engine::Counters;
 use crate::geometry::TriangleTest;
 use crate::store::hierarchy::NODE_RECORD;
-use crate::store::hierarchy::{disagree, Hierarchy, LevelReader, NodeRecord};
-use crate::store::{IoCounters, BBOX_RECORD};
+use crate::store::hierarchy::{disagree, Hierarchy, NodeRecord};
+use crate::store::BBOX_RECORD;
 use std::io;
-
-/// Counts of one level, over all sweeps.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct LevelTally {
-    /// Boxes read, boxes whose subtree was passed, objects below those.
-    pub read: u64,
-    pub skipped: u64,
-    pub objects_skipped: u64,
-    /// Ray–box tests made on this level's nodes.
-    pub ray_tests: u64,
-}
-
-/// The hierarchy in use: one reader per level (index K − 1 for level K) and its counts.
-pub struct Tree {
-    pub info: Hierarchy,
-    pub levels: Vec<LevelReader>,
-    /// Index K for level K (0: the objects' boxes read by the sweep).
-    pub tally: Vec<LevelTally>,
-}
-
-impl Tree {
-    pub fn open(info: Hierarchy, buffer: usize) -> io::Result<Tree> {
-        let levels = info
-            .levels
-            .iter()
-            .enumerate()
-            .map(|(i, &n)| LevelReader::open(&info.dir, i as u32 + 1, n, buffer))
-            .collect::<io::Result<Vec<_>>>()?;
-        let tally = vec![LevelTally::default(); levels.len() + 1];
-        Ok(Tree {
-            info,
-            levels,
-            tally,
-        })
-    }
-
-    pub fn io(&self) -> IoCounters {
-        let mut io = IoCounters::default();
-        for l in &self.levels {
-            io.add(&l.file.io);
-        }
-        io
-    }
-
-    pub fn drop_cache(&self) {
-        for l in &self.levels {
-            l.file.drop_cache();
-        }
-    }
-
-    /// Records of level `k` (0: objects).
-    fn count(&self, k: usize) -> u64 {
-        if k == 0 {
-            self.info.objects
-        } else {
-            self.info.levels[k - 1]
-        }
-    }
-}
 
 impl Work {
     /// The sweep of a pass through the hierarchy, from the top level down.
@@ -181,12 +124,7 @@ impl Work {
     /// Some ray registered in a voxel the node's box reaches hits the box (within its segment):
     /// the node's subtree must be swept. Walks the voxels, or the registrations when they are
     /// fewer (a top box reaches every voxel).
-    fn node_needed(
-        &self,
-        n: &NodeRecord,
-        any: bool,
-        lt: &mut super::hierarchy::LevelTally,
-    ) -> bool {
+    fn node_needed(&self, n: &NodeRecord, any: bool, lt: &mut LevelTally) -> bool {
         if !(n.lo.is_finite() && n.hi.is_finite()) || n.lo.cmpgt(n.hi).any() {
             return false;
         }

@@ -3,7 +3,7 @@
 //! grouped by voxel come in the order of the linked lists they replaced, and a ray that is not
 //! traceable is a miss.
 
-use super::intersect::BoxRay;
+use super::slot::BoxRay;
 use super::voxels::Registrations;
 use crate::geometry::aabb::{Aabb, SlabRay};
 use crate::test_support::{kv, spd};

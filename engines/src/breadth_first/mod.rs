@@ -46,7 +46,7 @@
 //! | `block` | bytes | 1/8 of `memory` | one X-slab block of the on-disk grid (`two-level`) |
 //! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
 //! | `hrgrid` | `build`, `reuse`, `resume` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there; `resume`: make it keeping `hrgrid.progress.json` after each subspace, and take up an interrupted or finished build of the same grid (its subspaces and seconds from the record: `hr_build_resumed_subspaces`, `hr_build_prior_s`, both counted in `hr_build_s` and `preprocess_s`) |
-//! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than a session, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
+//! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than one sitting, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -70,12 +70,15 @@
 //! (`hr_subspace_side`, `hr_subspaces`, `hr_build_boxes_read`, `hr_build_nodes_culled`,
 //! `hr_build_objects_culled`, `hr_build_bytes_written`, `hr_build_s`).
 
+pub mod bytes;
 pub mod cap;
 pub mod config;
 pub mod hierarchy;
 pub mod hires;
 pub mod intersect;
+pub mod slot;
 pub mod spill;
+pub mod tree;
 pub mod voxels;
 
 #[cfg(test)]
@@ -233,7 +236,7 @@ impl BreadthFirst {
             bh_stats.insert("bh_m".into(), constants.m as f64);
             bh_stats.insert("bh_l".into(), constants.l as f64);
             bh_stats.insert("bh_t".into(), constants.t);
-            Some(hierarchy::Tree::open(info, config.buffer as usize).map_err(open_err)?)
+            Some(tree::Tree::open(info, config.buffer as usize).map_err(open_err)?)
         } else {
             None
         };
@@ -338,7 +341,7 @@ impl BreadthFirst {
                 .as_ref()
                 .map_or(0, |t| t.levels.len() as u64 * config.buffer);
         let initial = config.registration.initial(voxels.max_res());
-        let per_ray = intersect::slot_bytes()
+        let per_ray = slot::slot_bytes()
             + initial as u64 * reg_bytes
             + if plan.is_some() {
                 hires::walk_bytes()

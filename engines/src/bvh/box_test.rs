@@ -33,7 +33,7 @@ pub trait ChildTest<const N: usize> {
     /// then its entry distance.
     fn test(node: &WideNode<N>, r: &Self::Ray, tmin: f32, tmax: f32, dist: &mut [f32; N]) -> u32;
     /// Whether [`Self::test_octant`] is worth a traversal loop per octant (the SIMD forms,
-    /// whose plane rows then become constants; issue 20, session 10).
+    /// whose plane rows then become constants).
     const OCTANTS: bool = false;
     /// [`Self::test`] for a ray whose direction is negative on the axes of the bits of `NEG`
     /// (`slab_lanes`' sign bits): the same answer, with the near and far plane rows known at

@@ -138,7 +138,7 @@ fn node(
 /// the root's children are cut into `threads` contiguous groups of about equal primitive
 /// counts, each group is collapsed into a tree of its own, and the groups are appended in
 /// order, so the nodes come out in the one-thread order, node for node. Collapsing was 41–45 ms
-/// of a two-thread build of balls4 tessellated on one thread alone (issue 20, session 15).
+/// of a two-thread build of balls4 tessellated on one thread alone.
 pub fn collapse_threads(
     bin: &BuildTree,
     width: usize,

@@ -19,7 +19,7 @@
 //!
 //! `leaf` is an upper bound when `max_leaf` is `leaf` (bvh2, `packets=off`, or `leaf` given);
 //! otherwise subtrees of at most `leaf` primitives are always leaves and the SAH may choose
-//! leaves of up to `max_leaf` (issue 20: the default bvh8 tree of gears4 went from 3,462 inner
+//! leaves of up to `max_leaf` (the default bvh8 tree of gears4 went from 3,462 inner
 //! nodes with 2.9 triangles per leaf to 1,566 with 7.7, as Embree's 1,610). bvh2 and `wide=direct` stop splitting at ≤ `leaf` primitives when
 //! the SAH prefers a leaf (`median`: always). With `wide=collapse` a subtree of ≤ `leaf`
 //! primitives becomes a leaf; with `split_leaves=on` node slots left free are spent splitting
@@ -168,7 +168,7 @@ impl Config {
         let precompute = settings.get("precompute", OnOff(true))?.0;
         // Embree's leaf rule (`max_leaf`, `sah_block`) assumes a packet of 1-4 triangles costs
         // one SIMD test; tested lane by lane (`simd=off`) every triangle costs a test, and the
-        // rule's larger leaves cost teapot1 39% more instructions (issue 20, nightly), so the
+        // rule's larger leaves cost teapot1 39% more instructions, so the
         // scalar variant keeps 001's count and leaves of at most `leaf`.
         let wide_packets = width > 2 && packets && simd;
         // A `leaf` given is the largest leaf, as before `max_leaf` existed (001's leaf=1).

@@ -57,7 +57,7 @@ fn packet_of(ids: &[u32], geometry: &Geometry) -> LeafPacket {
 /// packet's range of `order`, then each thread makes a contiguous part of the packets
 /// ([`extend_par`]); one thread makes them all in order. The same references, packets and primitives at any thread count. Packet making was
 /// 80 M of the 403 M instructions the first thread ran alone in a two-thread build of balls4
-/// tessellated (callgrind, issue 20, session 12).
+/// tessellated (callgrind).
 pub fn lay_out_threads<const N: usize>(
     nodes: &mut [WideNode<N>],
     root: &mut u32,

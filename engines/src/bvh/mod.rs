@@ -169,8 +169,8 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     }
 }
 
-/// Wall time per build phase on stderr when `RTBENCH_BUILD_PHASES` is set (a diagnostic, issue
-/// 20: which parts of a two-thread build run alone); nothing otherwise.
+/// Wall time per build phase on stderr when `RTBENCH_BUILD_PHASES` is set (a diagnostic:
+/// which parts of a two-thread build run alone); nothing otherwise.
 struct Phases(Option<(Instant, f64, i64)>);
 
 impl Phases {
@@ -266,8 +266,8 @@ pub fn build_bvh<const N: usize>(
         "builder broke an invariant"
     );
     // On one thread: in a fresh process's two-thread build of balls4 tessellated, flattening
-    // on two threads (session 12) took 7.7–11 ms and on one 8.3–8.7 ms, both mostly faulting in
-    // fresh pages (issue 20, session 15), so the threaded copy was dropped.
+    // on two threads took 7.7–11 ms and on one 8.3–8.7 ms, both mostly faulting in
+    // fresh pages, so the threaded copy was dropped.
     let mut flat = flatten::<N>(&tree);
     phases.mark("flatten");
     let extent = flat
@@ -280,7 +280,7 @@ pub fn build_bvh<const N: usize>(
         // The statistics read the nodes as flattened, the leaf layout rewrites their leaf
         // references: the statistics get a copy and run beside it (the two were 42 M and 80 M
         // of the 403 M instructions the first thread ran alone on balls4 tessellated at two
-        // threads; callgrind, issue 20, session 12). The same figures and leaves either way.
+        // threads; callgrind). The same figures and leaves either way.
         let copy = flat.nodes.clone();
         let (root, bounds) = (flat.root, flat.root_bounds);
         std::thread::scope(|scope| {

@@ -3,7 +3,7 @@
 //! `rtcIntersect8/16` packets do (Wald, Slusallek, Benthin and Wagner 2001, "Interactive
 //! rendering with coherent ray tracing"; Embree's `BVHNIntersectorKHybrid`).
 //!
-//! Issue 20, session 11 rebuilt it so that a packet costs less than its rays one by one:
+//! It is built so that a packet costs less than its rays one by one:
 //! - **Set-up once a packet, in lanes**: the rays are transposed into AVX2 lanes (one 8×8
 //!   transpose per 8 rays) and the slab test's and the watertight test's per-ray values are
 //!   computed for all lanes at once, by the same IEEE operations as `SlabRay::new` and
@@ -338,7 +338,7 @@ mod x86 {
         span: Interval,
     }
 
-    /// An interval ray, every lane splatted (issue 20, session 11; the interval/frustum test
+    /// An interval ray, every lane splatted (the interval/frustum test
     /// of Reshetov, Soupikov and Hurley 2005, "Multi-level ray tracing algorithm", and
     /// Embree's `FrustumK`): per axis the least and greatest `rdir`, the greatest
     /// `org_near`, the least `org_far` over some lanes; the least `tmin` and greatest `tmax`.

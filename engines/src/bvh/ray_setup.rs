@@ -1,5 +1,5 @@
-//! The per-ray set-up of the single-ray traversal, computed in a few SSE instructions (issue
-//! 20, session 9). callgrind counted ~290 instructions run once per ray before the first node
+//! The per-ray set-up of the single-ray traversal, computed in a few SSE instructions.
+//! callgrind counted ~290 instructions run once per ray before the first node
 //! on gears4's shadow rays (of ~630 per ray in all; Embree's whole shadow ray is ~360): the
 //! traceability test branch by branch, the slab ray ([`SlabRay::new`]) and the watertight
 //! set-up ([`WatertightRay::new`]) component by component through glam's scalar `Vec3`, and
@@ -94,7 +94,7 @@ mod x86 {
     use crate::ray::Ray;
     use std::arch::x86_64::*;
 
-    /// [`super::traceable`] in two SSE2 registers (issue 20, session 10): the ray is
+    /// [`super::traceable`] in two SSE2 registers: the ray is
     /// `repr(C)` (origin, tmin, dir, tmax), so lanes 0–2 of `x − x` summed over the two loads
     /// are 0 exactly when origin and direction are finite; lane 3 (`tmin`, `tmax`) is masked
     /// out of that sum and only tested for NaN (`cmpord`).

@@ -77,7 +77,7 @@ struct Entry {
 }
 
 /// The packet tests' output lanes: written by a test before they are read, so made once a
-/// batch (setting them for every ray cost 8 stores a ray; issue 20, session 10).
+/// batch (setting them for every ray cost 8 stores a ray).
 #[derive(Default)]
 struct Lanes {
     one: LaneHits<4>,
@@ -181,7 +181,7 @@ fn node_test<const N: usize, T: ChildTest<N>, const OCT: u32>(
 }
 
 /// `f::<generics…, OCT>(args…)` with `OCT` the octant `oct` (0–7) as a constant: one loop
-/// per octant (issue 20, session 10), as the SIMD box tests want ([`ChildTest::OCTANTS`]).
+/// per octant, as the SIMD box tests want ([`ChildTest::OCTANTS`]).
 macro_rules! by_octant {
     ($oct:expr, $f:ident::<$($g:tt),*>($($arg:expr),*)) => {
         match $oct {
@@ -315,7 +315,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const 
                 let (mut a, mut b, mut c) = (entry(i), entry(j), entry(k));
                 if mask == 0 {
                     // Three: sorted in registers by adjacent exchanges (Embree's `sort` of
-                    // three stack items; issue 20, session 10).
+                    // three stack items).
                     order(&mut a, &mut b);
                     order(&mut b, &mut c);
                     order(&mut a, &mut b);

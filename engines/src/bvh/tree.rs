@@ -49,7 +49,7 @@ impl BuildTree {
     /// Appends the nodes of a tree built on its own (children numbered from its node 0),
     /// renumbered by where they land, copied on `threads` threads ([`extend_par`]); gives where
     /// its node 0 landed. Copying a subtree built on another thread (hundreds of thousands of
-    /// nodes) was a pass on one thread alone (issue 20, session 15).
+    /// nodes) was a pass on one thread alone.
     pub fn append_shifted(&mut self, sub: &[BuildNode], threads: usize) -> u32 {
         let at = self.nodes.len() as u32;
         let threads = if sub.len() < 2 * PARALLEL_MIN {
@@ -129,8 +129,7 @@ pub const PARALLEL_MIN: usize = 4096;
 /// Appends the `n` items `make(0)`, …, `make(n − 1)` to `v`, made on `threads` threads, each
 /// writing a contiguous part straight into the vector's spare capacity: no pass on one thread
 /// fills the vector first, and each thread takes the page faults of its own part (a fresh
-/// process's build of balls4 tessellated took 7,000 faults in its first pass alone; issue 20,
-/// session 15). One thread makes them all in order on the calling thread.
+/// process's build of balls4 tessellated took 7,000 faults in its first pass alone). One thread makes them all in order on the calling thread.
 pub fn extend_par<T: Send, F: Fn(usize) -> T + Sync>(
     v: &mut Vec<T>,
     n: usize,

@@ -2,10 +2,10 @@
 //! process starts: embree4-sys's types and constants as they are, and the functions this engine
 //! calls, by the same names and signatures, through pointers looked up once in the library.
 //!
-//! Why (issue 20, acceptance 5: peak RSS ≤ 3 × structure bytes + 16 MiB): linked, the loader
+//! Why (peak RSS ≤ 3 × structure bytes + 16 MiB): linked, the loader
 //! mapped and relocated Embree, its TBB and libstdc++ in every rtbench process, and they were
-//! 3.1 MiB of the resident set of a bvh8 render that never calls them (gears4 at 512², session
-//! 11, `/proc/PID/smaps`: Embree 1.35 MiB, libstdc++ 1.43, TBB 0.29). No function of
+//! 3.1 MiB of the resident set of a bvh8 render that never calls them (gears4 at 512²,
+//! `/proc/PID/smaps`: Embree 1.35 MiB, libstdc++ 1.43, TBB 0.29). No function of
 //! embree4-sys is referenced any more, so the linker (`--as-needed`) leaves the library out of
 //! the binary's dependencies; the library opened is the one the build found (`build.rs`), then
 //! `libembree4.so` on the system's search path.

@@ -24,7 +24,7 @@
 //! - `api` (default `single`): `single` traces ray by ray (`rtcIntersect1`/`rtcOccluded1`);
 //!   `packet8` / `packet16` hand consecutive rays of a batch to `rtcIntersect8/16` and
 //!   `rtcOccluded8/16` (Embree's packet traversal; a short last packet is masked), the fair
-//!   partner for packet tracers (issue 20). The answers are the same queries' answers.
+//!   partner for packet tracers. The answers are the same queries' answers.
 //!
 //! Memory: [`Engine::structure_bytes`] is what Embree holds after the build, as its memory monitor
 //! (`rtcSetDeviceMemoryMonitorFunction`) reports it — the BVH with its leaves (which copy the

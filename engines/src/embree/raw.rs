@@ -91,14 +91,14 @@ impl Device {
         Ok(Device { handle, state })
     }
 
-    /// The process's one device of configuration `config`, made on first use and never released
-    /// (issue 20, acceptance 3). Embree configures TBB's thread count once per device: a device
+    /// The process's one device of configuration `config`, made on first use and never released.
+    /// Embree configures TBB's thread count once per device: a device
     /// of `threads=1` installs a `tbb::global_control` of one thread, and releasing the last
     /// device (or making another) destroys it. With that limit lifted oneTBB woke a worker
     /// thread that then spun in `sched_yield` for the rest of the process (a whole CPU of system
     /// time, from the first Embree engine dropped on), and on two cores the scheduler stacked the
     /// two trace threads on the other CPU for a fifth to a third of a two-thread trace
-    /// (docs/benchmarks.md, session 14). One device per configuration for the process's life
+    /// (`RTBENCH_SCHED=1` shows it). One device per configuration for the process's life
     /// keeps the limit in place: no worker is ever started for `threads=1`.
     pub fn shared(config: &str) -> Result<&'static Device, String> {
         static DEVICES: OnceLock<Mutex<HashMap<String, &'static Device>>> = OnceLock::new();

@@ -370,7 +370,7 @@ mod with_embree {
     }
 
     /// Engines of one configuration share the process's one device, never released (releasing
-    /// it let oneTBB start a worker that spun beside the trace: session 14), and each still
+    /// it let oneTBB start a worker that spun beside the trace), and each still
     /// reports its own scene's bytes: two builds of one scene read the same, before and after
     /// another engine on the device is dropped.
     #[test]

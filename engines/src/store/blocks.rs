@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 pub const INDEX_MAGIC: &[u8; 8] = b"RTBIDX\0\0";
 /// Uncompressed bytes of a full block: 128 KiB, so that the index of a 10^9-object store
 /// (~100 GB of records, ~800,000 blocks) holds about 12 MB in memory, inside the thesis runs'
-/// 320 MiB peak-RSS bound beside `memory=256MiB` (docs/benchmarks.md, issue 19).
+/// 320 MiB peak-RSS bound beside `memory=256MiB`.
 pub const BLOCK_BYTES: usize = 1 << 17;
 pub const INDEX_ENTRY: usize = 24;
 const INDEX_HEADER: u64 = 16;

@@ -6,9 +6,8 @@
 //! `bytes_written` count the compressed bytes on disk and `codec_bytes` the uncompressed bytes
 //! through the codec. A forward seek decompresses and discards; a backward one (a rewind) opens
 //! the stream again from its start. zstd ([`Codec::Zstd`]) is offered beside gzip, which is the
-//! thesis's: the issue asks for both measured (docs/benchmarks.md, issue 15). A compressed file
-//! may hold several gzip members (RFC 1952 §2.2) or zstd frames (RFC 8878 §3.1) one after the
-//! other, read as one stream: a store written in segments across sessions ends a member or frame
+//! thesis's. A compressed file may hold several gzip members (RFC 1952 §2.2) or zstd frames (RFC 8878 §3.1) one after the
+//! other, read as one stream: a store written in segments across processes ends a member or frame
 //! at every segment ([`IoFile::checkpoint`]).
 
 use flate2::read::MultiGzDecoder;
@@ -136,7 +135,7 @@ fn encoder(codec: Codec, c: Counted<File>) -> io::Result<Backing> {
             e.include_checksum(true)?;
             // A 128 KiB window (level 3 would take 2 MiB or more): the reader's decoder holds
             // one window per open stream, and the engine's memory budget (Table 3.3: 64 MiB in
-            // all) has to hold them; measured in docs/benchmarks.md (issue 15).
+            // all) has to hold them.
             e.window_log(ZSTD_WINDOW_LOG)?;
             Backing::ZsWrite(Box::new(e))
         }

@@ -33,7 +33,7 @@
 //! same bytes, `header.json` adds `"compression": "gzip"` and `stored_bytes` (the compressed
 //! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
 //! offsets). Or zstd-compressed: `objects.bin.zst`, `"compression": "zstd"` (zstd is offered
-//! beside the thesis's gzip: it compresses several times faster, docs/benchmarks.md issue 15).
+//! beside the thesis's gzip: it compresses several times faster).
 //! The compressed file's header cannot carry the checksum of `header.json` (it is written,
 //! compressed, before the header is known), so `header.crc` does: 16 bytes, magic `RTHCRC\0\0`,
 //! u32 version, the CRC-32 of `header.json`, written right after it; a compressed basic store
@@ -41,7 +41,7 @@
 //! the records' checksums guard the data's bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
-//! A store too large to write in one session is written in segments ([`segments`]): while it
+//! A store too large to write in one sitting is written in segments ([`segments`]): while it
 //! is being written its directory holds `segments.json` and no `header.json`.
 //!
 //! A split store may carry a bounding-box hierarchy (`bbox-K.bin`, `hierarchy.json`; seed 000

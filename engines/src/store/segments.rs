@@ -1,6 +1,6 @@
-//! Writing a store in segments, across processes and sessions: the 10^8–10^9-object scenes of
+//! Writing a store in segments, across processes: the 10^8–10^9-object scenes of
 //! seed 000's Table 4.3 (mount14, 536,870,916 objects; rings368, 1,000,787,041) took the thesis
-//! 19–27 hours to generate, longer than one of our sessions.
+//! 19–27 hours to generate, longer than one sitting.
 //!
 //! Every `segment` objects the writer makes its files durable and complete up to that object
 //! ([`StoreWriter::checkpoint`]: a compressed file ends its gzip member, so the file is a valid

@@ -169,7 +169,7 @@ fn a_header_that_disagrees_with_the_files_is_refused() {
     write_store(&dir, Program::Tetra, 1);
     let path = dir.0.join(HEADER_FILE);
     let text = std::fs::read_to_string(&path).unwrap();
-    // The case: "objects": 1, even with the checksum put right.
+    // The reported case: "objects": 1, even with the checksum put right.
     let edited = text.replace("\"objects\": 4", "\"objects\": 1");
     assert_ne!(edited, text);
     std::fs::write(&path, &edited).unwrap();

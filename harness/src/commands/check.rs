@@ -43,7 +43,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     workload::check_json_settings(a.json, &settings)?;
     let src = Source::from_args(scene, &a.opts)?;
     workload::check_scene_fits(&src, &[engine, against], a.opts.force)?;
-    let pool = workload::pool(a.threads)?;
+    let pool = crate::measure::threads::pool(a.threads.count())?;
     let prepared = workload::prepare(&src)?;
     if let Some(w) = workload::precision_warning(&prepared.input.scene) {
         eprintln!("rtbench: warning: {w}");
@@ -148,7 +148,7 @@ fn run_suite(a: &CheckArgs, name: &str) -> Result<()> {
         std::fs::create_dir_all(dir)
             .map_err(|e| input(format!("--out {}: cannot create: {e}", dir.display())))?;
     }
-    let pool = workload::pool(a.threads)?;
+    let pool = crate::measure::threads::pool(a.threads.count())?;
     match name {
         "hard" => {
             let probe = suite::probe_input();

@@ -2,7 +2,10 @@
 
 pub mod check;
 pub mod engines;
+pub mod env;
+pub mod history;
 pub mod merge;
+pub mod nightly;
 pub mod plan;
 pub mod render;
 pub mod runs;

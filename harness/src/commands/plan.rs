@@ -3,10 +3,11 @@
 //! the groups (the units a shard takes whole) and each shard's slice.
 
 use crate::cli::{PlanCmdArgs, PlanWhat};
-use crate::commands::runs::{run_group, run_plan};
+use crate::commands::runs::run_plan;
 use crate::error::{input, Result};
 use crate::output::print_json;
-use crate::runs::shard::{group_count, ShardSpec, MAX_SHARDS};
+use crate::runs::plan::run_group;
+use crate::shard::{group_count, ShardSpec, MAX_SHARDS};
 use serde_json::json;
 
 pub fn run(a: &PlanCmdArgs) -> Result<()> {

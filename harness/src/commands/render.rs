@@ -2,10 +2,11 @@
 
 use crate::cli::RenderArgs;
 use crate::error::{input, Result};
-use crate::output::{print_json, write_png};
-use crate::runs::shard::{Manifest, ShardSpec};
+use crate::measure::memory;
+use crate::output::{hex, print_json, write_png};
+use crate::shard::{Manifest, ShardSpec};
 use crate::source::Source;
-use crate::workload::{self, memory, trace};
+use crate::workload::{self, trace};
 use serde_json::json;
 use sha2::{Digest, Sha256};
 
@@ -25,7 +26,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
     workload::check_scene_fits(&src, &[&a.engine], a.scene.opts.force)?;
-    let pool = workload::pool(a.threads)?;
+    let pool = crate::measure::threads::pool(a.threads.count())?;
     memory::phase("start");
     let prepared = workload::prepare(&src)?;
     if let Some(w) = workload::precision_warning(&prepared.input.scene) {
@@ -54,7 +55,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let pixels = r.pixels();
     // A run the pass cap stopped (`max_passes`) has no image: the rays left were not traced.
-    let capped = pass_capped(&r.counters);
+    let capped = crate::workload::out_of_core::pass_capped(&r.counters);
     let sha = (!capped).then(|| hex(&Sha256::digest(pixels)));
     if capped {
         eprintln!("render: the pass cap (max_passes) stopped the run: its counters and times are its first passes'; no image");
@@ -82,7 +83,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "intersect": r.intersect_s,
             "shade": r.shade_s,
         },
-        "memory": {"structure_bytes": engine.structure_bytes(), "geometry_bytes": geometry_bytes, "peak_rss_bytes": workload::peak_rss_bytes()},
+        "memory": {"structure_bytes": engine.structure_bytes(), "geometry_bytes": geometry_bytes, "peak_rss_bytes": crate::measure::rss::peak_rss_bytes()},
         "counters": r.counters,
         "build_stats": engine.build_stats(),
         "image": {"width": a.size, "height": a.size, "sha256": sha, "incomplete": capped},
@@ -138,10 +139,6 @@ fn tile_manifest(
     m.extra
         .insert("store".into(), dir.display().to_string().into());
     Ok(m)
-}
-
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// `rtbench render --scene STORE_DIR --engine breadth-first`: the out-of-core workload
@@ -206,11 +203,11 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
             trace_s: r.trace_s,
             intersect_s: r.intersect_s,
             shade_s: r.shade_s,
-            peak_rss_bytes: workload::peak_rss_bytes(),
+            peak_rss_bytes: crate::measure::rss::peak_rss_bytes(),
             corners,
         };
         t.write(out)?;
-        m.finished_at = Some(crate::runs::env::now_utc());
+        m.finished_at = Some(crate::measure::environment::now_utc());
         m.write(out)?;
         eprintln!(
             "render: tile {}/{} of {}: {} rays in {:.3} s into {}",
@@ -225,7 +222,7 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
     let r = &ooc.render;
     let pixels = r.pixels();
     // A run the pass cap stopped (`max_passes`) has no image: the rays left were not traced.
-    let capped = pass_capped(&r.counters);
+    let capped = crate::workload::out_of_core::pass_capped(&r.counters);
     let sha = (!capped).then(|| hex(&Sha256::digest(pixels)));
     if capped {
         eprintln!("render: the pass cap (max_passes) stopped the run: its counters and times are its first passes'; no image");
@@ -252,7 +249,7 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
             "shade": r.shade_s,
         },
         "memory": {"structure_bytes": rtbench_engines::Engine::structure_bytes(&engine),
-                   "peak_rss_bytes": workload::peak_rss_bytes()},
+                   "peak_rss_bytes": crate::measure::rss::peak_rss_bytes()},
         "counters": r.counters,
         "io": {"workload": ooc.io},
         "shading": {"group_rays": ooc.shade_group, "store_sweeps": ooc.shade_sweeps, "cap_rays": ooc.shade_cap},
@@ -270,15 +267,8 @@ fn run_store(a: &RenderArgs, dir: &std::path::Path, settings: Vec<(String, Strin
             s.total,
             r.trace_s,
             build_s,
-            workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+            crate::measure::rss::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
         );
     }
     Ok(())
-}
-
-/// Whether the breadth-first engine's pass cap stopped the run (`max_passes`).
-pub fn pass_capped(c: &rtbench_engines::Counters) -> bool {
-    c.extra
-        .get(rtbench_engines::breadth_first::cap::CAP_REACHED)
-        .is_some_and(|&n| n > 0)
 }

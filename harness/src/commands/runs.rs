@@ -1,11 +1,12 @@
-//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (../shared/CLI.md, "Runs and reports").
+//! `rtbench run`, `sweep`, `run-one`, `report`, `compare` (docs/concepts.md).
 
 use crate::cli::{CompareArgs, PlanArgs, ReportArgs, RunArgs, RunOneArgs, SweepArgs};
 use crate::error::{input, Failure, Result};
+use crate::measure::threads::Threads;
 use crate::output::print_json;
 use crate::runs::one::{run_one, OneSpec};
-use crate::runs::plan::{self, Common, Job, ResultsDir};
-use crate::runs::shard::{group_count, Manifest, ShardSpec};
+use crate::runs::plan::{self, plan_text, run_group, Common, Job, ResultsDir};
+use crate::shard::{group_count, Manifest, ShardSpec};
 use crate::source::Source;
 use crate::workload;
 use rtbench_scenes::spd::Program;
@@ -95,37 +96,12 @@ fn plan_engines(p: &PlanArgs) -> Result<Vec<EngineSettings>> {
     Ok(out)
 }
 
-/// The group a job of `run` is sharded with: its scene (program, SF, tessellation) and threads, so
-/// Embree's run and the engines measured against it land on one machine.
-pub fn run_group(j: &Job) -> (String, u32, Option<u32>, Option<usize>) {
-    (j.program.clone(), j.sf, j.tessellate, j.threads)
-}
-
 /// `--shard K/N`, if given.
 fn shard_of(p: &PlanArgs) -> Result<Option<ShardSpec>> {
     p.shard
         .as_deref()
         .map(|s| ShardSpec::parse(s, "--shard"))
         .transpose()
-}
-
-/// What identifies a plan across its shards: the command, the shared settings, every job key.
-pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
-    // `paired_threads` only when asked for, so plans written before it keep their text.
-    let threads = match c.paired_threads {
-        0 => String::new(),
-        n => format!(" paired_threads={n}"),
-    };
-    format!(
-        "{kind} repeats={} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
-        c.repeats,
-        c.size,
-        c.check,
-        c.paired,
-        c.max_seconds,
-        c.max_memory,
-        keys.join("\n")
-    )
 }
 
 fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
@@ -141,19 +117,19 @@ fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
 fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
     p.threads
         .split(',')
-        .map(|t| match t.trim() {
-            "all" => Ok(None),
-            n => match n.parse::<usize>() {
-                Ok(0) | Err(_) => Err(input(format!(
-                    "--threads '{}': expected counts ≥ 1 or 'all'",
-                    p.threads
-                ))),
-                Ok(n) if n > workload::thread_limit() => Err(input(format!(
+        .map(|t| match t.parse::<Threads>() {
+            Err(_) => Err(input(format!(
+                "--threads '{}': expected {}, comma-separated",
+                p.threads,
+                Threads::FORMS
+            ))),
+            Ok(Threads::Count(n)) if n > crate::measure::threads::thread_limit() => {
+                Err(input(format!(
                     "--threads {n}: more than the {} this machine runs at once",
-                    workload::thread_limit()
-                ))),
-                Ok(n) => Ok(Some(n)),
-            },
+                    crate::measure::threads::thread_limit()
+                )))
+            }
+            Ok(t) => Ok(t.count()),
         })
         .collect()
 }
@@ -244,7 +220,7 @@ pub fn run(a: &RunArgs) -> Result<()> {
     let mut out = ResultsDir::open(&a.plan.out, a.plan.resume)?;
     let failures = plan::run(&jobs, &common, &mut out, a.plan.resume)?;
     if let Some(mut m) = manifest {
-        m.finished_at = Some(crate::runs::env::now_utc());
+        m.finished_at = Some(crate::measure::environment::now_utc());
         m.write(&a.plan.out)?;
     }
     eprintln!(
@@ -346,7 +322,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
         a.plan.resume,
     )?;
     if let Some(mut m) = manifest {
-        m.finished_at = Some(crate::runs::env::now_utc());
+        m.finished_at = Some(crate::measure::environment::now_utc());
         m.write(&a.plan.out)?;
     }
     eprintln!(
@@ -366,7 +342,7 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
             a.scene.opts.tessellate,
             a.scene.opts.hash,
         )?,
-        threads: a.threads,
+        threads: a.threads.count(),
         repeats: a.repeat,
         size: a.size,
         check: !a.no_check,

@@ -1,4 +1,4 @@
-//! `rtbench scene list | gen | stats` (../shared/CLI.md, "Scenes").
+//! `rtbench scene list | gen | store | stats`.
 
 use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
@@ -7,20 +7,6 @@ use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
 use rtbench_scenes::Sink;
 use std::io::Write;
 
-/// `none`, `gzip`, `gzip:LEVEL` (1–9), `zstd` or `zstd:LEVEL` (1–19).
-pub fn parse_codec(s: &str) -> std::result::Result<Codec, String> {
-    let level = |p: &str| s.strip_prefix(p).map(str::parse::<u32>);
-    match s {
-        "none" => Ok(Codec::None),
-        "gzip" => Ok(Codec::Gzip(6)),
-        "zstd" => Ok(Codec::Zstd(3)),
-        _ => match (level("gzip:"), level("zstd:")) {
-            (Some(Ok(l)), _) if (1..=9).contains(&l) => Ok(Codec::Gzip(l)),
-            (_, Some(Ok(l))) if (1..=19).contains(&l) => Ok(Codec::Zstd(l as i32)),
-            _ => Err("expected none, gzip, gzip:LEVEL (1-9), zstd or zstd:LEVEL (1-19)".into()),
-        },
-    }
-}
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
 use rtbench_scenes::CountingSink;
@@ -28,8 +14,20 @@ use serde_json::json;
 use std::path::Path;
 
 pub fn list(as_json: bool) -> Result<()> {
+    // The room is seed 003's stand-in scene (`room` = room8, `roomN` at N patches per metre).
+    let room_ppm = rtbench_scenes::room::DEFAULT_PPM;
+    let room_objects = {
+        let mut c = CountingSink::default();
+        rtbench_scenes::room::generate(room_ppm, &mut c)
+            .map(|()| c.counts.sphere + c.counts.cone + c.counts.polygon + c.counts.patch)
+            .ok()
+    };
+    let room_about = "seed 003's room stand-in (Yamauchi 1997, Table 6): walls, furniture, two \
+                      light panels, mirror quadrics; roomN for N patches per metre";
+    let files = "OBJ, PLY, glTF/GLB and NFF files are scenes too: give their path wherever a \
+                 program name goes (--scene, --scenes, scene stats|gen|store)";
     if as_json {
-        let v: Vec<_> = Program::ALL
+        let mut v: Vec<_> = Program::ALL
             .iter()
             .map(|p| {
                 json!({"name": p.name(), "standard_sf": p.standard_sf(),
@@ -37,6 +35,11 @@ pub fn list(as_json: bool) -> Result<()> {
                        "description": p.description()})
             })
             .collect();
+        v.push(
+            json!({"name": "room", "standard_sf": null, "patches_per_metre": room_ppm,
+                      "objects_at_standard_sf": room_objects, "description": room_about}),
+        );
+        // Still a list of scenes (the contract); the note on files is for people.
         print_json(&json!(v));
     } else {
         println!(
@@ -56,6 +59,9 @@ pub fn list(as_json: bool) -> Result<()> {
                 p.description()
             );
         }
+        let n = room_objects.map_or_else(|| "?".into(), |n| n.to_string());
+        println!("{:<10} {:>4} {:>10}  {room_about}", "room", "-", n);
+        println!("\n{files}.");
     }
     Ok(())
 }
@@ -161,7 +167,7 @@ pub fn gen(src: &Source, out: Option<&Path>, max: u64) -> Result<()> {
                 bytes as f64 / 1e6,
                 secs,
                 bytes as f64 / 1e6 / secs.max(1e-9),
-                crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+                crate::measure::rss::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
             );
         }
     }
@@ -234,7 +240,8 @@ pub fn store(
     let layout: Layout = layout
         .parse()
         .map_err(|e| input(format!("--layout {layout}: {e}")))?;
-    let codec = parse_codec(compress).map_err(|e| input(format!("--compress {compress}: {e}")))?;
+    let codec = crate::workload::out_of_core::parse_codec(compress)
+        .map_err(|e| input(format!("--compress {compress}: {e}")))?;
     if matches!(codec, Codec::Gzip(_)) && layout == Layout::Split {
         return Err(input(format!(
             "--compress {compress}: a split store is read with seeks, so it is compressed as zstd blocks: use --compress zstd[:LEVEL] or --layout basic"
@@ -333,7 +340,7 @@ pub fn store(
         "bytes_written": io.bytes_written,
         "write_calls": io.write_calls,
         "time_s": secs,
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if as_json {
         print_json(&v);
@@ -345,7 +352,7 @@ pub fn store(
             header.primitives,
             io.bytes_written as f64 / 1e6,
             secs,
-            crate::workload::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
+            crate::measure::rss::peak_rss_bytes().unwrap_or(0) as f64 / 1048576.0
         );
     }
     Ok(())
@@ -374,7 +381,7 @@ pub fn stats(src: &Source, as_json: bool) -> Result<()> {
         "materials": c.materials,
         "bounds": bounds,
         // Shows that counting streamed: a materialised scene would show here.
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if as_json {
         print_json(&v);

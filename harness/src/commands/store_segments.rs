@@ -1,14 +1,14 @@
 //! `rtbench scene store … --segment N [--resume] [--max-seconds S]`: a store written in segments
 //! of N objects, across processes (`rtbench_engines::store::segments`), for the 10^8–10^9-object
-//! scenes of seed 000 Table 4.3 that take longer to write than a session lasts. Unlike a store
+//! scenes of seed 000 Table 4.3 that take longer to write than one sitting. Unlike a store
 //! written in one go (a temporary directory renamed when complete), the directory is written in
 //! place: until the last segment it holds `segments.json` and no `header.json`, which readers
 //! refuse, and `--resume` goes on from its last checkpoint.
 
-use super::scene::parse_codec;
 use crate::error::{input, Result};
 use crate::output::print_json;
 use crate::source::Source;
+use crate::workload::out_of_core::parse_codec;
 use rtbench_engines::store::{Layout, Outcome, SegmentLog, SegmentedWriter, StoreHeader};
 use serde_json::json;
 use std::path::Path;
@@ -123,7 +123,7 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
             "time_s": secs,
             "skipped_objects": objects_before,
         },
-        "peak_rss_bytes": crate::workload::peak_rss_bytes(),
+        "peak_rss_bytes": crate::measure::rss::peak_rss_bytes(),
     });
     if a.as_json {
         print_json(&v);

@@ -15,6 +15,8 @@ use crate::error::{input, Result};
 use rusqlite::{params, Connection, OpenFlags, OptionalExtension};
 use std::path::Path;
 
+pub mod dashboard;
+pub mod detect;
 pub mod export;
 
 /// The schema this rtbench writes and reads.

@@ -1,21 +1,18 @@
-//! `rtbench nightly --suite FILE --db FILE.sqlite [--out DIR]`: runs a suite (each engine × scene
+//! The nightly (`rtbench nightly --suite FILE --db FILE.sqlite [--out DIR]`): runs a suite (each engine × scene
 //! in its own child process, as `rtbench run` does), measures instruction counts under valgrind and
 //! the criterion kernels if the suite asks, compares the night with the history's baseline for the
-//! same machine fingerprint (`detect.rs`), writes the whole night to the history in one
+//! same machine fingerprint (`history/detect.rs`), writes the whole night to the history in one
 //! transaction, and exits 1 only when a gated metric regressed, naming it.
 
-pub mod dashboard;
-pub mod detect;
-pub mod plant;
 pub mod shard;
 pub mod suite;
 mod tools;
 
 use crate::cli::NightlyArgs;
-use crate::error::{input, Failure, Result};
-use crate::history::{Finding, History, Metric, Night};
+use crate::error::Result;
+use crate::history::{dashboard, detect, Finding, Metric};
 use crate::runs::plan::{self, Common, Job, ResultsDir};
-use crate::runs::shard::ShardSpec;
+use crate::shard::ShardSpec;
 use rtbench_reports::{Environment, RunRecord};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -35,7 +32,7 @@ pub fn fingerprint(env: &Environment) -> String {
         env.rustc,
         env.embree_version,
     ]);
-    crate::commands::render::hex(&Sha256::digest(key.to_string().as_bytes()))
+    crate::output::hex(&Sha256::digest(key.to_string().as_bytes()))
 }
 
 /// The jobs of a suite, Embree first within each (scene, SF, threads).
@@ -345,7 +342,7 @@ pub fn compare(
     out
 }
 
-fn fmt_secs(s: f64) -> String {
+pub fn fmt_secs(s: f64) -> String {
     if s >= 60.0 {
         format!("{}m{:02}s", (s / 60.0) as u64, (s % 60.0) as u64)
     } else {
@@ -354,7 +351,7 @@ fn fmt_secs(s: f64) -> String {
 }
 
 /// The metrics a night found changed for the first time (verdict `suspect`).
-fn suspects_of(findings: &[Finding]) -> std::collections::BTreeSet<String> {
+pub fn suspects_of(findings: &[Finding]) -> std::collections::BTreeSet<String> {
     findings
         .iter()
         .filter(|f| f.verdict == "suspect")
@@ -362,7 +359,7 @@ fn suspects_of(findings: &[Finding]) -> std::collections::BTreeSet<String> {
         .collect()
 }
 
-fn is_bad(f: &Finding) -> bool {
+pub fn is_bad(f: &Finding) -> bool {
     f.verdict == "regression" || f.verdict == "failed"
 }
 
@@ -430,9 +427,9 @@ pub fn summary_markdown(
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} |\n",
             m.name,
-            crate::nightly::dashboard::fmt_value(m.value),
+            dashboard::fmt_value(m.value),
             f.and_then(|f| f.baseline)
-                .map(crate::nightly::dashboard::fmt_value)
+                .map(dashboard::fmt_value)
                 .unwrap_or_default(),
             f.and_then(|f| f.change_pct)
                 .map(|c| format!("{c:+.2}%"))
@@ -488,23 +485,23 @@ pub struct Measured {
 
 /// Runs the suite's jobs (those of `spec`'s shard only, when given), its instruction counts and
 /// its criterion benchmarks (shard 1 only), writing the runs into `out` as they finish.
-fn measure(
+pub fn measure(
     suite: &Suite,
     a: &NightlyArgs,
     spec: Option<ShardSpec>,
     out: Option<&std::path::Path>,
 ) -> Result<Measured> {
     let start = Instant::now();
-    let env = crate::runs::env::capture();
+    let env = crate::measure::environment::capture();
     let fp = fingerprint(&env);
-    let started_at = crate::runs::env::now_utc();
+    let started_at = crate::measure::environment::now_utc();
     let mut results = match out {
         Some(d) => Some(ResultsDir::open(d, false)?),
         None => None,
     };
     let mut jobs = jobs(suite);
     if let Some(spec) = spec {
-        jobs = spec.select(&jobs, crate::commands::runs::run_group);
+        jobs = spec.select(&jobs, crate::runs::plan::run_group);
     }
     // Rounds: every job once per round, one timed repeat each, so that an engine's i-th sample
     // and Embree's i-th sample are minutes apart at most and a burst of load on a shared machine
@@ -653,345 +650,6 @@ fn measure(
         findings,
         wall_s: start.elapsed().as_secs_f64(),
     })
-}
-
-/// `rtbench nightly`.
-pub fn run(a: &NightlyArgs) -> Result<()> {
-    let suite = suite::load_runnable(&a.suite)?;
-    let spec = a
-        .shard
-        .as_deref()
-        .map(|s| ShardSpec::parse(s, "--shard"))
-        .transpose()?;
-    if let Some(spec) = spec {
-        return shard::run_shard(a, &suite, spec, |out| {
-            measure(&suite, a, Some(spec), Some(out))
-        });
-    }
-    let db = a.db.as_deref().ok_or_else(|| {
-        input("nightly: --db FILE is required (the history the night is compared with and written to)")
-    })?;
-    // Open the history before running anything: a bad file is exit 2 at once.
-    let mut history = History::open(db, true)?;
-    let start = Instant::now();
-    let Measured {
-        env,
-        fingerprint: fp,
-        started_at,
-        metrics,
-        mut findings,
-        wall_s: measured_s,
-    } = match &a.from {
-        Some(dir) => shard::load_merged(dir, &suite)?,
-        None => measure(&suite, a, None, a.out.as_deref())?,
-    };
-    let prev = history.runs(Some(&fp), Some(&suite.name))?;
-    if let Some(dir) = &a.from {
-        // A merged night is one night: recording it again would count it twice.
-        if let Some(r) = prev
-            .iter()
-            .find(|r| r.started_at == started_at && r.git_commit == env.git_commit)
-        {
-            return Err(input(format!(
-                "{}: this night (started {started_at}) is already night {} of {}",
-                dir.display(),
-                r.id,
-                db.display()
-            )));
-        }
-    }
-    let window: Vec<_> = prev
-        .iter()
-        .rev()
-        .take(suite.baseline_nights)
-        .rev()
-        .collect();
-    let mut baseline = Vec::new();
-    for r in &window {
-        baseline.push(history.metrics(r.id)?);
-    }
-    let suspects = match window.last() {
-        Some(r) => suspects_of(&history.findings(r.id)?),
-        None => Default::default(),
-    };
-    findings.extend(compare(&suite, &metrics, &baseline, &suspects));
-    let wall_s = match &a.from {
-        Some(_) => measured_s + start.elapsed().as_secs_f64(),
-        None => start.elapsed().as_secs_f64(),
-    };
-    let night = Night {
-        suite: suite.name.clone(),
-        suite_sha256: crate::commands::render::hex(&Sha256::digest(suite.text.as_bytes())),
-        started_at,
-        finished_at: crate::runs::env::now_utc(),
-        git_commit: env.git_commit.clone(),
-        git_dirty: env.git_dirty,
-        fingerprint: fp.clone(),
-        env_json: serde_json::to_string(&env).expect("environment serialises"),
-        wall_s,
-        note: a.note.clone(),
-        metrics: metrics.clone(),
-        findings: findings.clone(),
-    };
-    let md = summary_markdown(
-        &suite.name,
-        &env.git_commit,
-        wall_s,
-        window.len(),
-        &metrics,
-        &findings,
-    );
-    if a.no_record {
-        eprintln!(
-            "nightly: --no-record: the night is not written to {}",
-            db.display()
-        );
-    } else {
-        let id = history.append(&night)?;
-        eprintln!("nightly: night {id} written to {}", db.display());
-    }
-    if let Some(d) = &a.out {
-        crate::output::write_atomic(&d.join("nightly.md"), |w| {
-            std::io::Write::write_all(w, md.as_bytes())
-        })?;
-        dashboard::write(&history, &d.join("dashboard"))?;
-        eprintln!(
-            "nightly: summary {}, dashboard {}",
-            d.join("nightly.md").display(),
-            d.join("dashboard/index.html").display()
-        );
-    }
-    if a.json {
-        crate::output::print_json(&serde_json::json!({
-            "fingerprint": fp,
-            "wall_s": wall_s,
-            "metrics": metrics.len(),
-            "gated": metrics.iter().filter(|m| m.gated).count(),
-            "baseline_nights": window.len(),
-            "findings": findings,
-        }));
-    } else {
-        print!("{md}");
-    }
-    let bad: Vec<String> = findings
-        .iter()
-        .filter(|f| is_bad(f))
-        .map(|f| f.message.clone())
-        .collect();
-    if !bad.is_empty() {
-        return Err(Failure::Check(format!(
-            "nightly regression: {}",
-            bad.join("; ")
-        )));
-    }
-    Ok(())
-}
-
-/// `rtbench history list|show|export|dashboard`.
-pub fn history_cmd(c: &crate::cli::HistoryCommand) -> Result<()> {
-    use crate::cli::HistoryCommand as H;
-    match c {
-        H::List { db, json } => {
-            let h = History::open_read(db)?;
-            let runs = h.runs(None, None)?;
-            if *json {
-                crate::output::print_json(&serde_json::to_value(&runs).expect("rows serialise"));
-            } else {
-                println!("| id | started | suite | commit | machine | metrics | regressions | wall | note |");
-                println!("|---:|---|---|---|---|---:|---:|---:|---|");
-                for r in runs {
-                    println!(
-                        "| {} | {} | {} | {}{} | {} | {} | {} | {} | {} |",
-                        r.id,
-                        r.started_at,
-                        r.suite,
-                        crate::output::head(&r.git_commit, 10),
-                        if r.git_dirty { "+" } else { "" },
-                        crate::output::head(&r.fingerprint, 10),
-                        r.metrics,
-                        r.regressions,
-                        fmt_secs(r.wall_s),
-                        r.note.unwrap_or_default()
-                    );
-                }
-            }
-            Ok(())
-        }
-        H::Show { db, run, json } => {
-            let h = History::open_read(db)?;
-            let id = resolve_run(&h, run.as_deref(), db)?;
-            let row = h
-                .run(id)?
-                .ok_or_else(|| input(format!("{}: no night {id}", db.display())))?;
-            let metrics = h.metrics(id)?;
-            let findings = h.findings(id)?;
-            if *json {
-                let env: serde_json::Value = h
-                    .env_json(id)?
-                    .and_then(|t| serde_json::from_str(&t).ok())
-                    .unwrap_or_default();
-                crate::output::print_json(&serde_json::json!({
-                    "run": row, "environment": env, "metrics": metrics, "findings": findings
-                }));
-            } else {
-                print!(
-                    "{}",
-                    summary_markdown(
-                        &row.suite,
-                        &row.git_commit,
-                        row.wall_s,
-                        0,
-                        &metrics,
-                        &findings
-                    )
-                );
-            }
-            Ok(())
-        }
-        H::Export { db, format, run } => {
-            let h = History::open_read(db)?;
-            match format.as_str() {
-                "csv" => print!("{}", crate::history::export::csv(&h)?),
-                "bmf" => {
-                    let id = resolve_run(&h, run.as_deref(), db)?;
-                    crate::output::print_json(&crate::history::export::bmf(&h.metrics(id)?));
-                }
-                f => return Err(input(format!("--format '{f}': expected csv or bmf"))),
-            }
-            Ok(())
-        }
-        H::Replay { db, suite, json } => replay(db, suite, *json),
-        H::Check { db } => {
-            let h = History::open_read(db)?;
-            let problems = h.problems()?;
-            let runs = h.runs(None, None)?;
-            let metrics: usize = runs.iter().map(|r| r.metrics as usize).sum();
-            if problems.is_empty() {
-                println!(
-                    "{}: whole (integrity_check ok, schema {}, every table and column, every night's metrics); {} nights, {metrics} metrics",
-                    db.display(),
-                    crate::history::SCHEMA,
-                    runs.len()
-                );
-                return Ok(());
-            }
-            for p in &problems {
-                println!("{}: {p}", db.display());
-            }
-            Err(Failure::Check(format!(
-                "{}: not whole: {}",
-                db.display(),
-                problems[0]
-            )))
-        }
-        H::Dashboard { db, out } => {
-            let h = History::open_read(db)?;
-            dashboard::write(&h, out)?;
-            eprintln!("dashboard: {}", out.join("index.html").display());
-            Ok(())
-        }
-    }
-}
-
-/// `rtbench history replay`: every night of the suite, in order, compared (by [`compare`], as
-/// `rtbench nightly` compares) with the nights of the same machine before it.
-fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Result<()> {
-    let s = suite::load(suite_file)?;
-    let h = History::open_read(db)?;
-    let runs = h.runs(None, Some(&s.name))?;
-    if runs.is_empty() {
-        return Err(input(format!(
-            "{}: no night of suite '{}' in the history",
-            db.display(),
-            s.name
-        )));
-    }
-    let mut rows = Vec::new();
-    let mut alarmed = 0;
-    let mut previous: BTreeMap<i64, std::collections::BTreeSet<String>> = BTreeMap::new();
-    for (i, r) in runs.iter().enumerate() {
-        let prev: Vec<_> = runs[..i]
-            .iter()
-            .filter(|p| p.fingerprint == r.fingerprint)
-            .collect();
-        let window = &prev[prev.len().saturating_sub(s.baseline_nights)..];
-        let baseline = window
-            .iter()
-            .map(|p| h.metrics(p.id))
-            .collect::<Result<Vec<_>>>()?;
-        // The suspects of the night before, as this replay found them (the live run read them
-        // from the history the same way).
-        let suspects = match window.last() {
-            Some(p) => previous.get(&p.id).cloned().unwrap_or_default(),
-            None => Default::default(),
-        };
-        let findings = compare(&s, &h.metrics(r.id)?, &baseline, &suspects);
-        previous.insert(r.id, suspects_of(&findings));
-        let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
-        if !bad.is_empty() {
-            alarmed += 1;
-        }
-        if !json {
-            println!(
-                "night {} ({}, {} baseline nights): {}",
-                r.id,
-                r.note.as_deref().unwrap_or(""),
-                window.len(),
-                if bad.is_empty() {
-                    "no regression".to_string()
-                } else {
-                    bad.iter()
-                        .map(|f| f.message.as_str())
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                }
-            );
-        }
-        rows.push(serde_json::json!({
-            "id": r.id,
-            "note": r.note,
-            "baseline_nights": window.len(),
-            "recorded_regressions": r.regressions,
-            "regressions": bad.iter().map(|f| &f.message).collect::<Vec<_>>(),
-            "suspects": findings.iter().filter(|f| f.verdict == "suspect").map(|f| &f.message).collect::<Vec<_>>(),
-        }));
-    }
-    let recorded = runs.iter().filter(|r| r.regressions > 0).count();
-    if json {
-        crate::output::print_json(&serde_json::json!({
-            "suite": s.name,
-            "nights": runs.len(),
-            "nights_with_regression": alarmed,
-            "nights_with_regression_recorded": recorded,
-            "nights_detail": rows,
-        }));
-    } else {
-        println!(
-            "replay: {} nights of suite '{}': {alarmed} with a reported regression ({recorded} when they ran)",
-            runs.len(),
-            s.name
-        );
-    }
-    Ok(())
-}
-
-fn resolve_run(h: &History, run: Option<&str>, db: &std::path::Path) -> Result<i64> {
-    match run {
-        None | Some("latest") => h
-            .runs(None, None)?
-            .last()
-            .map(|r| r.id)
-            .ok_or_else(|| input(format!("{}: the history holds no night", db.display()))),
-        Some(s) => {
-            let id = s
-                .parse::<i64>()
-                .map_err(|_| input(format!("--run '{s}': expected a night's id or 'latest'")))?;
-            // A night that is not there is an error, not an empty answer.
-            h.run(id)?
-                .map(|r| r.id)
-                .ok_or_else(|| input(format!("{}: no night {id}", db.display())))
-        }
-    }
 }
 
 #[cfg(test)]

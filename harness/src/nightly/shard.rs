@@ -10,10 +10,10 @@
 
 use super::{jobs, Measured, Suite};
 use crate::cli::NightlyArgs;
-use crate::commands::merge::Shard;
 use crate::error::{input, Result};
 use crate::history::{Finding, Metric};
-use crate::runs::shard::{sha256_hex, Manifest, ShardSpec};
+use crate::shard::Shard;
+use crate::shard::{sha256_hex, Manifest, ShardSpec};
 use rtbench_reports::Environment;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -62,7 +62,7 @@ pub fn run_shard(
         .as_deref()
         .ok_or_else(|| input("nightly --shard: give --out DIR (the shard's results)"))?;
     let all = jobs(suite);
-    let mine = spec.select(&all, crate::commands::runs::run_group);
+    let mine = spec.select(&all, crate::runs::plan::run_group);
     let mut manifest = Manifest::new(
         "nightly",
         spec,
@@ -89,7 +89,7 @@ pub fn run_shard(
     crate::output::write_atomic(&out.join(MEASURED_FILE), |w| {
         std::io::Write::write_all(w, text.as_bytes())
     })?;
-    manifest.finished_at = Some(crate::runs::env::now_utc());
+    manifest.finished_at = Some(crate::measure::environment::now_utc());
     manifest.write(out)?;
     eprintln!(
         "nightly: shard {}/{}: {} of {} runs, {} metrics in {}",
@@ -153,7 +153,7 @@ pub fn load_merged(dir: &Path, suite: &Suite) -> Result<Measured> {
             crate::output::head(&sha, 12)
         )));
     }
-    if dir.join(crate::runs::shard::MANIFEST_FILE).is_file() {
+    if dir.join(crate::shard::MANIFEST_FILE).is_file() {
         return Err(input(format!(
             "{}: a single shard; merge the shards first (rtbench merge DIR… --out MERGED)",
             dir.display()

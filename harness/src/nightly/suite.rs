@@ -6,7 +6,7 @@
 //! variants = ["bvh4:simd=off"]              # an engine with its settings, run beside the others
 //! scenes = ["tetra", "balls"]
 //! sf = [2, 3]
-//! threads = [1]
+//! threads = [1]                             # counts or "all" (default [1])
 //! repeats = 5
 //! paired = 8                                # engine/Embree pairs timed back to back per run
 //! size = 128                                # image side of the workload, pixels
@@ -47,7 +47,7 @@ struct RawSuite {
     scenes: Vec<String>,
     sf: Vec<u32>,
     #[serde(default)]
-    threads: Option<Vec<usize>>,
+    threads: Option<Vec<toml::Value>>,
     repeats: Option<u32>,
     paired: Option<u32>,
     size: Option<u32>,
@@ -294,14 +294,22 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         return Err(input(format!("{file}: sf: size factors start at 1")));
     }
     let threads = match raw.threads {
-        None => vec![Some(1)],
+        None => vec![crate::measure::threads::Threads::DEFAULT.count()],
         Some(t) if t.is_empty() => {
             return Err(input(format!("{file}: threads must not be empty")));
         }
         Some(t) => t
             .into_iter()
-            .map(|n| if n == 0 { None } else { Some(n) })
-            .collect(),
+            .map(|v| {
+                let text = match &v {
+                    toml::Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                text.parse::<crate::measure::threads::Threads>()
+                    .map(|t| t.count())
+                    .map_err(|e| input(format!("{file}: {e}")))
+            })
+            .collect::<Result<Vec<_>>>()?,
     };
     for g in &raw.gate {
         if !GATES.contains(&g.as_str()) {

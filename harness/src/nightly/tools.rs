@@ -65,6 +65,12 @@ pub fn criterion(c: &Criterion, home: &Path, gated: bool) -> Result<(Vec<Metric>
     cmd.args(["bench", "-p", "rtbench-engines", "--bench", &c.bench, "--"])
         .args(&c.args)
         .env("CRITERION_HOME", home);
+    // The benches run for minutes with their output kept off stdout: say what is running.
+    eprintln!(
+        "nightly: cargo bench -p rtbench-engines --bench {} -- {}",
+        c.bench,
+        c.args.join(" ")
+    );
     let wall = run_tool(&mut cmd, "cargo bench", "")?;
     let mut out = Vec::new();
     let mut stack = vec![home.to_path_buf()];

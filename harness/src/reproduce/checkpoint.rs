@@ -1,6 +1,6 @@
 //! Partial progress of a long reproduction (`reproduce <id> --out DIR --resume`): a table saves each
 //! finished step as `DIR/.partial/<id>/<key>.json` and, resumed, loads it instead of measuring it
-//! again, so hours of tracing survive the end of a session. A run without `--resume` starts fresh
+//! again, so hours of tracing survive the end of a process. A run without `--resume` starts fresh
 //! (the folder is emptied); the steps stay after a finished run, so that runs over parts of a
 //! table (`scenes=`, `max-sf`) add up and a last `--resume` run writes the whole table from
 //! them. Keys must name everything the step's measurement depends on (scene, size factor, image

@@ -1,5 +1,5 @@
 //! What every reproduction row says: the claim it tests, published beside measured, how they compare,
-//! the verdict, and the fidelity label (../shared/ARCHITECTURE.md, "Growing the shape"): a claim is judged
+//! the verdict, and the fidelity label (docs/concepts.md): a claim is judged
 //! only on the algorithm, setting and scene it was made for, and a row says when it was not.
 
 use serde::Serialize;

@@ -3,11 +3,12 @@
 //! Shared by the tables that compare engines on the same rays (001's rendering experiments).
 
 use crate::error::Result;
+use crate::measure::repeat::Repeats;
+use crate::measure::span::Workers;
 use crate::select::median;
 use crate::workload;
 use rtbench_engines::{BuildInput, Counters, Hit, Ray};
 use serde::Serialize;
-use std::time::Instant;
 
 /// One engine to time: label, engine name, settings.
 pub type Timee = (
@@ -89,18 +90,19 @@ pub fn time_engines(
             build_times.push(s);
         }
         let mut hits = vec![Hit::MISS; rays.len()];
-        let mut counters = Counters::default();
-        e.intersect(rays, &mut hits, &mut counters);
-        let n_hits = hits.iter().filter(|x| x.t.is_finite()).count();
-        let (mut cpu, mut wall) = (Vec::new(), Vec::new());
-        for _ in 0..repeats {
+        // The one repeat policy: the untimed first pass gives the counters, then each timed
+        // pass is one span of this thread.
+        let mut counters: Option<Counters> = None;
+        let timed = Repeats::new(repeats as u32).run(Workers::Caller, |t| -> Result<()> {
             let mut c = Counters::default();
-            let t = Instant::now();
-            let c0 = workload::thread_cpu_seconds();
-            e.intersect(rays, &mut hits, &mut c);
-            cpu.push(workload::thread_cpu_seconds() - c0);
-            wall.push(t.elapsed().as_secs_f64());
-        }
+            t.span(|| e.intersect(rays, &mut hits, &mut c));
+            counters.get_or_insert(c);
+            Ok(())
+        })?;
+        let counters = counters.unwrap_or_default();
+        let n_hits = hits.iter().filter(|x| x.t.is_finite()).count();
+        let mut cpu: Vec<f64> = timed.iter().map(|(_, s)| s.thread_cpu_s).collect();
+        let mut wall: Vec<f64> = timed.iter().map(|(_, s)| s.wall_s).collect();
         out.push(Timed {
             scene,
             sf,

@@ -3,10 +3,10 @@
 //! (`grid=single cap=N`, the thesis's "-l"; `grid=two-level`, the high-resolution grid), each run
 //! with its peak RSS reset, its load average, its exact counters and its image hash.
 
-use crate::commands::render::hex;
 use crate::error::{input, Result};
+use crate::output::hex;
 use crate::source::Source as SceneSource;
-use crate::workload::{self, out_of_core};
+use crate::workload::out_of_core;
 use rtbench_engines::breadth_first::config::BreadthFirstConfig;
 use rtbench_engines::breadth_first::BreadthFirst;
 use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
@@ -105,7 +105,7 @@ pub struct Setup {
 
 /// Traces the store at `dir` with S+G+B and `grid` settings.
 pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> {
-    workload::reset_peak_rss();
+    crate::measure::rss::reset_peak_rss();
     let load_average = load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),
@@ -123,7 +123,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         .collect();
     pairs.extend(settings.iter().cloned());
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
-    let cpu0 = workload::process_cpu_seconds();
+    let cpu0 = crate::measure::clock::process_cpu_seconds();
     let t = std::time::Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let preprocess_s = t.elapsed().as_secs_f64();
@@ -140,7 +140,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         trace_s: r.trace_s,
         passes: x("bf_passes"),
         sha256: hex(&Sha256::digest(r.pixels())),
-        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        peak_rss_bytes: crate::measure::rss::peak_rss_bytes().unwrap_or(0),
         res: [bs("res_x") as u64, bs("res_y") as u64, bs("res_z") as u64],
         levels: levels.max(1),
         upper: if levels > 0 {
@@ -162,7 +162,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         subspaces: bs("hr_subspaces") as u64,
         grid_build_s: bs("hr_build_s"),
         load_average,
-        cpu_s: workload::process_cpu_seconds() - cpu0,
+        cpu_s: crate::measure::clock::process_cpu_seconds() - cpu0,
     })
 }
 

@@ -131,9 +131,9 @@ fn time(e: &dyn Engine, rays: &[Ray], repeats: usize) -> (Counters, f64, Vec<Hit
     let mut cpu = Vec::new();
     for i in 0..repeats {
         let mut c = Counters::default();
-        let c0 = workload::thread_cpu_seconds();
+        let c0 = crate::measure::clock::thread_cpu_seconds();
         e.intersect(rays, &mut hits, &mut c);
-        let s = workload::thread_cpu_seconds() - c0;
+        let s = crate::measure::clock::thread_cpu_seconds() - c0;
         cpu.push(s);
         if i == 0 {
             first = c;

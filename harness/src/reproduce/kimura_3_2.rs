@@ -99,7 +99,7 @@ fn rows(p: &Published, cells: &[Cell], ours: &[Sufficient]) -> Vec<Row> {
         .iter()
         .map(|c| {
             let r = Row::new("cell", format!("B={} D={}", c.branching, c.depth), c.printed.to_string(), c.computed.to_string(), Kind::Count, Verdict::of(c.printed == c.computed));
-            if c.printed == c.computed { r } else { r.with_note("printed value is an erratum (digest of 001)") }
+            if c.printed == c.computed { r } else { r.with_note("printed value is an erratum") }
         })
         .collect();
     for (o, pb) in ours.iter().zip(&p.smallest_sufficient) {

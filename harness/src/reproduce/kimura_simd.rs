@@ -1,6 +1,6 @@
 //! `kimura-simd`: 001 (Kimura 2007) §4.3, the rendering speed-up of SIMD single-ray traversal of the 4-ary
 //! SAH BVH (2.32–4.45×). 800×600 eye rays through pixel centres, one thread (the calling one), the same
-//! rays for every engine; a second table runs the engines at their defaults (issue 5's side-by-side).
+//! rays for every engine; a second table runs the engines at their defaults, side by side.
 
 use super::engine_timing::{self, Timed, Timee};
 use super::kimura_3_3::scenes;
@@ -31,7 +31,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "ablation",
             fidelity: Fidelity::Substituted,
-            why: "001's trees on today's CPU and compiler; 001's cloister has no source; ray packets are not implemented in rtbench (issue 20)",
+            why: "001's trees on today's CPU and compiler; 001's cloister has no source; ray packets are not implemented in rtbench",
         },
         Claim {
             key: "speedup-larger-where-slower",
@@ -46,7 +46,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "packets-10x",
             fidelity: Fidelity::NotReproducible,
-            why: "packets: not implemented in rtbench (issue 20)",
+            why: "packets: not implemented in rtbench",
         },
         Claim {
             key: "cloister",
@@ -182,9 +182,9 @@ fn run(ctx: &Ctx) -> Result<Output> {
         let src = SceneSource::resolve(scene, Some(sf), Some(3), None)?;
         let prepared = workload::prepare(&src)?;
         let camera = Camera::new(&prepared.input.scene.view);
-        let c0 = workload::thread_cpu_seconds();
+        let c0 = crate::measure::clock::thread_cpu_seconds();
         let rays = camera.pixel_centre_rays(IMAGE.0, IMAGE.1);
-        let generate_s = workload::thread_cpu_seconds() - c0;
+        let generate_s = crate::measure::clock::thread_cpu_seconds() - c0;
         let on = (scene, sf);
         let simd = engine_timing::time_engines(SIMD_ENGINES, &prepared.input, &rays, repeats, 1, on, ctx.id)?;
         ablation.extend(engine_timing::time_engines(ABLATION, &prepared.input, &rays, repeats, 1, on, ctx.id)?);
@@ -224,7 +224,7 @@ fn share(scene: &str, input: &rtbench_engines::BuildInput, rays: &[rtbench_engin
     e.intersect(rays, &mut hits, &mut rtbench_engines::Counters::default());
     // Stand-in for 001's dot(direction, normal): the hit point's direction from the origin as the
     // normal (one normalise and one dot per hit, as a triangle normal lookup and dot would cost).
-    let c0 = workload::thread_cpu_seconds();
+    let c0 = crate::measure::clock::thread_cpu_seconds();
     let mut image = vec![0u8; rays.len()];
     for ((r, h), px) in rays.iter().zip(&hits).zip(image.iter_mut()) {
         if h.t.is_finite() {
@@ -232,7 +232,7 @@ fn share(scene: &str, input: &rtbench_engines::BuildInput, rays: &[rtbench_engin
             *px = (r.dir.dot(n).abs() * 255.0) as u8;
         }
     }
-    let shade_s = workload::thread_cpu_seconds() - c0;
+    let shade_s = crate::measure::clock::thread_cpu_seconds() - c0;
     std::hint::black_box(&image);
     let get = |l: &str| simd.iter().find(|t| t.engine == l).map_or(f64::NAN, |t| t.cpu_s);
     Ok(Share { scene: scene.into(), generate_s, shade_s, traverse_scalar_s: get("bvh4 scalar"), traverse_simd_s: get("bvh4 SIMD") })
@@ -261,9 +261,9 @@ fn ablation_rows(factors: &[Factor], shares: &[Share], speedups: &[Speedup], mea
         .map(|f| Row::new("ablation", format!("{}: {}", f.scene, f.factor), "2.32-4.45 (the whole speed-up)", format!("{:.2} ({} ÷ {})", f.ratio, f.over, f.under), Kind::Ratio, Verdict::Shown))
         .collect();
     rows.push(Row::new("table-4.1-layout", "bvh4 SIMD", "aabbMin[3], aabbMax[3] (__m128 SoA), ray.o4[3], ray.invRayDir[3] (Table 4.1)", "planes[6][4] f32 SoA per node; ray: rdir and origin x rdir splatted per ray", Kind::Count, Verdict::Shown));
-    rows.push(Row::new("packets-10x", "-", "packet tracers [RSH05, WBS07] about 10x (§4.3)", "packets: not implemented in rtbench (issue 20)", Kind::Ratio, Verdict::NotMeasured));
+    rows.push(Row::new("packets-10x", "-", "packet tracers [RSH05, WBS07] about 10x (§4.3)", "packets: not implemented in rtbench", Kind::Ratio, Verdict::NotMeasured));
     rows.push(Row::new("cloister", "cloister", "81,410 triangles (Table 3.1); the largest speed-up (§4.3)", "no source; no same-kind scene in a registry package", Kind::Count, Verdict::NotMeasured));
-    rows.push(Row::new("ablation", "ray packets", "not used by 001 (future work)", "packets: not implemented in rtbench (issue 20)", Kind::Ratio, Verdict::NotMeasured));
+    rows.push(Row::new("ablation", "ray packets", "not used by 001 (future work)", "packets: not implemented in rtbench", Kind::Ratio, Verdict::NotMeasured));
     for s in shares {
         let other = s.generate_s + s.shade_s;
         rows.push(Row::new(
@@ -299,7 +299,7 @@ fn ablation_rows(factors: &[Factor], shares: &[Share], speedups: &[Speedup], mea
 
 fn ablation_document(doc: &mut Document, ablation: &[Timed], factors: &[Factor], shares: &[Share]) {
     doc.heading("Ablation on the same trees: where 001's 2.32-4.45x could come from");
-    doc.paragraph("Same rays, one thread, full-sweep SAH trees built by 001's direct N-ary builder. `precompute=off`: each box test divides by the direction and orders the two slab distances (no replicated origin or reciprocal direction). Ray packets: not implemented in rtbench (issue 20). The bvh2/bvh4 scalar and SIMD rows are in the first table.");
+    doc.paragraph("Same rays, one thread, full-sweep SAH trees built by 001's direct N-ary builder. `precompute=off`: each box test divides by the direction and orders the two slab distances (no replicated origin or reciprocal direction). Ray packets: not implemented in rtbench. The bvh2/bvh4 scalar and SIMD rows are in the first table.");
     doc.table(timed_table(ablation));
     let mut t = DocTable::new("", &["scene", "factor", "ratio", "numerator ÷ denominator", "isolates"]);
     for f in factors {
@@ -343,7 +343,7 @@ fn speedups(p: &Published, measured: &[Timed]) -> Vec<Speedup> {
     out
 }
 
-/// Issue 5's goals per scene: bvh4/bvh8 SIMD at ≥ 0.8× Embree's rays per second and ≥ 1.5× the faster
+/// Our goals for the engines per scene (not 001's claims): bvh4/bvh8 SIMD at ≥ 0.8× Embree's rays per second and ≥ 1.5× the faster
 /// obvhs layout's; builds ≤ 3× Embree's build time (pure).
 fn goals(defaults: &[Timed]) -> Vec<Goal> {
     let mut out = Vec::new();
@@ -388,7 +388,7 @@ fn rows(speedups: &[Speedup], goals: &[Goal]) -> Vec<Row> {
         .collect();
     rows.extend(goals.iter().map(|g| {
         Row::new("engine-goal", format!("{} {}", g.scene, g.ratio), g.goal, format!("{:.2}", g.measured), Kind::Ratio, Verdict::of(g.met))
-            .with_fidelity(Fidelity::Faithful, "issue 5's goal for our engines, not a claim of 001")
+            .with_fidelity(Fidelity::Faithful, "our goal for the engines, not a claim of 001")
     }));
     rows
 }
@@ -414,7 +414,7 @@ fn document(p: &Published, measured: &[Timed], speedups: &[Speedup], defaults: &
         s.push(vec![x.scene.clone(), x.over.into(), format!("{:.2}", x.speedup), format!("{lo}-{hi}"), x.compares.into()]);
     }
     doc.table(s);
-    doc.heading("The engines at their defaults, same rays (issue 5's side-by-side)");
+    doc.heading("The engines at their defaults, same rays (the engines side by side)");
     doc.paragraph("Default trees and leaves (bvh2: binned SAH, leaf 1; bvh4/bvh8: binned SAH collapsed, leaf 4, triangle packets; obvhs: PLOC, `medium` preset), one thread, same rays and timing as above; build: median wall time of 3 builds (Embree builds with its own threads).");
     doc.table(timed_table(defaults));
     let mut g = DocTable::new("", &["scene", "ratio", "goal", "measured", "met"]);

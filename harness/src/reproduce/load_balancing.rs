@@ -6,7 +6,6 @@
 use super::object_space_pass::{self as osp, PassRecord, SimRecord, Traced};
 use super::{Checkpoint, Claim, Ctx, Output, Runtime, Table};
 use crate::error::Result;
-use crate::workload;
 use rtbench_engines::object_space::config::FrameBuffer;
 use rtbench_engines::object_space::machine::Machine;
 use serde::Serialize;
@@ -81,7 +80,7 @@ pub fn measure_passes<M: Send>(
     traced: &[Traced],
     measure: impl Fn(&Traced) -> Result<M> + Send + Sync,
 ) -> Result<(Vec<M>, usize)> {
-    let pool = workload::pool(ctx.params.threads()?)?;
+    let pool = crate::measure::threads::pool(ctx.params.threads()?)?;
     let measured = traced
         .iter()
         .map(|t| pool.install(|| measure(t)))

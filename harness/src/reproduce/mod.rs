@@ -13,6 +13,7 @@
 mod checkpoint;
 mod claims;
 mod invocation;
+mod models;
 mod params;
 mod published;
 mod table;
@@ -83,8 +84,69 @@ fn fidelity_counts(t: &Table) -> serde_json::Map<String, serde_json::Value> {
         .collect()
 }
 
-/// `rtbench reproduce list [--json]`.
-pub fn list(as_json: bool) -> Result<()> {
+/// Each seed's document, cited as a paper, and where its engines live: the rows of the paper→code map.
+const PAPERS: &[(&str, &str, &str)] = &[
+    (
+        "SPD",
+        "Eric Haines, *A Proposal for Standard Graphics Environments*, IEEE CG&A 7(11), 1987; Standard Procedural Databases 3.14, README",
+        "every engine; generators in `scenes/src/spd/`",
+    ),
+    (
+        "000",
+        "Koji Nakamaru, *Ray Tracing for Massive Data* (大規模データに対するレイトレーシング), PhD thesis, Keio University, 2002",
+        "`engines/src/breadth_first/`, `engines/src/store/`, `engines/src/grid/` (presets `rss`, `rss-r`)",
+    ),
+    (
+        "001",
+        "Hidetaka Kimura, *Accelerating Ray Tracing with BVHs Suited to Parallel Computation*, master's thesis, JAIST, 2007",
+        "`engines/src/bvh/` (`bvh2`, `bvh4`, `bvh8`)",
+    ),
+    (
+        "002",
+        "Yoshihiro Kanamori, *Introduction to CG by Ray Tracing: a uniform grid for ray–triangle-mesh intersection*, lecture handout, University of Tsukuba, 2014",
+        "`engines/src/grid/`, `engines/src/geometry/dda.rs`",
+    ),
+    (
+        "003",
+        "Hitoshi Yamauchi, *A Study of Massively Parallel Processing for Image Generation* (画像生成用超並列処理に関する研究), PhD thesis, Tohoku University, 1997",
+        "`engines/src/object_space/`",
+    ),
+];
+
+/// The paper→code map as Markdown, generated from the registry (README.md holds a copy that a test
+/// compares with this): one row per seed, then one per table.
+pub fn markdown_map() -> String {
+    let mut s = String::from("| seed | paper | engines |\n|---|---|---|\n");
+    for (seed, paper, engines) in PAPERS {
+        s.push_str(&format!("| {seed} | {paper} | {engines} |\n"));
+    }
+    s.push_str(
+        "\n| id | seed | where in the paper | code (`harness/src/reproduce/`) | published figures | F | S | M | NR |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for t in TABLES {
+        let n = |f: Fidelity| t.claims.iter().filter(|c| c.fidelity == f).count();
+        s.push_str(&format!(
+            "| `{}` | {} | {} | `{}.rs` | `data/published/{}.json` | {} | {} | {} | {} |\n",
+            t.id,
+            t.seed,
+            t.source.replace('|', "\\|"),
+            t.id.replace(['-', '.'], "_"),
+            t.id,
+            n(Fidelity::Faithful),
+            n(Fidelity::Substituted),
+            n(Fidelity::Model),
+            n(Fidelity::NotReproducible),
+        ));
+    }
+    s
+}
+
+/// `rtbench reproduce list [--json | --markdown]`.
+pub fn list(as_json: bool, as_markdown: bool) -> Result<()> {
+    if as_markdown {
+        print!("{}", markdown_map());
+        return Ok(());
+    }
     if as_json {
         let rows: Vec<_> = TABLES
             .iter()
@@ -187,6 +249,83 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// README.md's paper→code map is the registry's: regenerate it with
+    /// `rtbench reproduce list --markdown` when a table is added or its claims change.
+    #[test]
+    fn the_readme_map_is_the_registry() {
+        let readme =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+                .expect("README.md");
+        let (begin, end) = (
+            "<!-- reproduce-map: rtbench reproduce list --markdown -->\n",
+            "<!-- /reproduce-map -->",
+        );
+        let start = readme
+            .find(begin)
+            .expect("README.md has no reproduce-map block")
+            + begin.len();
+        let stop = start
+            + readme[start..]
+                .find(end)
+                .expect("README.md's reproduce-map block is not closed");
+        assert_eq!(
+            readme[start..stop].trim(),
+            markdown_map().trim(),
+            "README.md's paper→code map differs from the registry: paste `rtbench reproduce list --markdown` between its markers"
+        );
+        for t in TABLES {
+            assert!(
+                PAPERS.iter().any(|p| p.0 == t.seed),
+                "{}: seed {} has no paper",
+                t.id,
+                t.seed
+            );
+        }
+    }
+
+    /// Every result of record in docs/results/ is a document `rtbench reproduce <id>` wrote, named
+    /// for its id, and says how to regenerate it: the command, commit, date and machine.
+    #[test]
+    fn every_result_of_record_names_its_command() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/results");
+        let mut seen = 0;
+        for e in std::fs::read_dir(&dir).expect("docs/results") {
+            let path = e.unwrap().path();
+            if path.extension().is_none_or(|x| x != "md") {
+                continue;
+            }
+            let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+            assert!(
+                TABLES.iter().any(|t| t.id == stem),
+                "{}: not named for a reproduce id",
+                path.display()
+            );
+            let text = std::fs::read_to_string(&path).unwrap();
+            let want = format!("Regenerate: `rtbench reproduce {stem} ");
+            assert!(
+                text.contains(&want),
+                "{}: does not say how to regenerate it ({want}…`)",
+                path.display()
+            );
+            assert!(
+                text.contains(", commit ")
+                    && (text.contains("Measured on ") || text.contains("Written on ")),
+                "{}: no commit, date or machine",
+                path.display()
+            );
+            // The folder beside the checkout the seeds once lived in (spelled so that this file
+            // does not cite it).
+            let outside = concat!("..", "/shared");
+            assert!(
+                !text.contains(outside),
+                "{}: cites a file outside the repository",
+                path.display()
+            );
+            seen += 1;
+        }
+        assert!(seen > 0, "no results of record in {}", dir.display());
+    }
 
     #[test]
     fn ids_are_unique_and_name_their_files() {

@@ -10,7 +10,7 @@
 //! Rows: the test-count premise (breadth-first's ray–object tests, box tests plus floor tests,
 //! within 10% of rss-r's primitive tests), and per phase the measured ratio beside the thesis's
 //! printed range. For balls and tree the floor is kept out of the grid in
-//! all three (§3.4: "the base plate was excluded, the rest handled the same way"). One thread each:
+//! all three (§3.5: "the base plate was excluded, the rest handled the same way"). One thread each:
 //! the thesis's machine had one processor, and the breadth-first engine runs on one. Times are medians
 //! of the repeats; preprocessing includes the scene's preparation (and for breadth-first the store's
 //! writing), not its generation.
@@ -147,7 +147,7 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
         ("floor".to_string(), floor.to_string()),
         ("count".to_string(), "objects".to_string()),
     ];
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let (e, build_s) = workload::build("grid", &prepared.input, set)?;
     let r = pool.install(|| trace::render(&prepared.input.scene, e.as_ref(), 512, None));
     let pre = prepared.prepare_s + build_s;

@@ -1,6 +1,6 @@
 //! `nakamaru-3.2`: Table 3.2 (memory used by rayshade-ss per SF) and Figs. 3.5–3.7 (time against
 //! scene data size: where the in-memory grid starts to thrash, and where the breadth-first method
-//! overtakes it), seed 000 §3.4; digest §2.2.
+//! overtakes it), seed 000 §3.5.
 //!
 //! Per scene and Table 3.2 size factor:
 //! - **memory account** ([`RayshadeImage`]): everything rayshade-ss allocates for the scene and
@@ -29,9 +29,9 @@ use super::published::{self, PublishedClaim, Source};
 use super::{Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
 use crate::error::{input, Result};
 use crate::source::Source as SceneSource;
-use crate::workload::paging::Mattson;
-use crate::workload::rayshade_memory::{Account, RayshadeImage};
-use crate::workload::replacement::{Clock, Lru};
+use super::models::paging::Mattson;
+use super::models::rayshade_memory::{Account, RayshadeImage};
+use super::models::replacement::{Clock, Lru};
 use crate::workload::{self, trace};
 use rtbench_engines::breadth_first::config::BreadthFirstConfig;
 use rtbench_engines::breadth_first::BreadthFirst;
@@ -305,7 +305,7 @@ fn replay(
 }
 
 fn grid_point(prepared: &workload::Prepared, floor: &str, frames: u64) -> Result<Point> {
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let t = Instant::now();
     let grid = Grid::build(&prepared.input, grid_config(floor)?)?;
     let grid_build_s = t.elapsed().as_secs_f64();
@@ -370,7 +370,7 @@ fn account_point(prepared: &workload::Prepared, floor: &str) -> Result<Point> {
 }
 
 fn breadth_first_point(prepared: &workload::Prepared, floor: &str, p: &mut Point) -> Result<()> {
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let t = Instant::now();
     let config = BreadthFirstConfig::from_settings(Settings::new(
         "breadth-first",
@@ -406,7 +406,7 @@ fn validate(scene: &str, sf: u32) -> Result<Validation> {
     let prepared = workload::prepare(&src)?;
     let grid = Grid::build(&prepared.input, grid_config(floor(scene))?)?;
     let mut rec = trace::Recording::default();
-    let pool = workload::pool(Some(1))?;
+    let pool = crate::measure::threads::pool(Some(1))?;
     let r = pool.install(|| trace::render(&prepared.input.scene, &grid, 512, Some(&mut rec)));
     let image = RayshadeImage::new(&prepared.input.scene, &prepared.input.geometry, &grid);
     let mut stream: Vec<u32> = Vec::new();
@@ -706,7 +706,7 @@ fn show(v: Option<u32>, last: Option<&u32>) -> String {
         .unwrap_or_else(|| format!("none ≤ {}", last.map(|l| l.to_string()).unwrap_or_default()))
 }
 
-/// The thesis's per-scene explanation (§3.4), as one testable statement per scene.
+/// The thesis's per-scene explanation (§3.5), as one testable statement per scene.
 fn scene_claim(scene: &str) -> &'static str {
     match scene {
         "balls" | "tree" => "many small objects in one place: page faults as soon as the data outgrows memory (time onset no later than the data-size onset)",
@@ -920,7 +920,7 @@ fn document(ctx: &Ctx, p: &Published, r: &Result_, disks: &[Disk], frames: u64, 
             v.accesses, v.pages, v.frames, v.mattson_lru, v.direct_lru, v.clock, (v.clock as f64 / v.direct_lru.max(1) as f64 - 1.0) * 100.0));
     }
     let pattern = &published::claim(&p.claims, "pattern").claim;
-    doc.paragraph(format!("Published pattern (000 §3.4): {pattern}"));
+    doc.paragraph(format!("Published pattern (000 §3.5): {pattern}"));
     doc
 }
 

@@ -15,7 +15,7 @@
 
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
-use crate::commands::render::hex;
+use crate::output::hex;
 use crate::error::{input, Result};
 use crate::source::Source as SceneSource;
 use crate::workload::{self, out_of_core};
@@ -210,7 +210,7 @@ fn trace(dir: &std::path::Path, size: u32, secondary: bool, codec: Codec) -> Res
         passes: x("bf_passes"),
         io_bytes_read: x("io_bytes_read"),
         io_codec_bytes: x("io_codec_bytes"),
-        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        peak_rss_bytes: crate::measure::rss::peak_rss_bytes().unwrap_or(0),
     })
 }
 
@@ -250,7 +250,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             }
             None => {
                 eprintln!("{}: {}{sf} compressed …", ctx.id, row.scene);
-                workload::reset_peak_rss();
+                crate::measure::rss::reset_peak_rss();
                 let gz_dir = spill.path().join("gzip");
                 let (hg, write_gzip_s) = write_store(&src, &gz_dir, Codec::Gzip(6))?;
                 let mut m = Measured {
@@ -282,7 +282,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
                 }
                 None => {
                     eprintln!("{}: {}{sf} plain …", ctx.id, row.scene);
-                    workload::reset_peak_rss();
+                    crate::measure::rss::reset_peak_rss();
                     let plain_dir = spill.path().join("plain");
                     let (hp, s) = write_store(&src, &plain_dir, Codec::None)?;
                     if hp.geometry_bytes != m.plain_bytes {

@@ -16,7 +16,7 @@
 use super::per_ray::{self, SizePoint};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
-use crate::commands::render::hex;
+use crate::output::hex;
 use crate::error::{input, Result};
 use crate::source::Source as SceneSource;
 use crate::workload::{self, out_of_core};
@@ -142,10 +142,10 @@ struct Run {
     /// `bh_level_K_skipped` per level K ≥ 1.
     bh_skipped: Vec<u64>,
     load_average: String,
-    /// Rays traced, every kind (0 in rows saved before session 7, which did not keep it).
+    /// Rays traced, every kind (0 in rows saved by older versions, which did not keep it).
     #[serde(default)]
     rays: u64,
-    /// CPU seconds of preprocessing and tracing (0 in rows saved before session 8): against
+    /// CPU seconds of preprocessing and tracing (0 in rows saved by older versions): against
     /// the total it shows a run that did not get its core (a shared machine's times).
     #[serde(default)]
     cpu_s: f64,
@@ -231,7 +231,7 @@ struct Setup<'a> {
 }
 
 fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
-    workload::reset_peak_rss();
+    crate::measure::rss::reset_peak_rss();
     let load_average = super::grid_runs::load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.into()),
@@ -243,7 +243,7 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
     }
     pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
-    let cpu0 = workload::process_cpu_seconds();
+    let cpu0 = crate::measure::clock::process_cpu_seconds();
     let t = std::time::Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let preprocess_s = t.elapsed().as_secs_f64();
@@ -260,7 +260,7 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
         shade_s: r.shade_s,
         passes: x("bf_passes"),
         sha256: hex(&Sha256::digest(r.pixels())),
-        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        peak_rss_bytes: crate::measure::rss::peak_rss_bytes().unwrap_or(0),
         preprocess_bytes_read: b.get("preprocess_bytes_read").copied().unwrap_or(0.0) as u64
             + b.get("bh_build_bytes_read").copied().unwrap_or(0.0) as u64,
         intersect_bytes_read: x("io_bytes_read"),
@@ -284,12 +284,12 @@ fn trace(dir: &Path, s: &Setup, extra: &[(&str, &str)]) -> Result<Run> {
             .collect(),
         load_average,
         rays: r.stats.total,
-        cpu_s: workload::process_cpu_seconds() - cpu0,
+        cpu_s: crate::measure::clock::process_cpu_seconds() - cpu0,
     })
 }
 
 /// One method's run, saved on its own (`{key}.{method}`) as soon as it finishes, so that a row of
-/// hours resumed in another session does not trace its finished methods again.
+/// hours resumed in another invocation does not trace its finished methods again.
 fn method(
     cp: &super::Checkpoint,
     key: &str,

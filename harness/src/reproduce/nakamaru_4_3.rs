@@ -6,7 +6,7 @@
 //! and B differ.
 //!
 //! A row is a chain of steps, each saved as it finishes (`--resume`), so a row of days is done
-//! in sessions: the basic store (gzip-compressed: the basic method reads it strictly forward,
+//! in sittings: the basic store (gzip-compressed: the basic method reads it strictly forward,
 //! §3.4) and the split store are written in segments (`rtbench_engines::store::segments`), each
 //! segment a checkpoint; `max-seconds=S` stops the run at the first checkpoint past S seconds
 //! (the report then says which steps are still to do). A scene's rows share its stores and run
@@ -34,9 +34,9 @@
 use super::per_ray::{self, SizePoint};
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Param, Row, Runtime, Table, Verdict};
-use crate::commands::render::hex;
+use crate::output::hex;
 use crate::error::{input, Result};
-use crate::runs::shard::ShardSpec;
+use crate::shard::ShardSpec;
 use crate::workload::frustum::Frustum;
 use crate::workload::view_file::ViewFile;
 use crate::workload::{self, out_of_core, tiles};
@@ -99,7 +99,7 @@ const SUBSPACES: Param = Param {
 };
 const METHODS: Param = Param {
     key: "methods",
-    help: "the methods this invocation measures, of basic,sgb,sg (default all three); the others keep what earlier invocations saved, so a 10^9-object row can be measured one method a session (e.g. methods=sgb first: the split store and S+G+B only)",
+    help: "the methods this invocation measures, of basic,sgb,sg (default all three); the others keep what earlier invocations saved, so a 10^9-object row can be measured one method an invocation (e.g. methods=sgb first: the split store and S+G+B only)",
 };
 const FRACTION: Param = Param {
     key: "basic-fraction",
@@ -149,7 +149,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "per-ray-growth",
             fidelity: Fidelity::Substituted,
-            why: "issue 19's goal, not the thesis's: S+G+B's time per eye ray grows less than 2× from 10^6 to 10^9 objects; judged on this machine with every method on the high-resolution grid, from the row nearest 10^6 objects (give it in rows=, e.g. mount10) to a row of at least 5·10^8",
+            why: "our goal, not the thesis's: S+G+B's time per eye ray grows less than 2× from 10^6 to 10^9 objects; judged on this machine with every method on the high-resolution grid, from the row nearest 10^6 objects (give it in rows=, e.g. mount10) to a row of at least 5·10^8",
         },
         Claim {
             key: "per-ray-growth-thesis",
@@ -226,7 +226,7 @@ struct Run {
     cpu_s: f64,
     /// Seconds of the on-disk grid's build spent by earlier invocations that were stopped
     /// (`hrgrid=resume`: rings368's basic preprocessing sweeps its 35 GB store 27 times, ~4 h,
-    /// more than a session), counted in `preprocess_s` but not in `cpu_s`.
+    /// more than one sitting), counted in `preprocess_s` but not in `cpu_s`.
     #[serde(default)]
     earlier_s: f64,
     /// The tracing split: the engine's passes (`intersect_s`) and shading (`shade_s`, whose
@@ -366,7 +366,7 @@ fn sweeps(generation_rays: &[u64], group: u64) -> u64 {
         .sum()
 }
 
-/// A store written in segments: its seconds summed over sessions, its size.
+/// A store written in segments: its seconds summed over invocations, its size.
 #[derive(Serialize, Deserialize, Clone, Default)]
 struct StoreStep {
     objects: u64,
@@ -499,7 +499,7 @@ fn trace(
     extra: &[(&str, &str)],
     image: Option<&Path>,
 ) -> Result<Run> {
-    workload::reset_peak_rss();
+    crate::measure::rss::reset_peak_rss();
     let load_average = super::grid_runs::load_average();
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),
@@ -516,7 +516,7 @@ fn trace(
     }
     pairs.extend(extra.iter().map(|(k, v)| (k.to_string(), v.to_string())));
     let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
-    let cpu0 = workload::process_cpu_seconds();
+    let cpu0 = crate::measure::clock::process_cpu_seconds();
     let t = Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
     let earlier_s = engine
@@ -539,7 +539,7 @@ fn trace(
         None => s.size + 1,
     };
     // A run the pass cap stopped has no image and no scale until a split run's passes are known.
-    let capped = crate::commands::render::pass_capped(&r.counters);
+    let capped = crate::workload::out_of_core::pass_capped(&r.counters);
     if let (Some(path), false, None) = (image, capped, tile) {
         if let Some(d) = path.parent() {
             std::fs::create_dir_all(d).map_err(|e| input(format!("{}: {e}", d.display())))?;
@@ -556,7 +556,7 @@ fn trace(
         } else {
             hex(&Sha256::digest(r.pixels()))
         },
-        peak_rss_bytes: workload::peak_rss_bytes().unwrap_or(0),
+        peak_rss_bytes: crate::measure::rss::peak_rss_bytes().unwrap_or(0),
         rows_traced,
         scale: if capped {
             0.0
@@ -566,7 +566,7 @@ fn trace(
         load_average,
         capped,
         passes_total: 0,
-        cpu_s: workload::process_cpu_seconds() - cpu0,
+        cpu_s: crate::measure::clock::process_cpu_seconds() - cpu0,
         earlier_s,
         intersect_s: r.intersect_s,
         shade_s: r.shade_s,
@@ -642,7 +642,7 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
             None => return Ok(false),
         }
         save(m)?;
-        // A budget spent on the store stops here, so that the next session starts the run.
+        // A budget spent on the store stops here, so that the next invocation starts the run.
         if past(s) {
             return Ok(false);
         }
@@ -896,7 +896,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
                 "nakamaru-4.3: split-compress={c}: a split store is compressed as zstd blocks (zstd, zstd:LEVEL) or not at all (none)"
             )))
         }
-        c => crate::commands::scene::parse_codec(c)
+        c => crate::workload::out_of_core::parse_codec(c)
             .map_err(|e| input(format!("nakamaru-4.3: split-compress={c}: {e}")))?,
     };
     let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;
@@ -1005,7 +1005,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
 }
 
 /// The rows with S+G+B measured, as points of the time-per-ray benchmark, each method's seconds
-/// NaN where it is not measured yet (a 10^9-object row is measured one method a session); the
+/// NaN where it is not measured yet (a 10^9-object row is measured one method an invocation); the
 /// rings368m view is a series of its own ("rings-view-m"): other eye rays.
 fn size_points(measured: &[Measured]) -> Vec<SizePoint> {
     let nan = f64::NAN;
@@ -1094,7 +1094,7 @@ impl ThesisSgb {
     }
 }
 
-/// Issue 19's goal per scene: S+G+B's time per eye ray from the point nearest 10^6 objects to
+/// Our goal per scene (not the thesis's): S+G+B's time per eye ray from the point nearest 10^6 objects to
 /// the largest, judged when those are within 3× of 10^6 and at least 5·10^8. Beside it, where
 /// the thesis has both rows, the thesis's own growth between them, and ours judged against it
 /// (within 2× either way): the goal asks for less growth than the thesis's own tables show.
@@ -1131,7 +1131,7 @@ fn growth_rows(points: &[SizePoint], size: u32, thesis: &ThesisSgb) -> Vec<Row> 
         rows.push(Row::new(
             "per-ray-growth",
             scene.to_string(),
-            "< 2× from 10^6 to 10^9 objects (issue 19's goal)",
+            "< 2× from 10^6 to 10^9 objects (our goal)",
             ours.clone(),
             Kind::Ratio,
             if judged { Verdict::of(g < 2.0) } else { Verdict::Shown },
@@ -1228,7 +1228,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         };
         let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
         // Each claim as soon as the runs it compares are saved: a 10^9-object row is measured
-        // one method a session (`methods`).
+        // one method an invocation (`methods`).
         if let Some(b) = &m.basic {
             let model = b.is_model();
             let tag = if model { " (basic: model)" } else { "" };

@@ -1,15 +1,15 @@
 //! What the three `yamauchi-*` tables share: seed 003's own ray-tracing pass
-//! ([`crate::workload::pass_003`]: one primary ray per pixel centre, ≤ 3 reflections, no shadow rays)
+//! ([`super::models::pass_003`]: one primary ray per pixel centre, ≤ 3 reflections, no shadow rays)
 //! executed once per scene on the object-space engine, then timed on many (Mπ)² machine
 //! configurations by the engine's event simulation; the options they take, the records they keep
 //! of a pass and of a simulated run, and their plot helpers.
 
+use super::models::pass_003;
 use super::params::{Param, MAX_PES, SCENES, SIZE, THREADS};
-use super::yamauchi_radiosity::{ROOM, THRESHOLD};
 use super::{Checkpoint, Ctx, Image};
 use crate::error::{input, Result};
 use crate::source::Source;
-use crate::workload::{self, pass_003};
+use crate::workload;
 use rayon::prelude::*;
 use rtbench_engines::object_space::config::{Costs, FrameBuffer, ObjectSpaceConfig};
 use rtbench_engines::object_space::fbpath::FbPath;
@@ -23,6 +23,32 @@ use std::time::Instant;
 
 /// The options every `yamauchi-*` table takes.
 pub const PARAMS: &[Param] = &[THREADS, SIZE, MAX_PES, SCENES, ROOM, THRESHOLD];
+
+pub const ROOM: Param = Param {
+    key: "room",
+    help: "the room's patches per metre (default 8: 18,910 patches; 2 with --quick)",
+};
+pub const THRESHOLD: Param = Param {
+    key: "threshold",
+    help: "radiosity shooting threshold on unshot radiosity, above 0 (default 0.05)",
+};
+/// The default threshold on unshot radiosity (the lights emit 12; see the document).
+pub const DEFAULT_THRESHOLD: f32 = 0.05;
+
+/// `threshold`, above 0.
+pub fn threshold(ctx: &Ctx) -> Result<f32> {
+    let t = match ctx.params.raw(THRESHOLD.key) {
+        None => DEFAULT_THRESHOLD,
+        Some(v) => v.trim().parse::<f32>().map_err(|_| {
+            input(format!(
+                "{}: threshold '{v}': expected a number above 0",
+                ctx.id
+            ))
+        })?,
+    };
+    radiosity::check_threshold(t).map_err(|e| input(format!("{}: {e}", ctx.id)))?;
+    Ok(t)
+}
 
 /// The radiosity pass of a scene with emitting patches (the room): its patches and threshold.
 /// Its shots are executed as each simulated machine makes them ([`radiosity::simulate`]).
@@ -196,7 +222,7 @@ pub fn load_balancing_setting(ctx: &Ctx, min_pes: u32) -> Result<(u32, u32, Vec<
         .params
         .number::<u32>(ROOM.key, 0)?
         .unwrap_or(if ctx.quick { 2 } else { 8 });
-    let threshold = super::yamauchi_radiosity::threshold(ctx)?;
+    let threshold = threshold(ctx)?;
     let room = format!("room{ppm}");
     let default: Vec<&str> = if ctx.quick {
         vec![&room, "tetra"]
@@ -358,7 +384,7 @@ fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
 
 /// 64-bit FNV-1a of `bytes`: fixed by its definition, unlike std's `DefaultHasher` (whose
 /// algorithm may change between Rust versions, which would orphan every saved step). Keys made
-/// with it are marked `-f` where the `DefaultHasher` ones (session 6) were marked `-c`.
+/// with it are marked `-f` where the `DefaultHasher` ones were marked `-c`.
 pub fn stable_hash(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)

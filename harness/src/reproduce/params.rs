@@ -5,6 +5,7 @@
 //! names; `--set key=value` reaches every other key.
 
 use crate::error::{input, Result};
+use crate::measure::threads::Threads;
 use std::collections::BTreeMap;
 use std::str::FromStr;
 
@@ -21,7 +22,7 @@ pub const ENGINES: Param = Param {
 };
 pub const THREADS: Param = Param {
     key: "threads",
-    help: "worker threads (default: all cores)",
+    help: "worker threads: a count or all (default 1)",
 };
 pub const SIZE: Param = Param {
     key: "size",
@@ -117,9 +118,16 @@ impl Params {
         Ok(Some(items))
     }
 
-    /// `threads`: at least 1 (the pool refuses more than it can start).
+    /// `threads`: a count or `all` ([`Threads`]'s one spelling and default; the pool refuses more
+    /// than it can start). `None`: all cores.
     pub fn threads(&self) -> Result<Option<usize>> {
-        self.number::<usize>(THREADS.key, 1)
+        match self.raw(THREADS.key) {
+            None => Ok(Threads::DEFAULT.count()),
+            Some(v) => v
+                .parse::<Threads>()
+                .map(Threads::count)
+                .map_err(|e| input(format!("{}: {e}", self.id))),
+        }
     }
 
     /// `engines`: each a registered engine that can run here; default every available engine but
@@ -187,7 +195,7 @@ mod tests {
         assert!(p.threads().is_err());
         let p = Params::new("t", pairs(&[("size", "64")]), &[SIZE]).unwrap();
         assert_eq!(p.number::<u32>("size", 1).unwrap(), Some(64));
-        assert_eq!(p.threads().unwrap(), None);
+        assert_eq!(p.threads().unwrap(), Some(1));
     }
 
     #[test]

@@ -1,9 +1,9 @@
 //! Time per ray against scene size for the three methods of seed 000 Chapter 4 (basic, S+G,
-//! S+G+B), with each run's peak RSS beside it: issue 19's benchmark ("time per ray from 10^5 to
+//! S+G+B), with each run's peak RSS beside it: our benchmark ("time per ray from 10^5 to
 //! 10^9 objects on one plot; memory flat"). One chart per scene, from the rows a reproduction
 //! measured (`nakamaru-4.1`, and `nakamaru-4.3`, whose rows reach 10^9 objects). The time is preprocessing + tracing over the eye rays, (size + 1)²
 //! pixel corners, each with its whole ray tree (shadow, reflected, refracted rays): every row
-//! saved before session 7 kept no count of the other rays, and the eye rays are the same for the
+//! saved by older versions kept no count of the other rays, and the eye rays are the same for the
 //! three methods and every size.
 
 use rtbench_reports::plot::{Chart, LegendAt, Panel, Point, Series, XyPanel};
@@ -11,7 +11,7 @@ use rtbench_reports::{Document, Table as DocTable};
 
 /// One row: a scene at one size, each method's total seconds and peak RSS bytes. A method not
 /// (yet) measured at this size has NaN seconds and 0 bytes: the plots leave its point out and the
-/// table prints "-" (a 10^9-object row is measured one method a session).
+/// table prints "-" (a 10^9-object row is measured one method an invocation).
 pub struct SizePoint {
     pub scene: String,
     pub sf: u32,
@@ -90,7 +90,7 @@ pub fn charts(id: &str, points: &[SizePoint], size: u32) -> Vec<Chart> {
         .collect()
 }
 
-/// Issue 19's benchmark in numbers: per scene, the time per eye ray at its smallest and largest
+/// The benchmark in numbers: per scene, the time per eye ray at its smallest and largest
 /// row and the growth between them, per method (the plots are `plots/<id>-per-ray-<scene>.svg`).
 pub fn table(doc: &mut Document, points: &[SizePoint], size: u32) {
     let mut t = DocTable::new(

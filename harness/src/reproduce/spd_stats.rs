@@ -1,5 +1,5 @@
 //! `spd-stats`: the SPD 3.14 README's ray statistics of the seven standard scenes against the ray counts
-//! of our workload, with each engine (../shared/SPD.md, "Published ray statistics"). The README says a
+//! of our workload, with each engine (docs/concepts.md). The README says a
 //! classical ray tracer's counts "should be within about 10%".
 
 use super::params::{ENGINES, THREADS};
@@ -132,7 +132,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
             "no engine to run (see `rtbench engines`)",
         ));
     }
-    let pool = workload::pool(ctx.params.threads()?)?;
+    let pool = crate::measure::threads::pool(ctx.params.threads()?)?;
     let mut measured = Vec::new();
     let mut images = Vec::new();
     for row in &p.rows {

@@ -5,12 +5,11 @@
 
 use super::object_space_pass::{self as osp, SimRecord, Traced};
 use super::params::{Param, MAX_PES, SCENES, SIZE, THREADS};
-use super::yamauchi_radiosity::ROOM;
+use super::object_space_pass::ROOM;
 use rtbench_engines::object_space::fbpath::FbPath;
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::Result;
-use crate::workload;
 use rayon::prelude::*;
 use rtbench_engines::object_space::config::{Costs, FrameBuffer};
 use rtbench_engines::object_space::machine::Allocation;
@@ -441,7 +440,7 @@ fn pmcr_rows(s: &Setup) -> Result<Vec<PmcrRow>> {
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
     let s = setup(ctx)?;
-    let pool = workload::pool(ctx.params.threads()?)?;
+    let pool = crate::measure::threads::pool(ctx.params.threads()?)?;
     let model = model_rows(&p);
     let (points, knees) = pool.install(|| curve(s.packets));
     let traced = osp::trace_scenes(&s.scenes, s.size, Costs::default(), None)?;
@@ -528,7 +527,7 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             Kind::Count,
             Verdict::of(agree),
         )
-        .with_note("the digest's arithmetic, not 003's: equal to 4 significant digits"),
+        .with_note("our arithmetic from eqs. 11-21, not 003's: equal to 4 significant digits"),
         Row::new(
             "sim-vs-theory",
             "4-ary 5-stage, P_M = 0.5",
@@ -685,7 +684,7 @@ fn model_section(doc: &mut Document, r: &Result_) {
             "m-ary n-stage",
             "P_M",
             "saturation λ_PE (per PE per clock)",
-            "digest's derived value",
+            "derived from eqs. 11-21",
         ],
     );
     for m in &r.model {

@@ -4,13 +4,14 @@
 //! the solution (the image), and how fast the simulation runs. The room is a stand-in for 003's
 //! scene ([`rtbench_scenes::room`]).
 
-use super::object_space_pass::{self as osp, Published};
+use super::object_space_pass::{self as osp, threshold, Published, ROOM, THRESHOLD};
 use super::params::{Param, SIZE, THREADS};
 use super::published;
 use super::{environment, Claim, Ctx, Fidelity, Image, Kind, Output, Row, Runtime, Table, Verdict};
 use crate::error::{input, Result};
 use crate::source::Source;
-use crate::workload::{self, pass_003};
+use super::models::pass_003;
+use crate::workload;
 use glam::Vec3;
 use rtbench_engines::object_space::config::{FrameBuffer, ObjectSpaceConfig};
 use rtbench_engines::object_space::machine::Allocation;
@@ -24,14 +25,6 @@ use rtbench_engines::object_space::trace::Trace;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-pub const ROOM: Param = Param {
-    key: "room",
-    help: "the room's patches per metre (default 8: 18,910 patches; 2 with --quick)",
-};
-pub const THRESHOLD: Param = Param {
-    key: "threshold",
-    help: "radiosity shooting threshold on unshot radiosity, above 0 (default 0.05)",
-};
 pub const PES: Param = Param {
     key: "pes",
     help: "PE counts of the 2D skewed machines, powers of two 1-1024 (default 1,16,256,1024; 1,16,256 with --quick)",
@@ -71,9 +64,6 @@ pub const TABLE: Table = Table {
 
 const PUBLISHED: &str = include_str!("../../../data/published/yamauchi-radiosity.json");
 
-/// The default threshold on unshot radiosity (the lights emit 12; see the document).
-pub const DEFAULT_THRESHOLD: f32 = 0.05;
-
 /// `pes`: powers of two from 1 to 1,024 (a 2D torus of them divides 32 × 32 subspaces).
 pub fn pe_counts(ctx: &Ctx) -> Result<Vec<u32>> {
     let Some(list) = ctx.params.list(PES.key)? else {
@@ -92,21 +82,6 @@ pub fn pe_counts(ctx: &Ctx) -> Result<Vec<u32>> {
             ))),
         })
         .collect()
-}
-
-/// `threshold`, above 0.
-pub fn threshold(ctx: &Ctx) -> Result<f32> {
-    let t = match ctx.params.raw(THRESHOLD.key) {
-        None => DEFAULT_THRESHOLD,
-        Some(v) => v.trim().parse::<f32>().map_err(|_| {
-            input(format!(
-                "{}: threshold '{v}': expected a number above 0",
-                ctx.id
-            ))
-        })?,
-    };
-    radiosity::check_threshold(t).map_err(|e| input(format!("{}: {e}", ctx.id)))?;
-    Ok(t)
 }
 
 /// The room, its engine and patches, and the single-process solution.
@@ -294,7 +269,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
     let size = osp::size(ctx)?;
     let pes = pe_counts(ctx)?;
-    let pool = workload::pool(ctx.params.threads()?)?;
+    let pool = crate::measure::threads::pool(ctx.params.threads()?)?;
     let room = Room::new(ctx, if ctx.quick { 2 } else { 8 })?;
     let diffuse = room.diffuse();
     eprintln!("{}: tracing 003's ray-tracing pass at {size}x{size} …", room.label);

@@ -1,6 +1,7 @@
-//! Runs and sweeps: the environment, one measured run, and the plans that run many.
+//! Runs: the plan (jobs, child processes, the groups a shard takes whole), one measured run, the
+//! regression plant beside the run it wraps, and merging the shards of a plan.
 
-pub mod env;
+pub mod merge;
 pub mod one;
 pub mod plan;
-pub mod shard;
+pub mod plant;

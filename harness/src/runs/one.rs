@@ -3,6 +3,8 @@
 //! Running in its own process makes the peak RSS this run's alone, and a crash costs one run.
 
 use crate::error::Result;
+use crate::measure::repeat::Repeats;
+use crate::measure::span::{Sample, Workers};
 use crate::source::Source;
 use crate::workload::{self, crosscheck, trace};
 use rtbench_reports::{run_key, CheckResult, RunRecord, SceneInfo, Spread, ThreadScaling, Timings};
@@ -81,7 +83,7 @@ fn paired_thread_times(
     size: u32,
     pairs: u32,
 ) -> Result<Vec<(f64, f64, f64, f64)>> {
-    let one = workload::pool(Some(1))?;
+    let one = crate::measure::threads::pool(Some(1))?;
     let mut image: Option<Vec<u8>> = None;
     let mut time = |p: &rayon::ThreadPool| -> Result<(f64, f64)> {
         let r = p.install(|| trace::render(scene, engine, size, None));
@@ -135,7 +137,7 @@ pub(crate) fn flatten_counters(c: &rtbench_engines::Counters) -> BTreeMap<String
     m
 }
 
-/// The engine with the regression `RTBENCH_PLANT` plants, if any (crate::nightly::plant).
+/// The engine with the regression `RTBENCH_PLANT` plants, if any (super::plant).
 fn plant(
     engine: Box<dyn rtbench_engines::Engine>,
     spec: &OneSpec,
@@ -144,8 +146,8 @@ fn plant(
         Source::Program(p, _) => Some(p.name()),
         Source::File(_) | Source::Room(_) => None,
     };
-    match crate::nightly::plant::from_env(&spec.engine, program) {
-        Some(p) => Box::new(crate::nightly::plant::Planted::new(engine, p)),
+    match super::plant::from_env(&spec.engine, program) {
+        Some(p) => Box::new(super::plant::Planted::new(engine, p)),
         None => engine,
     }
 }
@@ -165,20 +167,13 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             spec.paired_threads
         )));
     }
-    let pool = workload::pool(spec.threads)?;
+    let pool = crate::measure::threads::pool(spec.threads)?;
     let prepared = workload::prepare(&spec.source)?;
     let scene = &prepared.input.scene;
-    let (mut build, mut tr, mut is, mut sh, mut cpu) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut last = None;
-    // One untimed render first: the first repeats of a fresh process run measurably slower
-    // (cold caches, page faults on first touch), which would widen every spread.
-    {
-        let (engine, _) = workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
-        let engine = plant(engine, spec);
-        pool.install(|| trace::render(scene, engine.as_ref(), spec.size, None));
-    }
-    for _ in 0..spec.repeats.max(1) {
+    // The one repeat policy: an untimed render first, then the timed repeats, each engine built
+    // afresh and its trace measured by the render's span.
+    let passes = Repeats::new(spec.repeats).run(Workers::Pool, |t| -> Result<_> {
         let (engine, build_s) =
             workload::build(&spec.engine, &prepared.input, spec.settings.clone())?;
         let engine = plant(engine, spec);
@@ -186,16 +181,19 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         if let Some(f) = engine.failure() {
             return Err(crate::error::input(f));
         }
-        build.push(prepared.prepare_s + build_s);
-        tr.push(r.trace_s);
-        cpu.push(r.trace_cpu_s);
-        is.push(r.intersect_s);
-        sh.push(r.shade_s);
+        t.record(r.sample.clone());
+        let phases = (prepared.prepare_s + build_s, r.intersect_s, r.shade_s);
         last = Some((engine, r));
-    }
+        Ok(phases)
+    })?;
+    let samples: Vec<Sample> = passes.iter().map(|(_, s)| s.clone()).collect();
+    let col = |f: fn(&(f64, f64, f64)) -> f64| passes.iter().map(|(p, _)| f(p)).collect::<Vec<_>>();
+    let (build, is, sh) = (col(|p| p.0), col(|p| p.1), col(|p| p.2));
+    let tr: Vec<f64> = samples.iter().map(|s| s.wall_s).collect();
+    let cpu: Vec<f64> = samples.iter().map(|s| s.thread_cpu_s).collect();
     let (engine, render) = last.expect("at least one repeat");
     // Before the cross-check builds Embree too.
-    let peak_rss_bytes = workload::peak_rss_bytes().unwrap_or(0);
+    let peak_rss_bytes = crate::measure::rss::peak_rss_bytes().unwrap_or(0);
     let wants_yardstick = (spec.check || spec.paired > 0) && spec.engine != "embree";
     let yardstick = if wants_yardstick && embree_available() {
         Some(workload::build("embree", &prepared.input, vec![])?.0)
@@ -203,7 +201,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         None
     };
     let paired_ratio = match (&yardstick, spec.paired) {
-        (Some(y), n) if n > 0 => Some(Spread::of(&paired_ratios(
+        (Some(y), n) if n > 0 => Some(Spread::of_ratios(&paired_ratios(
             &pool,
             scene,
             engine.as_ref(),
@@ -290,9 +288,11 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         check,
         paired_ratio,
         thread_scaling,
-        image_sha256: Some(crate::commands::render::hex(&sha2::Sha256::digest(pixels))),
+        image_sha256: Some(crate::output::hex(&sha2::Sha256::digest(pixels))),
+        samples,
+        ratio_to_embree: None,
         wall_s: start.elapsed().as_secs_f64(),
-        finished_at: super::env::now_utc(),
+        finished_at: crate::measure::environment::now_utc(),
         machine: None,
     })
 }

@@ -27,6 +27,31 @@ pub struct Job {
     pub threads: Option<usize>,
 }
 
+/// The group a job of `run` is sharded with: its scene (program, SF, tessellation) and threads, so
+/// Embree's run and the engines measured against it land on one machine.
+pub fn run_group(j: &Job) -> (String, u32, Option<u32>, Option<usize>) {
+    (j.program.clone(), j.sf, j.tessellate, j.threads)
+}
+
+/// What identifies a plan across its shards: the command, the shared settings, every job key.
+pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
+    // `paired_threads` only when asked for, so plans written before it keep their text.
+    let threads = match c.paired_threads {
+        0 => String::new(),
+        n => format!(" paired_threads={n}"),
+    };
+    format!(
+        "{kind} repeats={} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
+        c.repeats,
+        c.size,
+        c.check,
+        c.paired,
+        c.max_seconds,
+        c.max_memory,
+        keys.join("\n")
+    )
+}
+
 impl Job {
     fn scene_label(&self) -> String {
         let mut s = format!("{}{}", self.program, self.sf);
@@ -92,7 +117,7 @@ impl ResultsDir {
                 records.len()
             );
         }
-        let env = super::env::capture();
+        let env = crate::measure::environment::capture();
         let text = serde_json::to_string_pretty(&env).expect("environment serialises");
         write_atomic(&dir.join("env.json"), |w| {
             std::io::Write::write_all(w, text.as_bytes())
@@ -111,6 +136,7 @@ impl ResultsDir {
     pub fn put(&mut self, rec: RunRecord) -> Result<()> {
         self.records.retain(|r| r.key != rec.key);
         self.records.push(rec);
+        rtbench_reports::attach_ratios(&mut self.records);
         let mut text = String::new();
         for r in &self.records {
             text.push_str(&serde_json::to_string(r).expect("records serialise"));
@@ -152,7 +178,7 @@ fn failed(job: &Job, common: &Common, reason: String, wall_s: f64) -> RunRecord 
         repeats: common.repeats,
         size: common.size,
         wall_s,
-        finished_at: super::env::now_utc(),
+        finished_at: crate::measure::environment::now_utc(),
         ..Default::default()
     }
 }
@@ -186,8 +212,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     for (k, v) in &job.settings {
         cmd.args(["--set", &format!("{k}={v}")]);
     }
-    if let Some(t) = job.threads {
-        cmd.args(["--threads", &t.to_string()]);
+    {
+        let t = job.threads.map_or("all".to_string(), |t| t.to_string());
+        cmd.args(["--threads", &t]);
     }
     cmd.args([
         "--repeat",

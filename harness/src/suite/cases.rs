@@ -1,4 +1,4 @@
-//! The hard cases (issue 9): small scenes, each with rays chosen to hit a numerical weak spot.
+//! The hard cases: small scenes, each with rays chosen to hit a numerical weak spot.
 //! Every case is made in f64 and rounded to the `f32` rays engines take; its right answer is
 //! computed afterwards in f64 on those rays (`truth.rs`). Categories:
 //!

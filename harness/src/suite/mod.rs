@@ -1,5 +1,5 @@
 //! `rtbench check --suite hard|tessellation`: numerical stability on hard cases, speed against
-//! error, and the cost of tessellating curved primitives (issue 9).
+//! error, and the cost of tessellating curved primitives.
 //!
 //! - `hard` (`hard.rs`): every available engine (test-only ones aside) in every kernel variant
 //!   it accepts (`variants`) on the hard cases of `cases.rs`, scored against f64 answers

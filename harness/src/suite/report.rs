@@ -214,6 +214,7 @@ pub fn hard_charts(h: &HardResults) -> Vec<Chart> {
                             value: t.leaks as f64,
                             color: engine_colors[&r.variant.engine],
                             note: format!("{} / {}", t.leaks, t.must_hit),
+                            range: None,
                         }
                     })
                     .collect(),
@@ -232,6 +233,7 @@ pub fn hard_charts(h: &HardResults) -> Vec<Chart> {
                             value: n as f64,
                             color: engine_colors[&r.variant.engine],
                             note: n.to_string(),
+                            range: None,
                         }
                     })
                     .collect(),

@@ -4,13 +4,7 @@ pub mod camera;
 pub mod crosscheck;
 pub mod footprint;
 pub mod frustum;
-pub mod memory;
 pub mod out_of_core;
-pub mod paging;
-pub mod pass_003;
-pub mod rayshade_memory;
-pub mod replacement;
-pub mod sched;
 pub mod surface;
 pub mod tiles;
 pub mod trace;
@@ -97,106 +91,9 @@ pub fn build(
     Ok((e, t.elapsed().as_secs_f64()))
 }
 
-/// Threads this machine runs at once (`std::thread::available_parallelism`, 1 if unknown).
-pub fn available_threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-}
-
-/// Environment variable that raises the most threads `--threads` takes above the machine's
-/// (`RTBENCH_MAX_THREADS=2`): for instruction counts and tests of a two-thread trace on a
-/// process pinned to one core (`taskset -c 1`, where the machine's count reads 1). Threads
-/// beyond the cores time nothing but the scheduler: not for time figures.
-pub const MAX_THREADS_VAR: &str = "RTBENCH_MAX_THREADS";
-
-/// The most threads `--threads` takes: the machine's ([`available_threads`]), or more with
-/// [`MAX_THREADS_VAR`] (at most 64).
-pub fn thread_limit() -> usize {
-    let most = available_threads();
-    std::env::var(MAX_THREADS_VAR)
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .map_or(most, |n| most.max(n.min(64)))
-}
-
-/// A rayon pool with `threads` threads (all cores when `None`). More threads than the machine
-/// runs at once are refused: they measure nothing but the scheduler (100,000 made a load
-/// average of 800 on two cores before failing); [`MAX_THREADS_VAR`] raises the limit.
-pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    if threads == Some(0) {
-        return Err(input("--threads must be at least 1"));
-    }
-    let most = thread_limit();
-    if let Some(n) = threads.filter(|&n| n > most) {
-        return Err(input(format!(
-            "--threads {n}: more than the {most} this machine runs at once"
-        )));
-    }
-    let mut b = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0));
-    if std::env::var_os(PIN_THREADS_VAR).is_some() {
-        let cpus = allowed_cpus();
-        if !cpus.is_empty() {
-            b = b.start_handler(move |i| pin_to_cpu(cpus[i % cpus.len()]));
-        }
-    }
-    b.build()
-        .map_err(|e| input(format!("cannot start threads: {e}")))
-}
-
-/// Environment variable that pins each thread of every pool [`pool`] makes to one CPU of those
-/// the process may run on (thread i to the i-th, round robin): an experiment on where the
-/// scheduler puts the pool's threads (issue 20, acceptance 3), not a default.
-pub const PIN_THREADS_VAR: &str = "RTBENCH_PIN_THREADS";
-
-/// The CPUs the calling thread may run on (empty where that cannot be read).
-pub fn allowed_cpus() -> Vec<usize> {
-    // SAFETY: a zeroed cpu_set_t is a valid empty set; sched_getaffinity writes only into it.
-    let mut set: libc::cpu_set_t = unsafe { std::mem::zeroed() };
-    // SAFETY: pid 0 is the calling thread; the size is the set's own.
-    let rc =
-        unsafe { libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) };
-    if rc != 0 {
-        return Vec::new();
-    }
-    (0..libc::CPU_SETSIZE as usize)
-        // SAFETY: `c` is below CPU_SETSIZE, the set's capacity.
-        .filter(|&c| unsafe { libc::CPU_ISSET(c, &set) })
-        .collect()
-}
-
-/// Pins the calling thread to `cpu` (best effort: a refusal leaves it where it was).
-pub fn pin_to_cpu(cpu: usize) {
-    // SAFETY: as in `allowed_cpus`; CPU_SET writes only into `set`, `cpu` < CPU_SETSIZE is checked.
-    unsafe {
-        if cpu >= libc::CPU_SETSIZE as usize {
-            return;
-        }
-        let mut set: libc::cpu_set_t = std::mem::zeroed();
-        libc::CPU_SET(cpu, &mut set);
-        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
-    }
-}
-
 /// Bytes the workload holds per pixel corner, at least: measured 80 (in-memory engines) to 210
 /// (breadth-first) at --size 2048 (corners, rays, hits, paths, shading records), rounded up.
 pub const BYTES_PER_CORNER: u64 = 256;
-
-/// Memory this process can still have: the smaller of the machine's available memory
-/// (`MemAvailable`) and the address space left under its limit (`ulimit -v`, less what is
-/// mapped already). None when neither is known.
-pub fn memory_available() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
-        let line = t.lines().find(|l| l.starts_with("MemAvailable:"))?;
-        line.split_whitespace().nth(1)?.parse::<u64>().ok()
-    });
-    let mem = meminfo.map(|kb| kb.saturating_mul(1024));
-    let limit = rtbench_engines::usage::address_space_left();
-    match (mem, limit) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
-}
 
 fn gib(b: u64) -> String {
     format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
@@ -209,7 +106,7 @@ pub fn check_size(size: u32) -> Result<()> {
     }
     let corners = (size as u64 + 1).pow(2);
     let need = corners * BYTES_PER_CORNER;
-    if let Some(have) = memory_available().filter(|&have| need > have) {
+    if let Some(have) = crate::measure::memory::memory_available().filter(|&have| need > have) {
         return Err(input(format!(
             "--size {size}: the workload needs at least {} ({BYTES_PER_CORNER} B per pixel \
              corner), {} is available",
@@ -233,7 +130,7 @@ pub fn check_scene_fits(src: &Source, engines: &[&str], force: bool) -> Result<(
     }
     let f = footprint::Census::of(*p, o);
     let need = f.bytes(engines);
-    if let Some(have) = memory_available().filter(|&have| need > have) {
+    if let Some(have) = crate::measure::memory::memory_available().filter(|&have| need > have) {
         return Err(input(format!(
             "{}: {} objects ({} primitives to build over) need about {} in memory with {}, {} is \
              available (--force to try anyway)",
@@ -246,46 +143,6 @@ pub fn check_scene_fits(src: &Source, engines: &[&str], force: bool) -> Result<(
         )));
     }
     Ok(())
-}
-
-/// Peak resident set size of this process (Linux `VmHWM`), in bytes.
-/// Starts the peak RSS (`VmHWM`) afresh from the current RSS (Linux's `clear_refs` 5), so that
-/// one step of a long run reports its own peak; false where the kernel does not allow it.
-pub fn reset_peak_rss() -> bool {
-    std::fs::write("/proc/self/clear_refs", "5").is_ok()
-}
-
-pub fn peak_rss_bytes() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// CPU seconds the calling thread has used (`CLOCK_THREAD_CPUTIME_ID`). The trace's CPU time
-/// is counted on our own threads only: a whole-process figure would include the worker threads
-/// of Embree's TBB, which spin on after a build and made Embree's time vary twofold between runs.
-pub fn thread_cpu_seconds() -> f64 {
-    cpu_seconds(libc::CLOCK_THREAD_CPUTIME_ID)
-}
-
-/// CPU seconds the whole process has used (`CLOCK_PROCESS_CPUTIME_ID`): for runs without
-/// Embree, where a process that got less than its core shows as CPU time well below wall time.
-pub fn process_cpu_seconds() -> f64 {
-    cpu_seconds(libc::CLOCK_PROCESS_CPUTIME_ID)
-}
-
-fn cpu_seconds(clock: libc::clockid_t) -> f64 {
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes only into `t`, which we own; the clock id is a constant.
-    let rc = unsafe { libc::clock_gettime(clock, &mut t) };
-    if rc != 0 {
-        return 0.0;
-    }
-    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
 /// Feature sizes below this share of the scene's scale (its largest coordinate, the camera's

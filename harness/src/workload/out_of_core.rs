@@ -58,10 +58,10 @@ pub fn shade_bytes_per_ray(lights: usize) -> usize {
 /// Rays shaded per group: Algorithm 3.6's "while memory not full of rays", the rays the engine
 /// holds in memory at once within its budget, as far as [`SHADE_BYTES`] holds them, and at least
 /// [`MIN_GROUP`]. The basic layout reads the store forward once per group up to the last object
-/// hit, so at 10^9 objects (rings368's 35 GB store: 284 s a read in session 13) the group's size
+/// hit, so at 10^9 objects (rings368's 35 GB store: 284 s a read, measured) the group's size
 /// sets the shading time: a fixed 16,384 makes the 263,169 eye rays of a 512² image 17 sweeps,
 /// rings368's 41,213 rays a pass 7. Without the byte cap, gears18's and rings94's peak RSS
-/// passed the 320 MiB bound (331.5 and 358.2 MiB in session 13).
+/// passed the 320 MiB bound (331.5 and 358.2 MiB, measured).
 pub fn shade_group(engine: &BreadthFirst, lights: usize) -> usize {
     engine
         .ray_capacity()
@@ -246,7 +246,7 @@ pub fn render(engine: &BreadthFirst, size: u32) -> io::Result<OutOfCoreRender> {
 pub fn render_tile(
     engine: &BreadthFirst,
     size: u32,
-    tile: Option<crate::runs::shard::ShardSpec>,
+    tile: Option<crate::shard::ShardSpec>,
 ) -> io::Result<OutOfCoreRender> {
     render_view(engine, size, tile, None)
 }
@@ -256,11 +256,11 @@ pub fn render_tile(
 pub fn render_view(
     engine: &BreadthFirst,
     size: u32,
-    tile: Option<crate::runs::shard::ShardSpec>,
+    tile: Option<crate::shard::ShardSpec>,
     view: Option<&rtbench_scenes::View>,
 ) -> io::Result<OutOfCoreRender> {
-    let start = Instant::now();
-    let cpu_start = super::thread_cpu_seconds();
+    // One thread does all the work here.
+    let span = crate::measure::span::Span::start(crate::measure::span::Workers::Caller);
     let h = engine.header();
     let config = engine.config();
     let buffer = config.buffer as usize;
@@ -517,6 +517,7 @@ pub fn render_view(
     }
     io_total.add(&rays.remove()?);
     io_total.add(&scene.io());
+    let sample = span.stop();
     Ok(OutOfCoreRender {
         render: Render {
             pixels: super::trace::pixels_of(size, &corners),
@@ -525,13 +526,37 @@ pub fn render_view(
             counters,
             intersect_s,
             shade_s,
-            trace_s: start.elapsed().as_secs_f64(),
-            // One thread does all the work here.
-            trace_cpu_s: super::thread_cpu_seconds() - cpu_start,
+            trace_s: sample.wall_s,
+            trace_cpu_s: sample.thread_cpu_s,
+            sample,
         },
         io: io_total,
         shade_group: group_len,
         shade_sweeps,
         shade_cap: SHADE_BYTES / shade_bytes_per_ray(lights.len()),
     })
+}
+
+/// Whether the breadth-first engine's pass cap stopped the run (`max_passes`).
+pub fn pass_capped(c: &rtbench_engines::Counters) -> bool {
+    c.extra
+        .get(rtbench_engines::breadth_first::cap::CAP_REACHED)
+        .is_some_and(|&n| n > 0)
+}
+
+/// `none`, `gzip`, `gzip:LEVEL` (1–9), `zstd` or `zstd:LEVEL` (1–19).
+pub fn parse_codec(s: &str) -> std::result::Result<rtbench_engines::store::Codec, String> {
+    let level = |p: &str| s.strip_prefix(p).map(str::parse::<u32>);
+    match s {
+        "none" => Ok(rtbench_engines::store::Codec::None),
+        "gzip" => Ok(rtbench_engines::store::Codec::Gzip(6)),
+        "zstd" => Ok(rtbench_engines::store::Codec::Zstd(3)),
+        _ => match (level("gzip:"), level("zstd:")) {
+            (Some(Ok(l)), _) if (1..=9).contains(&l) => Ok(rtbench_engines::store::Codec::Gzip(l)),
+            (_, Some(Ok(l))) if (1..=19).contains(&l) => {
+                Ok(rtbench_engines::store::Codec::Zstd(l as i32))
+            }
+            _ => Err("expected none, gzip, gzip:LEVEL (1-9), zstd or zstd:LEVEL (1-19)".into()),
+        },
+    }
 }

@@ -14,9 +14,9 @@
 //! little-endian RGB, its rows in ascending order) and `tile.json` ([`TileOutput`]).
 
 use super::trace::{pixels_of, RayStats};
-use crate::commands::merge::Shard;
 use crate::error::{input, Result};
-use crate::runs::shard::ShardSpec;
+use crate::shard::Shard;
+use crate::shard::ShardSpec;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -119,7 +119,7 @@ impl Merged {
             "counters": self.counters,
             "io": {"workload": self.io},
             "image": {"width": self.size, "height": self.size,
-                      "sha256": crate::commands::render::hex(&sha2::Sha256::digest(&self.pixels))},
+                      "sha256": crate::output::hex(&sha2::Sha256::digest(&self.pixels))},
             "tiles": self.tiles.iter().map(|(k, host, pre, trace, rss)| serde_json::json!({
                 "tile": k, "machine": host, "preprocess_s": pre, "trace_s": trace,
                 "peak_rss_bytes": rss})).collect::<Vec<_>>(),

@@ -1,5 +1,5 @@
-//! The SPD workload, traced as wavefront generations (../shared/SPD.md, "The testing
-//! procedure"): all rays of one depth are answered as batches by the engine before shading makes
+//! The SPD workload, traced as wavefront generations (docs/concepts.md, "The SPD
+//! workload"): all rays of one depth are answered as batches by the engine before shading makes
 //! the next generation. One shading code path serves every engine, so images and ray statistics
 //! agree across engines.
 //!
@@ -20,6 +20,7 @@
 
 use super::camera::Camera;
 use super::surface::Surfaces;
+use crate::measure::span::{Sample, Span, Workers};
 use glam::Vec3;
 use rayon::prelude::*;
 use rtbench_engines::{Counters, Engine, Hit, Ray};
@@ -128,6 +129,9 @@ pub struct Render {
     pub trace_s: f64,
     /// CPU seconds the trace used on our threads (the render's and the pool's).
     pub trace_cpu_s: f64,
+    /// The trace as its span measured it (`trace_s` and `trace_cpu_s` are its wall and worker
+    /// CPU seconds).
+    pub sample: Sample,
 }
 
 impl Render {
@@ -328,10 +332,9 @@ pub fn render(
     render_chunked(scene, engine, size, DEFAULT_CHUNK, false, record)
 }
 
-/// Environment variable that makes [`render_chunked`] print one line per band on stderr (its
-/// rows, thread, rays, engine counters and the thread's CPU seconds): how the trace's work is
-/// spread over bands and threads (issue 20, acceptance 3).
-pub const BANDS_VAR: &str = "RTBENCH_BANDS";
+// `RTBENCH_BANDS` (read once, in `measure::vars`) makes [`render_chunked`] print one line per
+// band on stderr (its rows, thread, rays, engine counters and the thread's CPU seconds): how the
+// trace's work is spread over bands and threads.
 
 /// The buffers of one chunk's generations, reused from chunk to chunk on a thread.
 #[derive(Default)]
@@ -420,8 +423,7 @@ pub fn render_chunked(
     keep_corners: bool,
     mut record: Option<&mut Recording>,
 ) -> Render {
-    let start = Instant::now();
-    let cpu_start = pool_cpu_seconds();
+    let span = Span::start(Workers::Pool);
     let batch = engine.batch_hint();
     let n = size as usize;
     let w = n + 1;
@@ -443,7 +445,7 @@ pub fn render_chunked(
     // (the seam) is made from the last corner row of the band above and the first of the band
     // below by whichever of the two finishes second, so only the edge rows of bands whose
     // neighbour is not yet done are held (on one thread: one row; all bands' edge rows were
-    // 0.9 MiB at 512², session 11).
+    // 0.9 MiB at 512²).
     let mut pixels = vec![0u8; n * n * 3];
     let mut slices = Vec::new();
     let mut seams = Vec::new();
@@ -469,18 +471,19 @@ pub fn render_chunked(
     }
     let seams = Mutex::new(seams);
     let recording = record.is_some();
-    let bands = std::env::var_os(BANDS_VAR).is_some();
-    let sched = std::env::var_os(super::sched::SCHED_VAR);
+    let vars = crate::measure::vars::values();
+    let bands = vars.bands;
+    let sched = vars.sched;
     let sched_on = sched.is_some();
     // With RTBENCH_SCHED: each pool thread's scheduler counts before the region, and every
     // band's (thread, start, end) seconds from the region's start.
     let sched_start = Instant::now();
-    let cpus_before = sched_on.then(super::sched::read_cpus);
-    let process_before = sched_on.then(super::sched::process_threads);
-    let sched_before = sched_on.then(|| rayon::broadcast(|_| super::sched::read_self()));
+    let cpus_before = sched_on.then(crate::measure::sched::read_cpus);
+    let process_before = sched_on.then(crate::measure::sched::process_threads);
+    let sched_before = sched_on.then(|| rayon::broadcast(|_| crate::measure::sched::read_self()));
     // With RTBENCH_SCHED=bands also every band's line: its thread, the CPU it started and
     // ended on, and its start and end.
-    let sched_bands = sched.is_some_and(|v| v == "bands");
+    let sched_bands = sched == Some(true);
     let band_times: Mutex<Vec<(usize, f64, f64)>> = Mutex::new(Vec::new());
     // One wavefront per pool thread, reused from band to band. A thread that runs a second band
     // while its first waits inside the engine's batches (rayon's join lets it) gets a fresh one.
@@ -495,8 +498,8 @@ pub fn render_chunked(
         // take only pieces still queued, never bands of the piece being traced. The bands' work
         // is uneven (gears4 bvh8 at 512², one thread's CPU seconds per band: the first half of
         // the bands 39 % of the trace, one band up to 5.9 %): split in two halves, two threads
-        // are bound at 1.65×; bands taken one by one as threads free up, at 1.99× (session 11,
-        // a model from the per-band seconds). The order bands are traced in changes no answer.
+        // are bound at 1.65×; bands taken one by one as threads free up, at 1.99× (a
+        // model from the per-band seconds). The order bands are traced in changes no answer.
         .with_max_len(1)
         .map(|(k, j0, out)| {
             let slot = rayon::current_thread_index().unwrap_or(0) % threads;
@@ -511,8 +514,8 @@ pub fn render_chunked(
                 None => own.insert(Wavefront::default()),
             };
             let rows = band_rows.min(w - j0);
-            let cpu = bands.then(super::thread_cpu_seconds);
-            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), super::sched::cpu()));
+            let cpu = bands.then(crate::measure::clock::thread_cpu_seconds);
+            let band_start = sched_on.then(|| (t.elapsed().as_secs_f64(), crate::measure::sched::cpu()));
             let mut part = trace_chunk(&setup, (j0 * w) as u32, rows * w, wf, recording);
             if let Some((s, cpu0)) = band_start {
                 let e = t.elapsed().as_secs_f64();
@@ -520,7 +523,7 @@ pub fn render_chunked(
                 if sched_bands {
                     eprintln!(
                         "sched band {k} thread {i} cpu {cpu0} {} start_s {s:.6} end_s {e:.6}",
-                        super::sched::cpu()
+                        crate::measure::sched::cpu()
                     );
                 }
                 band_times
@@ -538,7 +541,7 @@ pub fn render_chunked(
                     c.box_tests,
                     c.primitive_tests,
                     c.cells_visited,
-                    super::thread_cpu_seconds() - cpu
+                    crate::measure::clock::thread_cpu_seconds() - cpu
                 );
             }
             for (j, row) in out.chunks_exact_mut(n * 3).take(rows - 1).enumerate() {
@@ -603,6 +606,7 @@ pub fn render_chunked(
     } else {
         1.0
     };
+    let sample = span.stop();
     Render {
         corners,
         pixels,
@@ -610,30 +614,35 @@ pub fn render_chunked(
         counters,
         intersect_s: intersect_s * share,
         shade_s: shade_s * share,
-        trace_s: start.elapsed().as_secs_f64(),
-        trace_cpu_s: pool_cpu_seconds() - cpu_start,
+        trace_s: sample.wall_s,
+        trace_cpu_s: sample.thread_cpu_s,
+        sample,
     }
 }
 
-/// The `sched` lines of [`super::sched::SCHED_VAR`]: each pool thread's scheduler counts over
+/// The `sched` lines of `RTBENCH_SCHED`: each pool thread's scheduler counts over
 /// the parallel region (`before`: read by each thread at the region's start, in thread order,
 /// after `start`; the wall seconds are from `start` to when every thread has read its counts
 /// again) and its bands' wall seconds (`band_times`: thread, start, end).
 fn print_sched(
-    before: &[Option<super::sched::ThreadSched>],
+    before: &[Option<crate::measure::sched::ThreadSched>],
     cpus: &[(usize, [u64; 8])],
     process: &[(i64, u64)],
     start: Instant,
     band_times: &[(usize, f64, f64)],
 ) {
-    let after = rayon::broadcast(|_| super::sched::read_self());
+    let after = rayon::broadcast(|_| crate::measure::sched::read_self());
     let region_s = start.elapsed().as_secs_f64();
     let pool: Vec<i64> = after.iter().flatten().map(|t| t.tid).collect();
     eprintln!(
         "{}",
-        super::sched::process_line(process, &super::sched::process_threads(), &pool)
+        crate::measure::sched::process_line(
+            process,
+            &crate::measure::sched::process_threads(),
+            &pool
+        )
     );
-    for l in super::sched::cpu_lines(cpus, &super::sched::read_cpus()) {
+    for l in crate::measure::sched::cpu_lines(cpus, &crate::measure::sched::read_cpus()) {
         eprintln!("{l}");
     }
     for (i, (b, a)) in before.iter().zip(&after).enumerate() {
@@ -649,37 +658,21 @@ fn print_sched(
         let last = mine.iter().map(|x| x.1).fold(0.0, f64::max);
         eprintln!(
             "{}",
-            super::sched::line(
+            crate::measure::sched::line(
                 i,
                 region_s,
                 &a.since(b),
                 mine.len(),
-                super::sched::covered_seconds(&mine),
+                crate::measure::sched::covered_seconds(&mine),
                 last
             )
         );
     }
 }
 
-/// CPU seconds used so far by the threads of the current rayon pool, summed. A render's CPU
-/// time is counted on the pool's threads only: a whole-process figure would include the worker
-/// threads of Embree's TBB, which spin on after a build and made Embree's time vary twofold
-/// between runs. Called from outside any pool, the calling thread is counted with the global
-/// pool's.
-fn pool_cpu_seconds() -> f64 {
-    let pool: f64 = rayon::broadcast(|_| super::thread_cpu_seconds())
-        .into_iter()
-        .sum();
-    if rayon::current_thread_index().is_none() {
-        pool + super::thread_cpu_seconds()
-    } else {
-        pool
-    }
-}
-
 /// Traces the ray trees of the corners `first..first + count` to the end, their colours into
 /// `wf.corners`. Never inlined (once per band, so no cost): a profile then shows the bands'
-/// work apart from the serial rest of [`render_chunked`] (issue 20, acceptance 3).
+/// work apart from the serial rest of [`render_chunked`].
 #[inline(never)]
 fn trace_chunk(s: &Setup, first: u32, count: usize, wf: &mut Wavefront, recording: bool) -> Part {
     let t_chunk = Instant::now();

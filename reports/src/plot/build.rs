@@ -40,12 +40,11 @@ pub fn charts(summary: &Summary) -> Vec<Chart> {
             .push(r);
     }
     for ((threads, _, _, scene), rows) in &scenes {
-        charts.push(mrays_by_engine(
-            scene,
-            &thread_suffix(several_threads, *threads),
-            rows,
-            &colors,
-        ));
+        let suffix = thread_suffix(several_threads, *threads);
+        charts.push(mrays_by_engine(scene, &suffix, rows, &colors));
+        if let Some(c) = ratio_by_engine(scene, &suffix, rows, &colors) {
+            charts.push(c);
+        }
     }
 
     if let Some(c) = speed_vs_error(summary, &colors) {
@@ -215,6 +214,7 @@ fn mrays_by_engine(
                 ),
                 _ => number::sig(r.mrays_per_s, 3),
             },
+            range: None,
         })
         .collect();
     Chart {
@@ -318,4 +318,46 @@ mod tests {
         assert_eq!(super::file_stem("mrays-balls4-tess3"), "mrays-balls4-tess3");
         assert_eq!(super::file_stem("mrays-my scene/x"), "mrays-my_scene_x");
     }
+}
+
+/// Trace time over Embree's by engine for one scene, each bar with its 95 % interval as an error
+/// bar (and, where the run timed pairs, the paired ratio as a bar of its own); none without an
+/// interval to draw.
+fn ratio_by_engine(
+    scene: &str,
+    suffix: &(String, String),
+    rows: &[&Row],
+    colors: &BTreeMap<String, usize>,
+) -> Option<Chart> {
+    let mut bars = Vec::new();
+    for r in rows.iter().filter(|r| r.engine != EMBREE) {
+        let color = colors.get(&r.label).copied().unwrap_or(0);
+        let mut push = |label: String, i: &crate::interval::Interval| {
+            bars.push(Bar {
+                label,
+                value: i.estimate,
+                color,
+                note: format!("{} (n {})", i.text(), i.n),
+                range: Some((i.lo, i.hi)),
+            })
+        };
+        if let Some(i) = &r.ratio_interval {
+            push(r.label.clone(), i);
+        }
+        if let Some(i) = r.paired_ratio.as_ref().and_then(|p| p.interval.as_ref()) {
+            push(format!("{} paired", r.label), i);
+        }
+    }
+    if bars.is_empty() {
+        return None;
+    }
+    Some(Chart {
+        stem: file_stem(&format!("ratio-{scene}{}", suffix.0)),
+        title: format!("{scene}: trace time × Embree, 95 % interval{}", suffix.1),
+        panels: vec![Panel::Bars(BarPanel {
+            title: String::new(),
+            value_label: "× Embree".to_string(),
+            bars,
+        })],
+    })
 }

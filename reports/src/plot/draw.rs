@@ -266,7 +266,8 @@ fn draw_bars<DB: DrawingBackend>(
     let max = p
         .bars
         .iter()
-        .map(|b| b.value)
+        .flat_map(|b| [Some(b.value), b.range.map(|r| r.1)])
+        .flatten()
         .filter(|v| v.is_finite())
         .fold(0.0, f64::max);
     // Room at the right for the value printed after the longest bar.
@@ -317,9 +318,29 @@ fn draw_bars<DB: DrawingBackend>(
             r
         }))
         .map_err(e)?;
+    // Error bars: the interval as a line across the bar's end, with end caps.
+    for (i, b) in p.bars.iter().enumerate() {
+        let Some((lo, hi)) = b.range.filter(|r| r.0.is_finite() && r.1.is_finite()) else {
+            continue;
+        };
+        let row = n - 1 - i;
+        let at = |x: f64| (x.max(0.0), SegmentValue::CenterOf(row));
+        let ink = BLACK.stroke_width(2);
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![at(lo), at(hi)], ink)))
+            .map_err(e)?;
+        for x in [lo, hi] {
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at(at(x)) + PathElement::new(vec![(0, -6), (0, 6)], ink),
+                ))
+                .map_err(e)?;
+        }
+    }
     chart
         .draw_series(p.bars.iter().enumerate().map(|(i, b)| {
-            let at = (b.value.max(0.0), SegmentValue::CenterOf(n - 1 - i));
+            let end = b.range.map_or(b.value, |r| r.1.max(b.value));
+            let at = (end.max(0.0), SegmentValue::CenterOf(n - 1 - i));
             EmptyElement::at(at) + Text::new(b.note.clone(), (6, -7), text(13))
         }))
         .map_err(e)?;

@@ -70,4 +70,6 @@ pub struct Bar {
     pub color: usize,
     /// Printed at the end of the bar.
     pub note: String,
+    /// An interval drawn as an error bar across the bar's end (a ratio's 95 % interval).
+    pub range: Option<(f64, f64)>,
 }

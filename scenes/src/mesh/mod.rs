@@ -3,7 +3,7 @@
 //! never makes rtbench read outside its own folder (`folder.rs`).
 //!
 //! A mesh file carries triangles, not a scene: no camera, no lights, no materials that mean
-//! anything to the SPD workload. So every file becomes the same kind of scene (docs/meshes.md):
+//! anything to the SPD workload. So every file becomes the same kind of scene (docs/guides/meshes.md):
 //! - every face as a triangle patch with vertex normals (the file's, or area-weighted normals
 //!   computed from the faces when it has none); polygons are fanned; zero-area triangles are
 //!   dropped;

@@ -1,4 +1,4 @@
-//! NFF, the Neutral File Format of the SPD (../shared/SPD.md, "Output format").
+//! NFF, the Neutral File Format of the SPD (docs/concepts.md).
 
 pub mod cfmt;
 pub mod read;

@@ -11,7 +11,7 @@
 //! candidate of the next pass (the sentinel), so that whether it survives the sweep is decided
 //! without walking again: its hit is complete once it lies before the sentinel's entry.
 
-use super::super::intersect::{face_bit_of, Slot};
+use super::super::slot::{face_bit_of, Slot};
 use super::super::voxels::MARKED;
 use super::disk_grid::DiskGrid;
 use crate::engine::Counters;

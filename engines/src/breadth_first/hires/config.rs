@@ -40,7 +40,7 @@ pub struct TwoLevelConfig {
     /// ([`super::disk_grid::DiskGrid::build`]).
     pub resume: bool,
     /// `hrgrid_subspaces=K`: build only the first K subspaces of the on-disk grid and leave the
-    /// rest empty: a timing model of a build longer than a session (rings368's basic build is 27
+    /// rest empty: a timing model of a build longer than one sitting (rings368's basic build is 27
     /// sweeps of a 35 GB store). The answers are then not the scene's, so it needs `max_passes`
     /// (whose runs claim no image) and `hrgrid=build`, and the partial grid is removed from the
     /// store once opened, so that no later run can take it.

@@ -12,7 +12,7 @@
 //!   temporary, so no half-written grid is ever left. A file whose length disagrees with its
 //!   header is refused when opened, and a read past its end fails, naming the file.
 
-use super::super::hierarchy::Tree;
+use super::super::tree::Tree;
 use super::super::voxels::{face_bit, Voxels, MARKED};
 use crate::store::hierarchy::NODE_RECORD;
 use crate::store::{IoCounters, ObjectRecord, SceneReader, BBOX_RECORD, HEADER_FILE};

@@ -109,7 +109,7 @@ const FORK_MIN: usize = 4096;
 /// own side of the splitter in place ([`Binned::fork`]), and the subtrees are appended in the
 /// order the one-thread build makes them. Every split is the one the one-thread build chooses,
 /// so the tree is the same node for node (test `bvh::tests::threads_build_the_same_tree`);
-/// what runs in parallel is the binning of the subtrees, 86% of the build (callgrind, issue 20).
+/// what runs in parallel is the binning of the subtrees, 86% of the build (callgrind).
 pub fn binary_blocks_threads(mut s: Binned<'_>, rule: &BlockLeaves, threads: usize) -> BuildTree {
     if threads <= 1 {
         return binary_blocks(s, rule);
@@ -120,7 +120,7 @@ pub fn binary_blocks_threads(mut s: Binned<'_>, rule: &BlockLeaves, threads: usi
         order: Vec::new(),
     };
     // Four subtrees per thread, so that uneven splits still keep every core busy. Fresh
-    // processes' two-thread builds of balls4 tessellated (issue 20, session 15): with forks
+    // processes' two-thread builds of balls4 tessellated: with forks
     // that copied the splitter, two per thread took 0.243–0.254 s (3 builds) and four
     // 0.225–0.234 s (4); with forks in place, four 0.220–0.227 s (4) and eight 0.222–0.227 s (4).
     let forks = threads.next_power_of_two().trailing_zeros() as usize + 2;
@@ -146,7 +146,7 @@ fn fork_node(
     // (A range this large is never a leaf: n > max.) Only the top split has every thread
     // free: below it each range has a thread of its own already. Its binning ran alone on
     // one thread, 71 M instructions of the 403 M the first thread ran alone on balls4
-    // tessellated at two threads (callgrind, issue 20, session 12).
+    // tessellated at two threads (callgrind).
     let split = s.split_threads(r, None, depth >= SAH_MEDIAN_DEPTH, threads);
     let leaf_cost = super::blocks(n, rule.block) as f32 * T_TRI;
     if packable && leaf_cost <= split.cost - T_AABB {

@@ -74,7 +74,7 @@ pub struct Binned<'a> {
 
 /// A splitter's boxes or indices: its own, or a part of its parent's (a fork's side, split
 /// in place without copying: the copies and their page faults were a pass on one thread per
-/// fork; issue 20, session 15).
+/// fork).
 enum Store<'a, T> {
     Owned(Vec<T>),
     Part(&'a mut [T]),
@@ -116,8 +116,7 @@ impl Bin {
 /// `[0, last]`. The clamp is done on floats before the one SSE2 conversion (`cvttps2dq`);
 /// truncating then clamping gives the same bins (both are monotone and `last` is a whole
 /// number), and a NaN goes to bin 0 either way. glam's `as_uvec3` converted lane by lane with
-/// Rust's saturating casts, 23% of the build's instructions with the clamp (callgrind, issue
-/// 20, session 10).
+/// Rust's saturating casts, 23% of the build's instructions with the clamp (callgrind).
 #[derive(Clone, Copy)]
 struct BinMap {
     lo: Vec3A,
@@ -209,7 +208,7 @@ impl Binned<'static> {
     /// [`Binned::new`] over `BuildPrims::new(geometry)`'s boxes, made straight from the
     /// geometry on `threads` threads (contiguous parts; the same boxes and order), without the
     /// primitive boxes and centres of [`BuildPrims`] in between: 29 MB and a pass fewer on
-    /// balls4 tessellated (issue 20, session 15).
+    /// balls4 tessellated.
     pub fn of_geometry(geometry: &Geometry, bins: usize, threads: usize) -> Binned<'static> {
         let n = geometry.prims.len();
         let threads = if n < 2 * PARALLEL_MIN { 1 } else { threads };
@@ -337,8 +336,7 @@ fn bin_threads(
 }
 
 impl Binned<'_> {
-    /// [`Splitter::split`] with the binning pass (48 instructions per primitive, issue 20
-    /// session 10) on `threads` threads when the range is large: for the top split of a
+    /// [`Splitter::split`] with the binning pass (48 instructions per primitive) on `threads` threads when the range is large: for the top split of a
     /// parallel build, where every other thread would wait (`binary_blocks_threads`). The
     /// split is the one-thread search's ([`bin_threads`]).
     pub fn split_threads(
@@ -378,7 +376,7 @@ impl Binned<'_> {
         // costs exactly what the plane before it does and never wins (ties keep the first
         // plane): the sweeps run over the filled bins only, `filled[..m]` in order. Small
         // ranges get 2n bins, at least half of them empty, and on balls3 tessellated the
-        // average split has 6.4 filled bins of 24 per axis (callgrind, issue 20, session 10).
+        // average split has 6.4 filled bins of 24 per axis (callgrind).
         let mut best: Option<(usize, u32, f32)> = None; // (axis, plane, Σ A·N)
         for a in 0..3 {
             let filled = &mut self.filled;

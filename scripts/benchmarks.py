@@ -1,0 +1,212 @@
+#!/usr/bin/env python3
+"""The tables of docs/benchmarks.md from the runs of scripts/benchmarks.sh: python3 scripts/benchmarks.py OUT.
+
+Intervals are distribution-free 95 % intervals of a median from the order statistics of its samples (the
+binomial ranks; with 7 samples, the smallest and largest: 98 % coverage; with 9, the 2nd and 8th: 96 %). Fewer than 6 samples give no
+interval at 95 % and are shown as their range, marked "range"."""
+import json
+import math
+import os
+import sys
+
+ORDER = ["balls4", "gears4", "mount6", "rings7", "teapot12", "tetra6", "tree11"]
+
+
+def records(d):
+    path = os.path.join(d, "results.jsonl")
+    if not os.path.exists(path):
+        return []
+    return [json.loads(l) for l in open(path) if l.strip()]
+
+
+def env_line(d):
+    try:
+        e = json.load(open(os.path.join(d, "env.json")))
+    except OSError:
+        return "environment not recorded"
+    dirty = " (with uncommitted changes)" if e.get("git_dirty") else ""
+    return (f"{e.get('started_at', '?')[:16].replace('T', ' ')} UTC, commit {e.get('git_commit', '?')[:10]}{dirty}, "
+            f"{e.get('cpu_model', '?')}, {e.get('cores_logical', '?')} logical cores, "
+            f"{e.get('memory_bytes', 0) / 2**30:.1f} GiB, {e.get('os', '?')}, Embree {e.get('embree_version', '?')}")
+
+
+def median_ci(xs):
+    """(median, lo, hi, exact) with a >= 95 % order-statistic interval when the sample allows one."""
+    xs = sorted(xs)
+    n = len(xs)
+    if n == 0:
+        return None
+    med = xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+    best = None
+    for k in range(0, n // 2):
+        # P(X_(k+1) <= median <= X_(n-k)) = 1 - 2 * P(Bin(n, 1/2) <= k)
+        cover = 1 - 2 * sum(math.comb(n, i) for i in range(k + 1)) / 2 ** n
+        if cover >= 0.95:
+            best = (xs[k], xs[n - 1 - k])
+    if best is None:
+        return med, xs[0], xs[-1], False
+    return med, best[0], best[1], True
+
+
+def fmt_ci(c, digits=2):
+    if c is None:
+        return "–"
+    med, lo, hi, exact = c
+    tag = "" if exact else " range"
+    return f"{med:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}{tag}]"
+
+
+def label(r):
+    s = r.get("settings") or {}
+    if not s:
+        return r["engine"]
+    return r["engine"] + "[" + ",".join(f"{k}={v}" for k, v in sorted(s.items())) + "]"
+
+
+def by_scene(recs):
+    out = {}
+    for r in recs:
+        if r.get("status") != "ok":
+            continue
+        out.setdefault(r["scene"]["name"], {})[label(r)] = r
+    return out
+
+
+def scenes_of(table):
+    return [s for s in ORDER if s in table] + sorted(s for s in table if s not in ORDER)
+
+
+def engines_of(recs):
+    seen = []
+    for r in recs:
+        if label(r) not in seen:
+            seen.append(label(r))
+    return seen
+
+
+def md(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(out)
+
+
+def failures(recs):
+    bad = [r for r in recs if r.get("status") != "ok"]
+    return "".join(f"\nFailed: `{r['key']}`: {r.get('reason')}" for r in bad)
+
+
+def speed(d):
+    recs = records(d)
+    t = by_scene(recs)
+    engines = [e for e in engines_of(recs) if e != "embree"]
+    rows, logs = [], {e: [] for e in engines}
+    for s in scenes_of(t):
+        row = [s, f"{t[s]['embree']['mrays_per_s']:.2f}" if "embree" in t[s] else "–"]
+        for e in engines:
+            r = t[s].get(e)
+            p = (r or {}).get("paired_ratio")
+            c = median_ci(p["samples"]) if p else None
+            if c:
+                logs[e].append(math.log(c[0]))
+            agree = (r or {}).get("check") or {}
+            mark = "" if not agree or agree.get("hit_agreement", 0) >= 0.9999 else " ✗"
+            row.append(fmt_ci(c) + mark)
+        rows.append(row)
+    rows.append(["geometric mean", ""] + [f"{math.exp(sum(v) / len(v)):.2f}" if v else "–" for e, v in logs.items()])
+    return md(["scene", "embree Mrays/s"] + [f"{e} ÷ embree" for e in engines], rows) + failures(recs)
+
+
+def memory(d):
+    recs = records(d)
+    t = by_scene(recs)
+    engines = engines_of(recs)
+    rows = []
+    for s in scenes_of(t):
+        prims = next(iter(t[s].values()))["scene"]["primitives"]
+        row = [s, f"{prims:,}"]
+        for e in engines:
+            r = t[s].get(e)
+            row.append(f"{r['structure_bytes'] / prims:.0f} / {r['peak_rss_bytes'] / 2**20:.0f}" if r else "–")
+        rows.append(row)
+    return md(["scene", "primitives"] + [f"{e} B/prim / peak MiB" for e in engines], rows)
+
+
+def build(d):
+    recs = records(d)
+    t = by_scene(recs)
+    engines = engines_of(recs)
+    rows = []
+    for s in scenes_of(t):
+        row = [s]
+        for e in engines:
+            r = t[s].get(e)
+            row.append(fmt_ci(median_ci([x * 1e3 for x in r['time_s']['build']['samples']]), 1) if r else "–")
+        rows.append(row)
+    return md(["scene"] + [f"{e} ms" for e in engines], rows)
+
+
+def threads(d):
+    recs = records(d)
+    t = by_scene(recs)
+    engines = engines_of(recs)
+    rows = []
+    for s in scenes_of(t):
+        row = [s]
+        for e in engines:
+            ts = (t[s].get(e) or {}).get("thread_scaling")
+            row.append(fmt_ci(median_ci(ts["speedup"]["samples"])) if ts else "–")
+        rows.append(row)
+    return md(["scene"] + [f"{e} speed-up at 2 threads" for e in engines], rows) + failures(recs)
+
+
+def grid(d):
+    recs = records(d)
+    t = by_scene(recs)
+    engines = engines_of(recs)
+    rows = []
+    for s in scenes_of(t):
+        for e in engines:
+            r = t[s].get(e)
+            if not r:
+                continue
+            c, rays = r["counters"], max(r["counters"].get("rays", 0), 1)
+            extra = c.get("extra", {}) if isinstance(c.get("extra"), dict) else {}
+            rows.append([s, e, f"{c.get('primitive_tests', 0) / rays:.2f}", f"{c.get('cells_visited', 0) / rays:.2f}",
+                         f"{c.get('empty_cells_visited', 0) / rays:.2f}", f"{c.get('mailbox_skips', 0) / rays:.2f}",
+                         f"{c.get('shadow_cache_hits', 0):,}", f"{c.get('box_tests', 0) / rays:.2f}"])
+    return md(["scene", "engine", "tests/ray", "cells/ray", "empty cells/ray", "mailbox skips/ray",
+               "shadow-cache hits", "culling box tests/ray"], rows)
+
+
+def ooc(d):
+    rows = []
+    for name, what in [("memory-grid.json", "grid, in memory"), ("memory-bf.json", "breadth-first, in memory"),
+                       ("store-32MiB.json", "breadth-first, store, memory=32MiB"),
+                       ("store-8MiB.json", "breadth-first, store, memory=8MiB")]:
+        p = os.path.join(d, name)
+        if not os.path.exists(p):
+            continue
+        j = json.load(open(p))
+        ex = (j.get("counters") or {}).get("extra") or {}
+        io = j.get("io") or {}
+        read = ex.get("io_bytes_read", io.get("bytes_read", 0))
+        rows.append([what, f"{j['time_s']['preprocess']:.2f}", f"{j['time_s']['trace']:.2f}",
+                     f"{j['memory']['peak_rss_bytes'] / 2**20:.0f}", f"{read / 2**20:.0f}" if read else "–",
+                     ex.get("bf_passes", "–"), (j.get("image") or {}).get("sha256", "")[:12]])
+    return md(["mount8 (131,076 objects)", "preprocess s", "trace s", "peak RSS MiB", "MiB read", "passes",
+               "image sha256"], rows)
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "out/benchmarks"
+    parts = [("speed", speed), ("speed", memory), ("build", build), ("threads", threads), ("grid", grid)]
+    for sub, f in parts:
+        d = os.path.join(out, sub)
+        if records(d):
+            print(f"## {f.__name__} ({sub}: {env_line(d)})\n\n{f(d)}\n")
+    if os.path.isdir(os.path.join(out, "ooc")):
+        print(f"## ooc\n\n{ooc(os.path.join(out, 'ooc'))}\n")
+
+
+if __name__ == "__main__":
+    main()
