@@ -224,7 +224,7 @@ pub fn check_runnable(file: &str, s: &Suite) -> Result<()> {
         rtbench_engines::build_engine(&v.engine, &probe, v.settings.clone())
             .map_err(|e| input(format!("{file}: variant '{}': {e}", v.label())))?;
     }
-    let most = crate::workload::thread_limit();
+    let most = crate::measure::threads::thread_limit();
     if let Some(n) = s.threads.iter().flatten().find(|&&n| n > most) {
         return Err(input(format!(
             "{file}: threads = {n}: more than the {most} this machine runs at once"
