@@ -221,7 +221,7 @@ sed 's/"median":\([0-9]\)/"median":-\1/' "$S/results.jsonl" >"$WORK/neg/results.
 run 2 compare "$WORK/merged" "$WORK/neg"
 # Suites are checked whole before a night measures anything.
 for bad in 'engines = ["embree", "grid:simd=off"]' 'threads = [1000000]' 'sf = [40]'; do
-    { echo 'engines = ["embree", "grid"]'; echo 'scenes = ["gears"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; } >"$WORK/suite.toml"
+    { echo 'engines = ["embree", "grid"]'; echo 'scenes = ["gears"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; echo 'gate = ["counters"]'; } >"$WORK/suite.toml"
     key=${bad%% =*}
     sed -i "/^$key =/d" "$WORK/suite.toml"
     echo "$bad" >>"$WORK/suite.toml"
@@ -229,7 +229,7 @@ for bad in 'engines = ["embree", "grid:simd=off"]' 'threads = [1000000]' 'sf = [
     run 2 plan nightly --suite "$WORK/suite.toml"
 done
 # History: read commands never write, text is cut at characters, check sees what is missing.
-{ echo 'engines = ["embree", "grid"]'; echo 'scenes = ["tetra"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; } >"$WORK/night.toml"
+{ echo 'engines = ["embree", "grid"]'; echo 'scenes = ["tetra"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; echo 'gate = ["counters"]'; } >"$WORK/night.toml"
 H="$WORK/hist/h.sqlite"
 mkdir -p "$WORK/hist"
 if timeout 300 "$B" nightly --suite "$WORK/night.toml" --db "$H" >/dev/null 2>&1 && command -v sqlite3 >/dev/null; then

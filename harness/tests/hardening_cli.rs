@@ -234,7 +234,7 @@ fn duplicates_empty_sets_and_impossible_times_are_refused() {
 fn suites_are_checked_whole_before_measuring() {
     let d = dir("suite");
     let base =
-        "engines = [\"embree\", \"grid\"]\nscenes = [\"tetra\"]\nsf = [1]\nrepeats = 2\nsize = 8\n";
+        "engines = [\"embree\", \"grid\"]\nscenes = [\"tetra\"]\nsf = [1]\nrepeats = 2\nsize = 8\ngate = [\"counters\"]\n";
     for (bad, needle) in [
         ("engines = [\"embree\", \"grid:simd=off\"]", "simd"),
         ("threads = [1000000]", "threads"),
