@@ -238,7 +238,12 @@ pub fn check_runnable(file: &str, s: &Suite) -> Result<()> {
             };
             let src = crate::source::Source::Program(scene, o);
             for v in &s.variants {
-                crate::workload::check_scene_fits(&src, &[&v.engine, "embree"], false)
+                let engines: &[&str] = if v.engine == "embree" {
+                    &["embree"]
+                } else {
+                    &[&v.engine, "embree"]
+                };
+                crate::workload::check_scene_fits(&src, engines, false)
                     .map_err(|e| input(format!("{file}: sf = {sf}: {e}")))?;
             }
         }
