@@ -23,7 +23,8 @@ fi
 # criterion benches, which `rtbench nightly` would otherwise build behind its own quiet `cargo bench`.
 echo "nightly.sh: building rtbench and the criterion benches (cargo's progress below)"
 cargo build --release -p rtbench
-cargo bench -p rtbench-engines --no-run
+BENCH="$(sed -n 's/^bench *= *"\(.*\)"/\1/p' suites/nightly.toml | head -n 1)"
+cargo bench -p rtbench-engines ${BENCH:+--bench "$BENCH"} --no-run
 echo "nightly.sh: running suites/nightly.toml (each run's progress below)"
 mkdir -p "$OUT" "$(dirname "$DB")"
 RUN="$OUT/run-$(date -u +%Y%m%dT%H%M%SZ)"

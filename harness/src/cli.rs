@@ -81,6 +81,10 @@ pub enum Command {
     /// One measured run, printed as one JSON line (the child process of run and sweep).
     #[command(hide = true)]
     RunOne(RunOneArgs),
+    /// One trace on the calling thread, after an untimed one: the region the nightly's
+    /// instruction counts cover under valgrind (its child process).
+    #[command(hide = true)]
+    CountOne(CountOneArgs),
     /// Run a nightly suite, store every sample in the history, exit 1 on a detected regression.
     #[command(
         after_help = "Examples:\n  rtbench nightly --suite suites/nightly.toml --db out/nightly/history.sqlite --out out/nightly/run1\n  rtbench nightly --suite suites/nightly.toml --shard 1/2 --out out/n1                                 # one shard; merge, then --from\n  rtbench nightly --suite suites/nightly.toml --from out/merged --db out/nightly/history.sqlite"
@@ -103,7 +107,9 @@ pub enum Command {
     )]
     Plan(PlanCmdArgs),
     /// The RTBENCH_* environment variables: each one's value here, accepted forms and effect.
+    #[command(after_help = "Examples:\n  rtbench env\n  RTBENCH_MAX_THREADS=2 rtbench env --json")]
     Env {
+        /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,
     },
@@ -342,6 +348,18 @@ pub struct RunOneArgs {
     /// at `--threads` (alternating which goes first) and record the speed-up of each pair.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub paired_threads: u32,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct CountOneArgs {
+    #[command(flatten)]
+    pub scene: SceneFlag,
+    #[arg(long)]
+    pub engine: String,
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    #[arg(long, default_value_t = 32)]
+    pub size: u32,
 }
 
 #[derive(Args, Debug, Clone)]

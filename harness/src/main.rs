@@ -117,6 +117,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Run(a) => commands::runs::run(&a),
         Command::Sweep(a) => commands::runs::sweep(&a),
         Command::RunOne(a) => commands::runs::run_one_cmd(&a),
+        Command::CountOne(a) => commands::nightly::count_one(&a),
         Command::Report(a) => commands::runs::report(&a),
         Command::Compare(a) => commands::runs::compare(&a),
         Command::Nightly(a) => commands::nightly::run(&a),

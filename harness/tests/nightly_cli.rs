@@ -171,6 +171,56 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
         .map(|n| n["baseline_nights"].as_u64().unwrap())
         .collect();
     assert_eq!(baselines, [0, 1, 2, 3]);
+    // Each night says which gates were active: time ratios from the fourth night (three
+    // baseline nights), counters from the second.
+    let gates = |i: usize| nights[i]["gates"].to_string();
+    assert!(
+        gates(0).contains("counters: not active yet"),
+        "{}",
+        gates(0)
+    );
+    assert!(
+        gates(2).contains("counters: active since night 2"),
+        "{}",
+        gates(2)
+    );
+    assert!(
+        gates(2).contains("time_ratio: not active yet: 2 of the 3"),
+        "{}",
+        gates(2)
+    );
+    assert!(
+        gates(3).contains("time_ratio: active since"),
+        "{}",
+        gates(3)
+    );
+
+    // `history show` of the last night: its baseline nights, its gates, and what each gated
+    // metric was compared against.
+    let show = rtbench(&["history", "show", "--db", db.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&show.stdout);
+    assert!(text.contains("3 baseline nights of this machine"), "{text}");
+    assert!(text.contains("## Gates"), "{text}");
+    assert!(text.contains("- time_ratio: active since"), "{text}");
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("| grid tetra1@1/time_ratio |"))
+        .unwrap_or_else(|| panic!("no time ratio row: {text}"));
+    assert!(row.contains(" over 3 nights, interval ["), "{row}");
+    let replay = rtbench(&[
+        "history",
+        "replay",
+        "--db",
+        db.to_str().unwrap(),
+        "--suite",
+        suite.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&replay.stdout);
+    assert!(!text.contains("(, "), "{text}");
+    assert!(
+        text.contains("0 baseline nights; waiting: counters 0/1 nights"),
+        "{text}"
+    );
 
     // The dashboard, in headless Chromium.
     let out = d.join("dash");

@@ -76,6 +76,7 @@ fn cells(r: &Row) -> Vec<String> {
         number::sig(r.mrays_per_s, 3),
         match (&r.ratio_interval, r.ratio_to_embree) {
             (Some(i), _) => format!("{} ({})", i.text(), i.n),
+            (None, Some(q)) if r.engine == crate::anchor::EMBREE => number::ratio(q),
             (None, Some(q)) => format!("{} (too few repeats for an interval)", number::ratio(q)),
             _ => "–".to_string(),
         },

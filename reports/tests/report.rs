@@ -33,7 +33,7 @@ fn md_row(md: &str, scene: &str, engine: &str) -> Vec<String> {
                 .map(|c| c.trim().to_string())
                 .collect::<Vec<_>>()
         })
-        .find(|cells| cells.len() == 11 && cells[0] == scene && cells[1] == engine)
+        .find(|cells| cells.len() == 12 && cells[0] == scene && cells[1] == engine)
         .unwrap_or_else(|| panic!("no row for {scene} / {engine} in:\n{md}"))
 }
 
@@ -52,20 +52,26 @@ fn markdown_table_has_ratio_to_embree_and_failures() {
         "environment header:\n{md}"
     );
     assert!(md.contains("## 1 thread"));
-    // Columns: scene, engine, build, trace, Mrays/s, × Embree, structure MB, peak RSS MB, agreement, PSNR.
+    // Columns: scene, engine, build, trace, Mrays/s, × Embree [95 % CI] (n), paired × Embree,
+    // structure MB, B/prim, peak RSS MB, agreement, PSNR.
     let bvh2 = md_row(&md, "balls4", "bvh2");
-    assert_eq!(bvh2[5], "2.50");
+    assert!(
+        bvh2[5].starts_with("2.50 [2.4") && bvh2[5].ends_with("(6)"),
+        "{}",
+        bvh2[5]
+    );
+    assert_eq!(bvh2[6], "–", "no paired ratios in this set");
     assert_eq!(bvh2[3], "0.750 (0.743–0.758)");
-    assert_eq!(bvh2[7], "2000.0", "structure bytes per primitive");
-    assert_eq!(bvh2[9], "99.998%");
-    assert_eq!(bvh2[10], "48.3");
+    assert_eq!(bvh2[8], "2000.0", "structure bytes per primitive");
+    assert_eq!(bvh2[10], "99.998%");
+    assert_eq!(bvh2[11], "48.3");
     let grid = md_row(&md, "balls5", "grid");
-    assert_eq!(grid[5], "0.80");
-    assert_eq!(grid[9], "100%");
-    assert_eq!(grid[10], "∞");
+    assert!(grid[5].starts_with("0.80 ["), "{}", grid[5]);
+    assert_eq!(grid[10], "100%");
+    assert_eq!(grid[11], "∞");
     let embree = md_row(&md, "balls3", "embree");
     assert_eq!(embree[5], "1.00");
-    assert_eq!(embree[9], "–", "Embree has no check against itself");
+    assert_eq!(embree[10], "–", "Embree has no check against itself");
     // No Embree run on teapot3: no ratio.
     assert_eq!(md_row(&md, "teapot3", "bvh2")[5], "–");
     // Embree first within a scene.
@@ -119,7 +125,7 @@ fn csv_json_and_html_are_written() {
     let html = read(&dir.path().join("report.html"));
     assert!(html.starts_with("<!DOCTYPE html>"));
     assert!(
-        html.contains("<td class=\"n\">2.50</td>"),
+        html.contains("<td class=\"n\">2.50 [2.4"),
         "ratio cell in the HTML table"
     );
     assert_eq!(
@@ -148,10 +154,13 @@ fn plots_are_written_and_decode() {
             "mrays-balls4",
             "mrays-balls5",
             "mrays-teapot3",
+            "ratio-balls3",
+            "ratio-balls4",
+            "ratio-balls5",
             "speed-vs-error",
             "time-vs-sf-balls"
         ],
-        "teapot has one SF: no time-vs-SF plot"
+        "teapot has one SF: no time-vs-SF plot; no Embree run on teapot: no ratio plot"
     );
     for stem in stems {
         let svg = read(&dir.path().join(format!("plots/{stem}.svg")));
@@ -225,10 +234,8 @@ fn a_later_line_replaces_an_earlier_one_with_the_same_key() {
     let summary = write_report(dir.path(), &[Format::Md]).unwrap();
     assert_eq!(summary.runs, 2);
     assert!(summary.failures.is_empty());
-    assert_eq!(
-        md_row(&read(&dir.path().join("report.md")), "balls3", "bvh2")[5],
-        "3.00"
-    );
+    let cell = md_row(&read(&dir.path().join("report.md")), "balls3", "bvh2")[5].clone();
+    assert!(cell.starts_with("3.00 ["), "{cell}");
 }
 
 #[test]
@@ -283,8 +290,8 @@ fn one_table_per_thread_count_and_ratios_within_it() {
     let md = read(&dir.path().join("report.md"));
     let one = md.find("## 1 thread\n").expect("table for 1 thread");
     let two = md.find("## 2 threads\n").expect("table for 2 threads");
-    assert_eq!(md_row(&md[one..two], "balls4", "bvh2")[5], "2.00");
-    assert_eq!(md_row(&md[two..], "balls4", "bvh2")[5], "3.00");
+    assert!(md_row(&md[one..two], "balls4", "bvh2")[5].starts_with("2.00 ["));
+    assert!(md_row(&md[two..], "balls4", "bvh2")[5].starts_with("3.00 ["));
     for stem in [
         "time-vs-sf-balls-t1",
         "time-vs-sf-balls-t2",

@@ -25,9 +25,18 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do
     esac
 done
 [ "${1:-}" = "--" ] && shift
-RTBENCH="${RTBENCH:-$ROOT/target/release/rtbench}"
+# The binary: $RTBENCH, else ./rtbench of an unpacked package (scripts/package.sh), else the clone's build.
+if [ -z "${RTBENCH:-}" ]; then
+    RTBENCH="$ROOT/target/release/rtbench"
+    [ -x "$ROOT/rtbench" ] && RTBENCH="$ROOT/rtbench"
+fi
 [ -x "$RTBENCH" ] || die "$RTBENCH: not built (cargo build --release -p rtbench, or export RTBENCH)"
-command -v sbatch >/dev/null || die "sbatch not found (no Slurm here; bash scripts/slurm/local-cluster.sh start makes one)"
+command -v sbatch >/dev/null || die "sbatch not found: install Slurm's client and set SLURM_CONF to your cluster's slurm.conf (or start a one-node cluster here: bash scripts/slurm/local-cluster.sh start)"
+# A cluster must answer before anything is submitted (sbatch's own error would be a raw resolver
+# or socket message and exit 1).
+if ! scontrol ping 2>/dev/null | grep -q "is UP"; then
+    die "no Slurm controller answers (${SLURM_CONF:-SLURM_CONF unset, the default slurm.conf}): set SLURM_CONF to your cluster's slurm.conf, or start a one-node cluster here: bash scripts/slurm/local-cluster.sh start"
+fi
 mkdir -p "$SHARED"
 SHARED="$(cd "$SHARED" && pwd)"
 [ -z "$(ls -A "$SHARED")" ] || die "$SHARED: not empty (each submission gets a directory of its own)"

@@ -3,7 +3,9 @@
 
 use crate::error::{input, Failure, Result};
 use crate::history::{Finding, History};
-use crate::nightly::{compare, fmt_secs, is_bad, suite, summary_markdown, suspects_of};
+use crate::nightly::{
+    compare, fmt_secs, gate_findings, gates_clause, is_bad, suite, summary_markdown, suspects_of,
+};
 use std::collections::BTreeMap;
 
 /// `rtbench history list|show|export|dashboard`.
@@ -59,7 +61,13 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
                         &row.suite,
                         &row.git_commit,
                         row.wall_s,
-                        0,
+                        // The baseline the night had, as its gate rows recorded it (none on
+                        // nights written before they were kept).
+                        findings
+                            .iter()
+                            .find(|f| f.verdict == "gate")
+                            .and_then(|f| f.baseline)
+                            .map(|n| n as usize),
                         &metrics,
                         &findings
                     )
@@ -144,18 +152,26 @@ fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Res
             Some(p) => previous.get(&p.id).cloned().unwrap_or_default(),
             None => Default::default(),
         };
-        let findings = compare(&s, &h.metrics(r.id)?, &baseline, &suspects);
+        let metrics = h.metrics(r.id)?;
+        let findings = compare(&s, &metrics, &baseline, &suspects);
         previous.insert(r.id, suspects_of(&findings));
+        let earlier: Vec<i64> = prev.iter().map(|p| p.id).collect();
+        let gates = gate_findings(&s, &metrics, &earlier, window.len());
         let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
         if !bad.is_empty() {
             alarmed += 1;
         }
         if !json {
             println!(
-                "night {} ({}, {} baseline nights): {}",
+                "night {} ({}{} baseline nights; {}): {}",
                 r.id,
-                r.note.as_deref().unwrap_or(""),
+                r.note
+                    .as_deref()
+                    .filter(|n| !n.is_empty())
+                    .map(|n| format!("{n}, "))
+                    .unwrap_or_default(),
                 window.len(),
+                gates_clause(&gates),
                 if bad.is_empty() {
                     "no regression".to_string()
                 } else {
@@ -170,6 +186,7 @@ fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Res
             "id": r.id,
             "note": r.note,
             "baseline_nights": window.len(),
+            "gates": gates.iter().map(|f| &f.message).collect::<Vec<_>>(),
             "recorded_regressions": r.regressions,
             "regressions": bad.iter().map(|f| &f.message).collect::<Vec<_>>(),
             "suspects": findings.iter().filter(|f| f.verdict == "suspect").map(|f| &f.message).collect::<Vec<_>>(),

@@ -5,7 +5,8 @@ use crate::cli::NightlyArgs;
 use crate::error::{input, Failure, Result};
 use crate::history::{dashboard, History, Night};
 use crate::nightly::{
-    compare, is_bad, measure, shard, suite, summary_markdown, suspects_of, Measured,
+    compare_all, gate_findings, is_bad, measure, shard, suite, summary_markdown, suspects_of,
+    Measured,
 };
 use crate::shard::ShardSpec;
 use sha2::{Digest, Sha256};
@@ -70,7 +71,9 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         Some(r) => suspects_of(&history.findings(r.id)?),
         None => Default::default(),
     };
-    findings.extend(compare(&suite, &metrics, &baseline, &suspects));
+    let earlier: Vec<i64> = prev.iter().map(|r| r.id).collect();
+    findings.extend(gate_findings(&suite, &metrics, &earlier, window.len()));
+    findings.extend(compare_all(&suite, &metrics, &baseline, &suspects));
     let wall_s = match &a.from {
         Some(_) => measured_s + start.elapsed().as_secs_f64(),
         None => start.elapsed().as_secs_f64(),
@@ -93,7 +96,7 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         &suite.name,
         &env.git_commit,
         wall_s,
-        window.len(),
+        Some(window.len()),
         &metrics,
         &findings,
     );
@@ -140,5 +143,19 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
             bad.join("; ")
         )));
     }
+    Ok(())
+}
+
+/// `rtbench count-one`: the nightly's counted region (run under valgrind).
+pub fn count_one(a: &crate::cli::CountOneArgs) -> Result<()> {
+    let source = crate::source::Source::resolve(
+        &a.scene.scene,
+        a.scene.opts.sf,
+        a.scene.opts.tessellate,
+        a.scene.opts.hash,
+    )?;
+    let settings = crate::workload::parse_settings(&a.set)?;
+    let rays = crate::nightly::count::count_one(&a.engine, settings, &source, a.size)?;
+    println!("{{\"rays\":{rays}}}");
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! (`rtbench_reports::plot`) as inline SVG; the trend charts are also written as PNG files.
 
 use super::detect;
-use super::{History, Metric};
+use super::{Finding, History, Metric};
 use crate::error::{input, Result};
 use rtbench_reports::plot::{self, Chart, LegendAt, Panel, Point, Series, XyPanel};
 use std::collections::BTreeMap;
@@ -146,6 +146,25 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         last_metrics.len(),
         mine.len()
     ));
+    // What the night's gates were and what each gated metric was compared against (`gate` and
+    // `ok` rows), apart from what it found.
+    let gates: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "gate").collect();
+    body.push_str("<h2>Gates of the latest night</h2>\n");
+    if gates.is_empty() {
+        body.push_str("<p>Not recorded with this night.</p>\n");
+    } else {
+        body.push_str("<ul>\n");
+        for f in &gates {
+            body.push_str(&format!("<li>{}</li>\n", esc(&f.message)));
+        }
+        body.push_str("</ul>\n");
+    }
+    let compared: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "ok").collect();
+    let findings: Vec<Finding> = findings
+        .iter()
+        .filter(|f| f.verdict != "ok" && f.verdict != "gate")
+        .cloned()
+        .collect();
     body.push_str("<h2>Findings of the latest night</h2>\n");
     if findings.is_empty() {
         body.push_str("<p class=\"ok\">No regression, no improvement, no counter change.</p>\n");
@@ -172,6 +191,24 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         }
         body.push_str("</table>\n");
     }
+    if !compared.is_empty() {
+        body.push_str(&format!(
+            "<details><summary>{} gated metrics compared and unchanged</summary>\n<table><tr><th>metric</th><th>tonight</th><th>compared against</th><th>change</th></tr>\n",
+            compared.len()
+        ));
+        for f in &compared {
+            body.push_str(&format!(
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                esc(&f.name),
+                f.value.map(fmt_value).unwrap_or_default(),
+                esc(&f.message),
+                f.change_pct
+                    .map(|c| format!("{c:+.3}%"))
+                    .unwrap_or_default()
+            ));
+        }
+        body.push_str("</table></details>\n");
+    }
     // Groups: time ratios by scene, instruction counts, criterion kernels.
     let mut groups: BTreeMap<(u8, String), Vec<Trend>> = BTreeMap::new();
     for (name, pts) in &trend {
@@ -185,7 +222,7 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
                     .push((label.to_string(), pts.clone()));
                 continue;
             }
-            Some("instructions") => (1, "instructions under cachegrind".to_string()),
+            Some("instructions") => (1, "instructions of the trace under callgrind".to_string()),
             Some("criterion") => (2, "criterion kernels, ns per call".to_string()),
             _ => (3, "other".to_string()),
         };

@@ -170,7 +170,10 @@ pub struct Metric {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Finding {
     pub name: String,
-    /// `regression`, `improvement`, `failed`, `change` (an ungated metric moved).
+    /// `regression`, `improvement`, `failed`, `change` (an ungated metric moved), `suspect` (a
+    /// time slowdown on its first night), `ok` (a gated metric compared and unchanged: the message
+    /// names what it was compared against), `gate` (a gate's state that night, named
+    /// `gate/<gate>`: `baseline` holds the night's baseline nights, `value` those the gate needs).
     pub verdict: String,
     pub baseline: Option<f64>,
     pub value: Option<f64>,

@@ -37,6 +37,22 @@ fn non_negative(v: &str) -> bool {
     v.parse::<f64>().is_ok_and(|x| x.is_finite() && x >= 0.0)
 }
 
+/// Whether every `;`-separated plant of `spec` is well formed (`RTBENCH_PLANT`, read by `runs/plant.rs`).
+fn plant(spec: &str) -> bool {
+    spec.split(';').all(|one| {
+        let parts: Vec<&str> = one.trim().split(':').collect();
+        match parts.as_slice() {
+            ["work", e, s, f] => {
+                !e.is_empty()
+                    && !s.is_empty()
+                    && f.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)
+            }
+            ["counter", e, s] => !e.is_empty() && !s.is_empty(),
+            _ => false,
+        }
+    })
+}
+
 fn any(v: &str) -> bool {
     !v.is_empty()
 }
@@ -83,7 +99,7 @@ pub const VARS: &[Var] = &[
                 (SCENE a program or *, FRACTION above 0)",
         about: "plants a regression in an engine, to measure whether compare and the nightly \
                 find it",
-        check: crate::runs::plant::valid,
+        check: plant,
     },
     Var {
         name: "RTBENCH_BUILD_PHASES",

@@ -4,6 +4,7 @@
 //! same machine fingerprint (`history/detect.rs`), writes the whole night to the history in one
 //! transaction, and exits 1 only when a gated metric regressed, naming it.
 
+pub mod count;
 pub mod shard;
 pub mod suite;
 mod tools;
@@ -174,12 +175,30 @@ fn round_medians(s: &Suite, m: &Metric) -> Vec<f64> {
         .collect()
 }
 
-/// Tonight's metrics against the baseline nights (oldest first): the findings.
+/// Tonight's metrics against the baseline nights (oldest first): the findings, without the
+/// `ok` rows of [`compare_all`].
+pub fn compare(
+    s: &Suite,
+    tonight: &[Metric],
+    baseline: &[Vec<Metric>],
+    suspects: &std::collections::BTreeSet<String>,
+) -> Vec<Finding> {
+    compare_all(s, tonight, baseline, suspects)
+        .into_iter()
+        .filter(|f| f.verdict != "ok")
+        .collect()
+}
+
+/// Tonight's metrics against the baseline nights (oldest first): the findings, and a row of
+/// verdict `ok` for every gated instruction count and time metric that was compared and did not
+/// move, naming what it was compared against (the baseline value, the tolerance or interval, and
+/// the change). Gated counters get no `ok` row: each is compared with the last night's exact
+/// value, which [`gate_findings`] names once for all.
 /// `suspects`: the time metrics the last baseline night found changed on their first night
 /// (verdict `suspect`); with `confirm_nights = 2` a time regression is reported only when the
 /// night before was a suspect for the same metric, and a suspect night leaves that metric's
 /// baseline.
-pub fn compare(
+pub fn compare_all(
     s: &Suite,
     tonight: &[Metric],
     baseline: &[Vec<Metric>],
@@ -244,6 +263,18 @@ pub fn compare(
                         message: format!(
                             "{}: instructions {:.0} → {:.0} ({pct:+.3}%, tolerance ±{tol}%)",
                             m.name, last.value, m.value
+                        ),
+                    });
+                } else if m.gated {
+                    out.push(Finding {
+                        name: m.name.clone(),
+                        verdict: "ok".into(),
+                        baseline: Some(last.value),
+                        value: Some(m.value),
+                        change_pct: Some(pct),
+                        message: format!(
+                            "the last baseline night's {:.0}, tolerance ±{tol}%",
+                            last.value
                         ),
                     });
                 }
@@ -334,12 +365,171 @@ pub fn compare(
                         f.message
                             .push_str(" — confirmed: the night before was a suspect");
                     }
+                } else if m.gated {
+                    // The prediction interval tonight's value (or, confirming a suspect, the two
+                    // nights' mean) had to leave: the centre times e^(±threshold · width).
+                    let k = nights.len() as f64;
+                    let width = v.spread
+                        * if previous.is_some() {
+                            (0.5 + 1.0 / k).sqrt()
+                        } else {
+                            (1.0 + 1.0 / k).sqrt()
+                        };
+                    let (lo, hi) = (
+                        v.baseline * (-v.threshold * width).exp(),
+                        v.baseline * (v.threshold * width).exp(),
+                    );
+                    out.push(Finding {
+                        name: m.name.clone(),
+                        verdict: "ok".into(),
+                        baseline: Some(v.baseline),
+                        value: Some(m.value),
+                        change_pct: Some(v.change_pct),
+                        message: format!(
+                            "{:.4} over {} nights, interval [{lo:.4}, {hi:.4}] at α = {used_alpha:.2e}{}",
+                            v.baseline,
+                            nights.len(),
+                            if previous.is_some() {
+                                " (the mean with the suspect night before)"
+                            } else {
+                                ""
+                            }
+                        ),
+                    });
                 }
             }
             _ => {}
         }
     }
     out
+}
+
+/// Baseline nights of this machine a gate needs before it can flag anything: the last night's
+/// value for counters and instruction counts; three nights' spread for time metrics
+/// ([`detect::time_verdict_over`]).
+pub fn gate_needs(gate: &str) -> usize {
+    match gate {
+        "time_ratio" | "criterion" => 3,
+        _ => 1,
+    }
+}
+
+/// The kind of metric a gate covers.
+fn gate_kind(gate: &str) -> &str {
+    match gate {
+        "counters" => "counter",
+        g => g,
+    }
+}
+
+/// One row of verdict `gate` per gate of the suite's list: whether it was active tonight, since
+/// which night, and what its metrics were compared against. `earlier`: the ids of this machine's
+/// earlier nights of the suite, oldest first; `window`: how many of them were tonight's baseline.
+/// The row's `baseline` is `window` and its `value` the baseline nights the gate needs.
+pub fn gate_findings(
+    s: &Suite,
+    tonight: &[Metric],
+    earlier: &[i64],
+    window: usize,
+) -> Vec<Finding> {
+    let gated_times = tonight
+        .iter()
+        .filter(|m| m.gated && (m.kind == "time_ratio" || m.kind == "criterion"))
+        .count()
+        .max(1);
+    let alpha = s.false_alarm_budget / gated_times as f64;
+    let mut out = Vec::new();
+    for g in suite::GATES {
+        let n = tonight.iter().filter(|m| m.kind == gate_kind(g)).count();
+        let needs = gate_needs(g);
+        let message = if !s.gates(g) {
+            if n == 0 {
+                continue;
+            }
+            format!("{g}: not gated by this suite ({n} metric(s) stored and plotted only)")
+        } else if window < needs {
+            format!(
+                "{g}: not active yet: {window} of the {needs} baseline night(s) of this machine it \
+                 needs; active from this machine's night {} of the suite ({} more)",
+                needs + 1,
+                needs - window
+            )
+        } else {
+            let since = match earlier.get(needs) {
+                Some(id) => format!("since night {id}"),
+                None => "since this night".to_string(),
+            };
+            let last = earlier
+                .last()
+                .map(|id| format!("night {id}"))
+                .unwrap_or_default();
+            let against = match g {
+                "counters" => format!("each against {last}'s exact value"),
+                "instructions" => format!(
+                    "each against {last}'s count, tolerance ±{}%",
+                    s.instructions
+                        .as_ref()
+                        .map(|i| i.tolerance_pct)
+                        .unwrap_or(0.1)
+                ),
+                _ => format!(
+                    "each against the geometric mean of its {window} baseline nights (from the \
+                     latest change point), outside a prediction interval at α = {alpha:.2e} \
+                     (a budget of {} shared by {gated_times} gated time metrics) and by {}% or \
+                     more{}",
+                    s.false_alarm_budget,
+                    s.min_change_pct,
+                    if s.confirm_nights > 1 {
+                        "; a slowdown is a suspect on its first night and a regression when the \
+                         next night confirms it"
+                    } else {
+                        ""
+                    }
+                ),
+            };
+            format!("{g}: active {since}: {n} metric(s), {against}")
+        };
+        out.push(Finding {
+            name: format!("gate/{g}"),
+            verdict: "gate".into(),
+            baseline: Some(window as f64),
+            value: Some(needs as f64),
+            change_pct: None,
+            message,
+        });
+    }
+    out
+}
+
+/// The gates' states in a few words (`history replay`): `counters, instructions active;
+/// time_ratio 2/3 nights`.
+pub fn gates_clause(findings: &[Finding]) -> String {
+    let mut active = Vec::new();
+    let mut waiting = Vec::new();
+    for f in findings.iter().filter(|f| f.verdict == "gate") {
+        let g = f.name.trim_start_matches("gate/");
+        if f.message.contains(": active ") {
+            active.push(g.to_string());
+        } else if f.message.contains(": not active yet") {
+            waiting.push(format!(
+                "{g} {}/{} nights",
+                f.baseline.unwrap_or(0.0),
+                f.value.unwrap_or(0.0)
+            ));
+        }
+    }
+    let mut parts = Vec::new();
+    if !active.is_empty() {
+        parts.push(format!("{} active", active.join(", ")));
+    }
+    if !waiting.is_empty() {
+        parts.push(format!("waiting: {}", waiting.join(", ")));
+    }
+    if parts.is_empty() {
+        "no gate".into()
+    } else {
+        parts.join("; ")
+    }
 }
 
 pub fn fmt_secs(s: f64) -> String {
@@ -368,7 +558,7 @@ pub fn summary_markdown(
     suite: &str,
     commit: &str,
     wall_s: f64,
-    baseline_nights: usize,
+    baseline_nights: Option<usize>,
     metrics: &[Metric],
     findings: &[Finding],
 ) -> String {
@@ -376,7 +566,7 @@ pub fn summary_markdown(
     let gated = metrics.iter().filter(|m| m.gated).count();
     let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
     s.push_str(&format!(
-        "# Nightly `{suite}` at `{}`: {}\n\n{} metrics ({gated} gated), {} baseline nights of this machine, {}.\n\n",
+        "# Nightly `{suite}` at `{}`: {}\n\n{} metrics ({gated} gated), {}, {}.\n\n",
         crate::output::head(&commit, 12),
         if bad.is_empty() {
             "no regression".to_string()
@@ -384,10 +574,21 @@ pub fn summary_markdown(
             format!("{} regression(s)", bad.len())
         },
         metrics.len(),
-        baseline_nights,
+        match baseline_nights {
+            Some(n) => format!("{n} baseline nights of this machine"),
+            None => "baseline nights not recorded with this night".to_string(),
+        },
         fmt_secs(wall_s)
     ));
-    s.push_str("## Regressions\n\n");
+    s.push_str("## Gates\n\n");
+    let gates: Vec<&Finding> = findings.iter().filter(|f| f.verdict == "gate").collect();
+    if gates.is_empty() {
+        s.push_str("Not recorded with this night.\n");
+    }
+    for f in gates {
+        s.push_str(&format!("- {}\n", f.message));
+    }
+    s.push_str("\n## Regressions\n\n");
     if bad.is_empty() {
         s.push_str("None.\n");
     }
@@ -419,22 +620,28 @@ pub fn summary_markdown(
             s.push_str(&format!("- {}\n", f.message));
         }
     }
-    s.push_str("\n## Table\n\n| metric | tonight | baseline | change | verdict |\n|---|---:|---:|---:|---|\n");
+    s.push_str("\n## Table\n\n| metric | tonight | compared against | change | verdict |\n|---|---:|---|---:|---|\n");
     let by_name: BTreeMap<&str, &Finding> = findings.iter().map(|f| (f.name.as_str(), f)).collect();
     let counters = metrics.iter().filter(|m| m.kind == "counter").count();
     for m in metrics.iter().filter(|m| m.gated && m.kind != "counter") {
         let f = by_name.get(m.name.as_str());
+        let against = match f {
+            Some(f) if f.verdict == "ok" => f.message.clone(),
+            Some(f) => f
+                .baseline
+                .map(|b| format!("{} (above)", dashboard::fmt_value(b)))
+                .unwrap_or_default(),
+            None => "not compared (see Gates)".to_string(),
+        };
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} |\n",
             m.name,
             dashboard::fmt_value(m.value),
-            f.and_then(|f| f.baseline)
-                .map(dashboard::fmt_value)
-                .unwrap_or_default(),
+            against,
             f.and_then(|f| f.change_pct)
-                .map(|c| format!("{c:+.2}%"))
+                .map(|c| format!("{c:+.3}%"))
                 .unwrap_or_default(),
-            f.map(|f| f.verdict.as_str()).unwrap_or("ok"),
+            f.map(|f| f.verdict.as_str()).unwrap_or("not compared"),
         ));
     }
     let changed = findings

@@ -14,7 +14,7 @@
 //! false_alarm_budget = 0.03                 # accepted nights with a false alarm, per night
 //! confirm_nights = 2                        # a time regression needs two nights in a row (1: one)
 //!
-//! [instructions]                            # valgrind (cachegrind) instruction counts
+//! [instructions]                            # valgrind (callgrind) instruction counts of the trace
 //! engines = ["grid", "bvh4"]
 //! scenes = ["tetra"]
 //! sf = 1

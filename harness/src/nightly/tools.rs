@@ -1,4 +1,4 @@
-//! The nightly suite's two outside tools: valgrind's cachegrind for instruction counts, and
+//! The nightly suite's two outside tools: valgrind's callgrind for instruction counts, and
 //! `cargo bench` for the criterion kernels.
 
 use super::suite::{Criterion, Variant};
@@ -8,9 +8,15 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-/// Instructions executed by one `rtbench run-one` (scene generation, build, one untimed and one
-/// timed render, one thread) under `valgrind --tool=cachegrind --cache-sim=no`, and the wall
-/// seconds valgrind took.
+/// The environment variables the counted child keeps: the rest are cleared, so the count does
+/// not depend on the environment's size or content (its strings sit on the stack and in
+/// whatever reads them).
+const KEPT_ENV: [&str; 3] = ["PATH", "LD_LIBRARY_PATH", "RTBENCH_PLANT"];
+
+/// Instructions executed by the traced region of one `rtbench count-one` (the scene generated,
+/// the engine built and the workload traced once before it, all uncounted, on one thread with no
+/// pool; see [`super::count`]) under `valgrind --tool=callgrind --collect-atstart=no
+/// --toggle-collect=…`, in a fixed environment, and the wall seconds valgrind took.
 pub fn instructions(
     v: &Variant,
     program: Program,
@@ -20,32 +26,59 @@ pub fn instructions(
 ) -> Result<(u64, f64), String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot find rtbench: {e}"))?;
     let out = scratch.join(format!(
-        "cachegrind-{}-{}-{}.out",
+        "callgrind-{}-{}-{}.out",
         std::process::id(),
-        v.label().replace(['[', ']', '=', ','], "_"),
+        v.label().replace(['[', ']', '=', ',', ':'], "_"),
         program.name()
     ));
     let mut cmd = Command::new("valgrind");
-    cmd.args(["--tool=cachegrind", "--cache-sim=no"])
-        .arg(format!("--cachegrind-out-file={}", out.display()))
+    cmd.env_clear();
+    for k in KEPT_ENV {
+        if let Some(val) = std::env::var_os(k) {
+            cmd.env(k, val);
+        }
+    }
+    cmd.env("LC_ALL", "C")
+        .args(["--tool=callgrind", "--cache-sim=no", "--collect-atstart=no"])
+        .arg(format!("--toggle-collect={}", super::count::COUNTED_SYMBOL))
+        .arg(format!("--callgrind-out-file={}", out.display()))
         .arg(exe)
-        .args(["run-one", "--engine", &v.engine, "--scene", program.name()])
-        .args(["--sf", &sf.to_string(), "--repeat", "1", "--size"])
-        .arg(size.to_string())
-        .args(["--threads", "1", "--no-check"]);
+        .args([
+            "count-one",
+            "--engine",
+            &v.engine,
+            "--scene",
+            program.name(),
+        ])
+        .args(["--sf", &sf.to_string(), "--size"])
+        .arg(size.to_string());
     for (k, val) in &v.settings {
         cmd.args(["--set", &format!("{k}={val}")]);
     }
     let wall = run_tool(&mut cmd, "valgrind", " (apt-get install valgrind)")?;
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     let _ = std::fs::remove_file(&out);
-    let ir = text
-        .lines()
-        .find_map(|l| l.strip_prefix("summary:"))
-        .and_then(|s| s.split_whitespace().next())
-        .and_then(|s| s.parse::<u64>().ok())
-        .ok_or_else(|| "cachegrind wrote no summary line".to_string())?;
+    let ir = summary_ir(&text).ok_or_else(|| "callgrind wrote no summary line".to_string())?;
+    if ir == 0 {
+        return Err(format!(
+            "callgrind counted no instruction in the traced region: is the binary stripped of the \
+             symbol {}?",
+            super::count::COUNTED_SYMBOL
+        ));
+    }
     Ok((ir, wall))
+}
+
+/// The instruction count of a callgrind or cachegrind output file (its `summary:` line, or the
+/// `totals:` line where callgrind writes no summary).
+fn summary_ir(text: &str) -> Option<u64> {
+    let line = |p: &str| {
+        text.lines()
+            .find_map(|l| l.strip_prefix(p))
+            .and_then(|s| s.split_whitespace().next())
+            .and_then(|s| s.parse::<u64>().ok())
+    };
+    line("summary:").or_else(|| line("totals:"))
 }
 
 fn read_json(p: &Path) -> Option<serde_json::Value> {

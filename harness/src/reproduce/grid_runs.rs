@@ -50,6 +50,10 @@ pub struct GridRun {
     /// The process's CPU seconds over the run (0 in runs saved before it was kept).
     #[serde(default)]
     pub cpu_s: f64,
+    /// Rays held in memory at once (what the budget left after the grid and its buffers, or a
+    /// `rays=` cap): the rays of one pass. 0 in runs saved before it was kept.
+    #[serde(default)]
+    pub rays_in_memory: u64,
 }
 
 impl GridRun {
@@ -96,6 +100,7 @@ pub fn write_split_store(src: &SceneSource, dir: &Path) -> Result<StoreHeader> {
 }
 
 /// The common settings of every run.
+#[derive(Clone)]
 pub struct Setup {
     pub size: u32,
     pub memory: String,
@@ -103,10 +108,8 @@ pub struct Setup {
     pub spill: Option<String>,
 }
 
-/// Traces the store at `dir` with S+G+B and `grid` settings.
-pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> {
-    crate::measure::rss::reset_peak_rss();
-    let load_average = load_average();
+/// The engine's configuration for the store at `dir`: S+G+B and `grid` settings.
+fn config(s: &Setup, grid: &[(&str, String)]) -> Result<BreadthFirstConfig> {
     let mut pairs: Vec<(String, String)> = vec![
         ("memory".into(), s.memory.clone()),
         ("verify".into(), "records".into()),
@@ -121,8 +124,32 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         .iter()
         .map(|(k, v)| (k.to_string(), v.clone()))
         .collect();
-    pairs.extend(settings.iter().cloned());
-    let config = BreadthFirstConfig::from_settings(Settings::new("breadth-first", pairs))?;
+    pairs.extend(settings);
+    Ok(BreadthFirstConfig::from_settings(Settings::new(
+        "breadth-first",
+        pairs,
+    ))?)
+}
+
+/// The rays the engine would hold in memory with these settings (it is opened, not traced).
+pub fn rays_in_memory(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<u64> {
+    let engine = BreadthFirst::open(dir, config(s, grid)?)?;
+    Ok(engine
+        .build_stats()
+        .get("rays_in_memory")
+        .copied()
+        .unwrap_or(0.0) as u64)
+}
+
+/// Traces the store at `dir` with S+G+B and `grid` settings.
+pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> {
+    crate::measure::rss::reset_peak_rss();
+    let load_average = load_average();
+    let settings: Vec<(String, String)> = grid
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.clone()))
+        .collect();
+    let config = config(s, grid)?;
     let cpu0 = crate::measure::clock::process_cpu_seconds();
     let t = std::time::Instant::now();
     let engine = BreadthFirst::open(dir, config)?;
@@ -163,6 +190,7 @@ pub fn trace(dir: &Path, s: &Setup, grid: &[(&str, String)]) -> Result<GridRun> 
         grid_build_s: bs("hr_build_s"),
         load_average,
         cpu_s: crate::measure::clock::process_cpu_seconds() - cpu0,
+        rays_in_memory: bs("rays_in_memory") as u64,
     })
 }
 

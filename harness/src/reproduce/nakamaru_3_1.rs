@@ -29,6 +29,7 @@ use rtbench_engines::Settings;
 use rtbench_reports::{Document, Table as DocTable};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::Path;
 use std::time::Instant;
 
 pub const TABLE: Table = Table {
@@ -55,7 +56,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "preprocess-ratio",
             fidelity: Fidelity::Substituted,
-            why: "machine substituted (page cache, not a 1995 disk): the thesis attributes this ratio mainly to disk I/O",
+            why: "machine substituted (page cache, not a 1995 disk): the thesis attributes this ratio mainly to disk I/O; the scope is the thesis's: the grid reads and parses the scene's NFF file and builds, the breadth-first engine reads its store and marks voxels (writing the store is generation, untimed)",
         },
         Claim {
             key: "intersect-ratio",
@@ -141,16 +142,24 @@ fn floor_setting(scene: &str) -> &'static str {
     }
 }
 
-fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<Timed> {
+/// Preprocessing as each program of Table 3.1 did it, from a scene file on disk to a structure ready
+/// to trace: Rayshade read its input file and built its grid; sray read its scene store and marked
+/// its voxels (the conversion to sray's format is generation, which the thesis times apart, Table
+/// 4.1's "generation"). So the grid's preprocessing here reads and parses the scene's NFF file and
+/// builds, and the breadth-first engine's opens its store (written beforehand, untimed); both files
+/// were just written and sit in the page cache alike.
+fn grid_run(nff: &Path, preset: &str, floor: &str) -> Result<Timed> {
     let set = vec![
         ("preset".to_string(), preset.to_string()),
         ("floor".to_string(), floor.to_string()),
         ("count".to_string(), "objects".to_string()),
     ];
     let pool = crate::measure::threads::pool(Some(1))?;
-    let (e, build_s) = workload::build("grid", &prepared.input, set)?;
+    let t = Instant::now();
+    let prepared = workload::prepare(&SceneSource::File(nff.to_path_buf()))?;
+    let (e, _) = workload::build("grid", &prepared.input, set)?;
+    let pre = t.elapsed().as_secs_f64();
     let r = pool.install(|| trace::render(&prepared.input.scene, e.as_ref(), 512, None));
-    let pre = prepared.prepare_s + build_s;
     Ok(Timed {
         s: [pre + r.trace_s, pre, r.intersect_s, r.shade_s],
         tests: r.counters.primitive_tests,
@@ -160,7 +169,6 @@ fn grid_run(prepared: &workload::Prepared, preset: &str, floor: &str) -> Result<
 }
 
 fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed> {
-    let t = Instant::now();
     let config = BreadthFirstConfig::from_settings(Settings::new(
         "breadth-first",
         vec![
@@ -175,8 +183,9 @@ fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed
     StoreWriter::create_layout(spill.path(), "x", Layout::Basic)
         .and_then(|w| w.write_scene(&prepared.input.scene))
         .map_err(|e| input(format!("writing the scene store: {e}")))?;
+    let t = Instant::now();
     let engine = BreadthFirst::open(spill.path(), config)?;
-    let pre = prepared.prepare_s + t.elapsed().as_secs_f64();
+    let pre = t.elapsed().as_secs_f64();
     let ooc =
         out_of_core::render(&engine, 512).map_err(|e| input(format!("out-of-core render: {e}")))?;
     let r = &ooc.render;
@@ -192,13 +201,24 @@ fn breadth_first_run(prepared: &workload::Prepared, floor: &str) -> Result<Timed
 /// Runs rss, rss-r and breadth-first `repeats` times on one published row's scene.
 fn measure(row: &PublishedRow, repeats: usize) -> Result<Measured> {
     let src = SceneSource::resolve(&row.scene, Some(row.sf), None, None)?;
-    let prepared = workload::prepare(&src)?;
     let floor = floor_setting(&row.scene);
     eprintln!("nakamaru-3.1: {}{} …", row.scene, row.sf);
+    // The scene as a file, as Rayshade read it.
+    let spill = SpillDir::create(None).map_err(input)?;
+    let nff = spill.path().join(format!("{}{}.nff", row.scene, row.sf));
+    {
+        let file = std::fs::File::create(&nff).map_err(|e| input(format!("{}: {e}", nff.display())))?;
+        let mut w = rtbench_scenes::nff::NffWriter::new(std::io::BufWriter::new(file));
+        src.stream(&mut w)?;
+        w.finish().map_err(|e| input(format!("{}: {e}", nff.display())))?;
+    }
+    // Every program traces the scene as the file gives it (NFF's `%g` numbers), so that their
+    // images and test counts compare.
+    let prepared = workload::prepare(&SceneSource::File(nff.clone()))?;
     let mut runs: [Vec<Timed>; 3] = [Vec::new(), Vec::new(), Vec::new()];
     for _ in 0..repeats {
-        runs[0].push(grid_run(&prepared, "rss", floor)?);
-        runs[1].push(grid_run(&prepared, "rss-r", floor)?);
+        runs[0].push(grid_run(&nff, "rss", floor)?);
+        runs[1].push(grid_run(&nff, "rss-r", floor)?);
         runs[2].push(breadth_first_run(&prepared, floor)?);
     }
     let med = |c: usize, p: usize| median(&mut runs[c].iter().map(|t| t.s[p]).collect::<Vec<_>>());
@@ -280,6 +300,13 @@ fn count_reason(scene: &str) -> &'static str {
     }
 }
 
+/// Table 3.1's ranges are its ratios as printed, to two decimals (balls4's total 710.01 / 137.59 =
+/// 5.1603 prints as the range's 5.16): a ratio is judged as printed.
+fn in_printed_range(v: f64, lo: f64, hi: f64) -> bool {
+    let printed = (v * 100.0).round() / 100.0;
+    (lo..=hi).contains(&printed)
+}
+
 /// Per scene: the test-count premise, the overall overhead (goal: smaller than the thesis's),
 /// and each phase's ratio against the thesis's printed range (pure).
 fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
@@ -318,7 +345,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
             format!("sray/rss {pt:.2}"),
             format!("bf/rss {bf:.2} (bf/rss-r {:.2})", t.measured["bf/rss-r"]),
             Kind::Ratio,
-            Verdict::of(bf < pt),
+            // Being faster than the thesis's sray is a goal of ours, not a claim of the thesis's:
+            // shown here, the thesis's range judged in total-ratio.
+            Verdict::Shown,
         ));
         for (claim, phase, against) in [
             ("preprocess-ratio", "preprocess", "rss"),
@@ -331,7 +360,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
             let key_p = format!("sray/{against}");
             let key_m = format!("bf/{against}");
             let (pv, mv) = (f.published[key_p.as_str()], f.measured[key_m.as_str()]);
-            let side = if mv < lo {
+            let side = if in_printed_range(mv, lo, hi) {
+                "inside"
+            } else if mv < lo {
                 "below the range"
             } else if mv > hi {
                 "above the range"
@@ -345,7 +376,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                     format!("{key_p} {pv:.2} (range {lo}-{hi})"),
                     format!("{key_m} {mv:.2}"),
                     Kind::Range,
-                    Verdict::of((lo..=hi).contains(&mv)),
+                    Verdict::of(in_printed_range(mv, lo, hi)),
                 )
                 .with_note(side),
             );
@@ -404,4 +435,46 @@ fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -
     }
     doc.table(tests);
     doc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Table 3.1 fed through its own claims' checks: sray's figures as if measured.
+    #[test]
+    fn every_range_holds_on_the_thesis_table() {
+        let (p, _): (Published, _) = published::load("nakamaru-3.1", PUBLISHED);
+        let measured: Vec<Measured> = p
+            .rows
+            .iter()
+            .map(|r| {
+                let phases = PHASES
+                    .iter()
+                    .map(|&ph| {
+                        let [rss, rss_r, sray] = r.phases[ph];
+                        let published = BTreeMap::from([("sray/rss", sray / rss), ("sray/rss-r", sray / rss_r)]);
+                        let measured = BTreeMap::from([("bf/rss", sray / rss), ("bf/rss-r", sray / rss_r)]);
+                        (ph, PhaseFigures { published, measured })
+                    })
+                    .collect();
+                Measured {
+                    scene: r.scene.clone(),
+                    sf: r.sf,
+                    floor: "",
+                    phases,
+                    object_tests: BTreeMap::from([("rss-r", 100), ("breadth-first", 100)]),
+                    resolution: BTreeMap::new(),
+                    image_equal_to_rss_r: true,
+                    repeats: 1,
+                }
+            })
+            .collect();
+        assert_eq!(measured.len(), 6);
+        let rows = rows(&p, &measured);
+        for r in &rows {
+            assert_ne!(r.verdict, Verdict::Fails, "{} {}: {} vs {}", r.claim, r.subject, r.published, r.measured);
+        }
+        assert_eq!(rows.iter().filter(|r| r.kind == Kind::Range).count(), 24);
+    }
 }

@@ -148,23 +148,32 @@ fn measure_row(scene: &str, sf: u32, thesis_row: bool, cap: u32, s: &Setup) -> R
     let dir = spill.path().join("split");
     eprintln!("nakamaru-4.2: {scene}{sf}: store …");
     let h = grid_runs::write_split_store(&src, &dir)?;
-    let single = [("grid", "single".to_string()), ("cap", cap.to_string())];
-    eprintln!("nakamaru-4.2: {scene}{sf}: single-level, cap {cap} …");
-    let single = grid_runs::trace(&dir, s, &single)?;
-    let two = |upper: u32, lower: u32| {
-        eprintln!("nakamaru-4.2: {scene}{sf}: two-level {upper}/{lower} …");
-        grid_runs::trace(
-            &dir,
-            s,
-            &[
-                ("grid", "two-level".to_string()),
-                ("upper", upper.to_string()),
-                ("lower", lower.to_string()),
-            ],
-        )
+    // The thesis compares the grids, not how our budget is split: the two-level grid's block
+    // buffer (1/8 of the budget) and lower-grid pool (1/16) leave it room for fewer rays, hence
+    // more passes. Every grid gets the same rays per pass: the fewest any of them can hold.
+    let probe = |settings: &[(&str, String)]| grid_runs::rays_in_memory(&dir, s, settings);
+    let single_set = vec![("grid", "single".to_string()), ("cap", cap.to_string())];
+    let two_set = |upper: u32, lower: u32| {
+        vec![
+            ("grid", "two-level".to_string()),
+            ("upper", upper.to_string()),
+            ("lower", lower.to_string()),
+        ]
     };
-    let half = two(cap / 2, 2)?;
-    let quarter = two(cap / 4, 4)?;
+    let sets = [single_set, two_set(cap / 2, 2), two_set(cap / 4, 4)];
+    let mut rays = u64::MAX;
+    for set in &sets {
+        rays = rays.min(probe(set)?);
+    }
+    let traced = |set: &[(&str, String)], what: &str| {
+        eprintln!("nakamaru-4.2: {scene}{sf}: {what}, {rays} rays per pass …");
+        let mut set = set.to_vec();
+        set.push(("rays", rays.to_string()));
+        grid_runs::trace(&dir, s, &set)
+    };
+    let single = traced(&sets[0], &format!("single-level, cap {cap}"))?;
+    let half = traced(&sets[1], &format!("two-level {}/2", cap / 2))?;
+    let quarter = traced(&sets[2], &format!("two-level {}/4", cap / 4))?;
     Ok(Measured {
         scene: scene.into(),
         sf,
@@ -205,7 +214,8 @@ fn run(ctx: &Ctx) -> Result<Output> {
     let mut measured = Vec::new();
     for (scene, sf) in todo {
         let thesis = p.rows.iter().any(|r| r.scene == scene && r.sf == sf) && cap == 128;
-        let key = format!("{scene}{sf}-cap{cap}-{size}-{}-{}", setup.memory, setup.cache);
+        // "same-rays": rows saved before every grid got the same rays per pass are not reused.
+        let key = format!("{scene}{sf}-cap{cap}-{size}-{}-{}-same-rays", setup.memory, setup.cache);
         let m = match ctx.checkpoint.load::<Measured>(&key)? {
             Some(m) => {
                 eprintln!("{}: {scene}{sf}: saved by an earlier run", ctx.id);
@@ -234,6 +244,14 @@ fn run(ctx: &Ctx) -> Result<Output> {
         rows,
         doc,
     ))
+}
+
+/// The text's "1.1–1.3×" is stated to one decimal: four of the table's own fourteen cells (0.91,
+/// 0.92 and twice 0.93, overheads 1.075–1.099) lie below 1.1 unrounded and round to it. The
+/// overhead is judged as the text rounds it.
+fn in_text_band(overhead: f64, lo: f64, hi: f64) -> bool {
+    let rounded = (overhead * 10.0).round() / 10.0;
+    (lo..=hi).contains(&rounded)
 }
 
 fn ratio(a: f64, b: f64) -> f64 {
@@ -278,17 +296,22 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 .with_note(note.clone()),
             );
             let over = ratio(t, s);
+            let per_pass = ratio(
+                t / run.passes.max(1) as f64,
+                s / m.single.passes.max(1) as f64,
+            );
             rows.push(
                 Row::new(
                     "overhead",
                     format!("{} {name}", m.label()),
-                    format!("{lo}–{hi}×"),
+                    format!("{lo}–{hi}× (to one decimal, as the text states it)"),
                     format!(
-                        "{over:.2}× (direct registrations {} of {}, range checks turned away {})",
+                        "{over:.2}× ({} rays per pass; passes {} vs {}; per pass {per_pass:.2}×; direct registrations {} of {}, range checks turned away {})",
+                        run.rays_in_memory, run.passes, m.single.passes,
                         run.direct_registrations, run.registrations, run.direct_misses
                     ),
                     Kind::Range,
-                    Verdict::of((lo..=hi).contains(&over)),
+                    Verdict::of(in_text_band(over, lo, hi)),
                 )
                 .with_note(note.clone()),
             );
@@ -317,7 +340,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
 fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool) -> Document {
     let mut doc = Document::new("nakamaru-4.2: overhead of the two-level grid");
     doc.paragraph(format!(
-        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-4.2{}`, {}×{}, breadth-first engine with S+G+B, memory {}, cache {}, one thread; times are preprocessing (with the hierarchy's and the on-disk grid's build) + tracing. Ratio = single-level time / two-level time (the thesis's); overhead = its inverse.",
+        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-4.2{}`, {}×{}, breadth-first engine with S+G+B, memory {}, cache {}, one thread; times are preprocessing (with the hierarchy's and the on-disk grid's build) + tracing. Every grid of a row traces the same rays per pass (`rays=`: the fewest any of the three can hold in the budget; the two-level grid's block buffer and lower-grid pool would otherwise leave it fewer rays and more passes, a difference of our memory split, not of the grids). Ratio = single-level time / two-level time (the thesis's); overhead = its inverse, and per pass (time per pass over the single-level grid's).",
         p.source.cite(),
         p.source.machine.as_deref().unwrap_or(""),
         if quick { " --quick" } else { "" },
@@ -381,6 +404,22 @@ mod tests {
             sha256: sha.repeat(12),
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn the_text_band_holds_on_every_cell_of_the_table() {
+        let (p, _): (Published, _) = published::load("nakamaru-4.2", PUBLISHED);
+        let [lo, hi] = p.overhead_range;
+        let cells: Vec<f64> = p.rows.iter().flat_map(|r| [r.r64_2, r.r32_4]).collect();
+        assert_eq!(cells.len(), 14);
+        for c in &cells {
+            assert!(in_text_band(1.0 / c, lo, hi), "cell {c}: overhead {}", 1.0 / c);
+        }
+        // Unrounded, four cells fall below the text's band.
+        let below = cells.iter().filter(|c| !(lo..=hi).contains(&(1.0 / *c))).count();
+        assert_eq!(below, 4);
+        assert!(!in_text_band(1.04, lo, hi));
+        assert!(!in_text_band(1.36, lo, hi));
     }
 
     #[test]

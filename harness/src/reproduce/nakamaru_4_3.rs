@@ -134,7 +134,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "sgb-ratio",
             fidelity: Fidelity::Substituted,
-            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; a basic method traced on a fraction of the rows makes the row a model",
+            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; codecs differ: the basic store is gzip level 1 (the codec of the thesis's Table 3.3, where gzip cost the basic method 2.5-3.4x), the split store zstd, so the basic time carries a decoding cost the others do not (not measured apart here); a row whose basic time is extrapolated is a model",
         },
         Claim {
             key: "sg-ratio",
@@ -145,11 +145,6 @@ pub const TABLE: Table = Table {
             key: "basic-model",
             fidelity: Fidelity::Model,
             why: "basic tracing time extrapolated from a tile set of the image rows (basic-fraction) or from its first N passes: passes by the split runs' pass count, shading by the whole run's store sweeps (basic-passes); --quick: against the whole run, measured",
-        },
-        Claim {
-            key: "per-ray-growth",
-            fidelity: Fidelity::Substituted,
-            why: "our goal, not the thesis's: S+G+B's time per eye ray grows less than 2× from 10^6 to 10^9 objects; judged on this machine with every method on the high-resolution grid, from the row nearest 10^6 objects (give it in rows=, e.g. mount10) to a row of at least 5·10^8",
         },
         Claim {
             key: "per-ray-growth-thesis",
@@ -1098,6 +1093,13 @@ impl ThesisSgb {
 /// the largest, judged when those are within 3× of 10^6 and at least 5·10^8. Beside it, where
 /// the thesis has both rows, the thesis's own growth between them, and ours judged against it
 /// (within 2× either way): the goal asks for less growth than the thesis's own tables show.
+/// Our S+G+B growth per eye ray between two rows, against the thesis's own between the same rows
+/// (Tables 4.1 and 4.3 give about 38× for mount10 → mount14 and 42× for rings36 → rings368): within
+/// 2× either way. Growing less than 2× is a goal of ours (docs/benchmarks.md), not the thesis's claim.
+fn within_thesis_growth(ours: f64, thesis: f64) -> bool {
+    ours <= 2.0 * thesis && ours >= thesis / 2.0
+}
+
 fn growth_rows(points: &[SizePoint], size: u32, thesis: &ThesisSgb) -> Vec<Row> {
     let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
     scenes.sort();
@@ -1120,7 +1122,6 @@ fn growth_rows(points: &[SizePoint], size: u32, thesis: &ThesisSgb) -> Vec<Row> 
         }
         let per = |p: &SizePoint| per_ray::per_eye_ray(p.seconds[2], size);
         let g = per(b) / per(a).max(1e-12);
-        let judged = near(&a) <= 3f64.log10() && b.objects >= 500_000_000;
         let ours = format!(
             "S+G+B {:.1} µs → {:.1} µs per eye ray, {} → {} objects: {g:.2}×",
             1e6 * per(a),
@@ -1128,14 +1129,6 @@ fn growth_rows(points: &[SizePoint], size: u32, thesis: &ThesisSgb) -> Vec<Row> 
             a.objects,
             b.objects
         );
-        rows.push(Row::new(
-            "per-ray-growth",
-            scene.to_string(),
-            "< 2× from 10^6 to 10^9 objects (our goal)",
-            ours.clone(),
-            Kind::Ratio,
-            if judged { Verdict::of(g < 2.0) } else { Verdict::Shown },
-        ));
         if let (Some((ta, sa)), Some((tb, sb))) =
             (thesis.seconds(scene, a.sf), thesis.seconds(scene, b.sf))
         {
@@ -1149,7 +1142,7 @@ fn growth_rows(points: &[SizePoint], size: u32, thesis: &ThesisSgb) -> Vec<Row> 
                 ),
                 ours,
                 Kind::Ratio,
-                Verdict::of(g <= 2.0 * gt && g >= gt / 2.0),
+                Verdict::of(within_thesis_growth(g, gt)),
             ));
         }
     }
@@ -1259,6 +1252,16 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     )
                     .with_note(note.clone()),
                 );
+                if model {
+                    // A ratio over an extrapolated basic time is a model's figure, not a measurement.
+                    let r = rows.pop().expect("just pushed");
+                    let why = if note.is_empty() {
+                        "the basic time is extrapolated (basic-model row)".to_string()
+                    } else {
+                        format!("the basic time is extrapolated (basic-model row); {note}")
+                    };
+                    rows.push(r.with_fidelity(Fidelity::Model, why));
+                }
             }
             rows.push(
                 Row::new(
@@ -1515,11 +1518,10 @@ mod tests {
         }
     }
 
-    /// The goal is judged from the row nearest 10^6 objects to a row of at least 5·10^8, and
-    /// only then; a curve that stops short is shown, not judged. Where the thesis has both rows
-    /// (Tables 4.1 and 4.3), its own growth is put beside ours and ours judged within 2× of it.
+    /// Our growth per eye ray is put beside the thesis's own between the same rows (Tables 4.1 and
+    /// 4.3) and judged within 2× of it; the thesis's growth fed through the check holds.
     #[test]
-    fn the_per_ray_goal_is_judged_from_near_a_million_to_at_least_half_a_billion() {
+    fn the_per_ray_growth_is_judged_against_the_thesis_growth() {
         let (p, _): (Published, _) = published::load("nakamaru-4.3", PUBLISHED);
         let thesis = ThesisSgb::new(&p);
         let mut pts = [
@@ -1539,25 +1541,34 @@ mod tests {
             .iter()
             .map(|r| (r.claim, r.subject.clone(), r.verdict))
             .collect();
-        assert_eq!(v.len(), 6, "{v:?}");
-        // mount: 2,097,156 is the row nearest 10^6; 25 / 10 = 2.5× does not hold.
-        assert_eq!(v[0], ("per-ray-growth", "mount".into(), Verdict::Fails));
+        assert_eq!(v.len(), 3, "{v:?}");
+        assert!(v.iter().all(|r| r.0 == "per-ray-growth-thesis"));
+        // mount: 2,097,156 is the row nearest 10^6. The thesis: mount10 641 s / 1.86, mount14
+        // 69,975 s / 5.33: 38.10×; ours 25 / 10 = 2.5× is more than 2× below it.
+        assert_eq!(v[0], ("per-ray-growth-thesis", "mount".into(), Verdict::Fails));
+        assert!(rows[0].published.contains("38.10×"), "{}", rows[0].published);
+        assert!(rows[0].published.contains("Table 4.1, SF 10"), "{}", rows[0].published);
         assert!(rows[0].measured.contains("2.50×"), "{}", rows[0].measured);
-        // The thesis: mount10 641 s / 1.86, mount14 69,975 s / 5.33: 38.10×; ours 2.5× is more
-        // than 2× below it.
-        assert_eq!(v[1], ("per-ray-growth-thesis", "mount".into(), Verdict::Fails));
-        assert!(rows[1].published.contains("38.10×"), "{}", rows[1].published);
-        assert!(rows[1].published.contains("Table 4.1, SF 10"), "{}", rows[1].published);
-        assert_eq!(v[2], ("per-ray-growth", "rings".into(), Verdict::Holds));
-        assert_eq!(v[3].0, "per-ray-growth-thesis");
-        assert_eq!(v[4], ("per-ray-growth", "tetra".into(), Verdict::Shown));
-        // tetra10 → tetra12 are both Table 4.1 rows: the thesis's growth is shown beside.
-        assert_eq!(v[5].0, "per-ray-growth-thesis");
-        // Ours at the thesis's own growth holds.
-        pts[2].seconds[2] = 10.0 * 38.0;
+        // rings36 → rings368: the thesis's about 42×.
+        assert!(rows[1].published.contains("42."), "{}", rows[1].published);
+        // Ours at the thesis's own growth holds: the check on the thesis's numbers.
+        pts[2].seconds[2] = 10.0 * 38.10;
         let rows = growth_rows(&pts, 1, &thesis);
-        assert_eq!(rows[1].verdict, Verdict::Holds);
+        assert_eq!(rows[0].verdict, Verdict::Holds);
+        for gt in [38.10, 42.0, 1.5] {
+            assert!(within_thesis_growth(gt, gt));
+        }
     }
+
+    /// Table 4.3's S+G+B column fed through the text's 5–14× band.
+    #[test]
+    fn the_improvement_band_holds_on_table_4_3() {
+        let (p, _): (Published, _) = published::load("nakamaru-4.3", PUBLISHED);
+        let [lo, hi] = p.improvement_range;
+        assert_eq!(p.rows.len(), 3);
+        assert!(p.rows.iter().all(|r| (lo..=hi).contains(&r.sgb)));
+    }
+
     /// A capped basic run is extrapolated part by part: passes by a split run's pass count, shading by
     /// the whole run's sweeps (one per group of each S+G generation), the rest as measured; a
     /// row saved without the split keeps the old model (all of the trace by the passes).

@@ -203,12 +203,95 @@ pub fn scenes(ctx: &Ctx, default: &[&str]) -> Result<Vec<String>> {
         .unwrap_or_else(|| default.iter().map(|s| s.to_string()).collect()))
 }
 
+/// The suffix of a scene name that asks for the room as it is generated (y up, the eye along +z):
+/// an extra orientation, reported under its own label beside 003's.
+pub const Y_UP: &str = "-yup";
+
+/// Rows on the room in another orientation than 003's (`roomN-yup`): shown beside 003's, never
+/// judged, and saying which orientation they are.
+pub fn mark_extra_orientation(rows: &mut [super::Row]) {
+    for r in rows.iter_mut().filter(|r| r.subject.contains(Y_UP)) {
+        if matches!(r.verdict, super::Verdict::Holds | super::Verdict::Fails) {
+            r.verdict = super::Verdict::Shown;
+        }
+        r.note =
+            "an extra orientation, the room y up as generated (not 003's, z up): shown, not judged"
+                .into();
+    }
+}
+
+/// 003's orientation of its room: z up. §3.3.2 designs the skewed allocation for objects coherent
+/// along the vertical ("walls stand upright, as do pillars and trees") and shifts ownership along the
+/// axis that has no PE dimension, which on the 2D machine of eq. (10), PE = ((X + Z) mod N_x,
+/// Y mod N_y), is Z; with y up, every plane of fixed Y (the floor and the ceiling, 43% of the
+/// room's patches) sits on one PE row. The room is generated y up ([`rtbench_scenes::room`]), and
+/// its `turn` is its own inverse, so applying it once more gives the modelling frame: floor x-y,
+/// z up, the eye looking along +y.
+pub fn turn_room_z_up(scene: &mut rtbench_scenes::Scene) {
+    use rtbench_scenes::room::turn;
+    use rtbench_scenes::Shape;
+    let dir = |v: glam::DVec3| glam::DVec3::new(-v.x, v.z, v.y);
+    scene.view.from = turn(scene.view.from);
+    scene.view.at = turn(scene.view.at);
+    scene.view.up = dir(scene.view.up);
+    for l in &mut scene.lights {
+        l.position = turn(l.position);
+    }
+    for o in &mut scene.objects {
+        match &mut o.shape {
+            Shape::Sphere { center, .. } => *center = turn(*center),
+            Shape::Cone { base, apex, .. } => {
+                *base = turn(*base);
+                *apex = turn(*apex);
+            }
+            Shape::Polygon(vs) => vs.iter_mut().for_each(|v| *v = turn(*v)),
+            Shape::Patch { vertices, normals } => {
+                vertices.iter_mut().for_each(|v| *v = turn(*v));
+                normals.iter_mut().for_each(|n| *n = dir(*n));
+            }
+        }
+    }
+}
+
+/// A scene of the load-balancing tables ready for the engine: the room in 003's orientation (z up;
+/// `roomN-yup`: as generated, y up, labelled so), anything else as it is.
+fn prepare_oriented(name: &str) -> Result<workload::Prepared> {
+    let (base, y_up) = match name.strip_suffix(Y_UP) {
+        Some(b) => (b, true),
+        None => (name, false),
+    };
+    let src = Source::resolve(base, None, None, None)?;
+    if !matches!(src, Source::Room(_)) {
+        if y_up {
+            return Err(input(format!("{name}: '{Y_UP}' applies to the room only")));
+        }
+        return workload::prepare(&src);
+    }
+    let mut scene = src.load()?;
+    if y_up {
+        scene.name = format!("{}{Y_UP}", src.label());
+    } else {
+        turn_room_z_up(&mut scene);
+    }
+    let geometry = rtbench_engines::geometry::Geometry::from_scene(&scene);
+    Ok(workload::Prepared {
+        input: rtbench_engines::BuildInput {
+            scene: std::sync::Arc::new(scene),
+            geometry: std::sync::Arc::new(geometry),
+        },
+        generate_s: 0.0,
+        prepare_s: 0.0,
+    })
+}
+
 /// The load-balancing tables' shared setting: image size, largest PE count (256 with `--quick`,
 /// else 1,024), the room with both passes (003's setting: `room` patches per metre, 2 with
 /// `--quick`, else 8; radiosity `threshold`), then the SPD scenes as a second set (tetra with
 /// `--quick`, else balls, rings, tetra; ray-tracing pass only: they have no emitters), each traced
 /// with 003's pass at default costs. `scenes` replaces the default list (`room`/`roomN` or SPD
-/// names). A `max-pes` below `min_pes` is refused before anything is traced.
+/// names; `roomN-yup` adds the room as generated, y up, as extra rows). The room is traced in 003's
+/// orientation, z up ([`turn_room_z_up`]). A `max-pes` below `min_pes` is refused before anything is
+/// traced.
 pub fn load_balancing_setting(ctx: &Ctx, min_pes: u32) -> Result<(u32, u32, Vec<Traced>)> {
     let size = size(ctx)?;
     let max_pes = max_pes(ctx, if ctx.quick { 256 } else { 1024 })?;
@@ -254,8 +337,8 @@ pub fn trace_scenes(
 ) -> Result<Vec<Traced>> {
     let mut v = Vec::new();
     for s in scenes {
-        let src = Source::resolve(s, None, None, None)?;
-        let prepared = workload::prepare(&src)?;
+        let prepared = prepare_oriented(s)?;
+        let is_room = s.starts_with("room");
         let label = prepared.input.scene.name.clone();
         let config = ObjectSpaceConfig {
             costs,
@@ -263,7 +346,7 @@ pub fn trace_scenes(
         };
         let os = ObjectSpace::build(&prepared.input, config.clone())
             .map_err(|e| input(e.to_string()))?;
-        if let (Some(threshold), Source::Room(_)) = (radiosity, &src) {
+        if let (Some(threshold), true) = (radiosity, is_room) {
             let scene = &prepared.input.scene;
             let em = rtbench_scenes::room::emission(&scene.materials);
             let patches = Patches::from_scene(scene, &prepared.input.geometry.prim_object, &em)

@@ -12,7 +12,8 @@ use serde_json::{json, Value};
 use std::path::Path;
 
 /// Gives each row its claim's fidelity (a row's own label may only be lower), and fails on a row
-/// naming a claim its table does not declare: a broken table, not bad input.
+/// naming a claim its table does not declare: a broken table, not bad input. A claim's reason is
+/// stated once, in [`claims_table`]; a row's note keeps only what is particular to it.
 fn label(table: &Table, rows: &mut [Row]) {
     for r in rows.iter_mut() {
         let c = table
@@ -27,10 +28,28 @@ fn label(table: &Table, rows: &mut [Row]) {
         } else {
             c.fidelity
         });
-        if r.note.is_empty() && own == c.fidelity {
-            r.note = c.why.to_string();
-        }
     }
+}
+
+/// Each claim the rows test, once: its label, why (when not faithful), and how many rows test it.
+fn claims_table(table: &Table, rows: &[Row]) -> DocTable {
+    let mut t = DocTable::new(
+        "Claims tested: fidelity and its reason",
+        &["claim", "rows", "fidelity", "why"],
+    );
+    for c in table.claims {
+        let n = rows.iter().filter(|r| r.claim == c.key).count();
+        if n == 0 {
+            continue;
+        }
+        t.push(vec![
+            c.key.to_string(),
+            n.to_string(),
+            c.fidelity.name().to_string(),
+            c.why.to_string(),
+        ]);
+    }
+    t
 }
 
 /// The rows as the document's last table.
@@ -75,6 +94,7 @@ pub fn write(table: &Table, out: &Path, mut o: Output, as_json: bool) -> Result<
     label(table, &mut o.rows);
     let mut doc = o.doc;
     if !o.rows.is_empty() {
+        doc.table(claims_table(table, &o.rows));
         doc.table(rows_table(&o.rows));
     }
     let counts: serde_json::Map<String, Value> = Fidelity::ALL
@@ -158,4 +178,43 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir)
         .map_err(|e| input(format!("{}: cannot create: {e}", dir.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{find, Kind, Verdict};
+    use super::*;
+
+    #[test]
+    fn a_claims_reason_is_stated_once_not_on_every_row() {
+        let table = find("yamauchi-cfbs").unwrap();
+        let c = table
+            .claims
+            .iter()
+            .find(|c| c.fidelity != Fidelity::Faithful)
+            .unwrap();
+        let mut rows: Vec<Row> = (0..3)
+            .map(|i| {
+                Row::new(
+                    c.key,
+                    format!("s{i}"),
+                    "p",
+                    "m",
+                    Kind::Ratio,
+                    Verdict::Shown,
+                )
+            })
+            .collect();
+        label(table, &mut rows);
+        assert!(rows
+            .iter()
+            .all(|r| r.note.is_empty() && r.fidelity == Some(c.fidelity)));
+        let md = {
+            let mut d = Document::new("t");
+            d.table(claims_table(table, &rows));
+            d.table(rows_table(&rows));
+            d.to_markdown()
+        };
+        assert_eq!(md.matches(c.why).count(), 1, "{md}");
+    }
 }

@@ -29,22 +29,6 @@ pub fn from_env(engine: &str, program: Option<&str>) -> Option<Plant> {
     )
 }
 
-/// Whether every `;`-separated plant of `spec` is well formed (`RTBENCH_PLANT`'s check).
-pub fn valid(spec: &str) -> bool {
-    spec.split(';').all(|one| {
-        let parts: Vec<&str> = one.trim().split(':').collect();
-        match parts.as_slice() {
-            ["work", e, s, f] => {
-                !e.is_empty()
-                    && !s.is_empty()
-                    && f.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)
-            }
-            ["counter", e, s] => !e.is_empty() && !s.is_empty(),
-            _ => false,
-        }
-    })
-}
-
 fn parse(spec: &str, engine: &str, program: Option<&str>) -> Option<Plant> {
     spec.split(';')
         .find_map(|one| parse_one(one.trim(), engine, program))
