@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The hostile suite, re-runnable: the reproducers of hostile input, absurd settings, stdout to
+# The hostile suite, re-runnable: the reproducers of each round (views, limits, meshes, stores,
+# plugins, history, merge and compare, suites), absurd settings, stdout to
 # /dev/full and to a closed pipe for every command, mutated NFF files through several engines,
 # and random bit flips in a scene store (scripts/store_bitflips.sh). Every invocation runs under
 # a time limit and an address-space limit. It counts invocations, refusals (exit 2), panics
@@ -130,6 +131,128 @@ for c in "${COMMANDS[@]}"; do
     [ "$rc" = 141 ] && rc=0
     tally "$rc" any "$c | (closed)"
 done
+
+echo "hostile: meshes, limits, stores, plugins, history, merge and compare" >&2
+M="$ROOT/tests/fuzz/corpus/mesh"
+mkdir -p "$WORK/m/sub"
+cp "$M"/* "$WORK/m/"
+cp "$M/quad.bin" "$WORK/quad.bin"
+gl() { # NAME SED-EXPRESSION [SEED]: a variant of a seed glTF (one-line JSON) → its path
+    sed "$2" "${3:-$M/quad-data.gltf}" >"$WORK/m/$1.gltf"
+    echo "$WORK/m/$1.gltf"
+}
+R="--engine bvh4 --size 8"
+for f in quad-data.gltf quad.glb quad-file.gltf quad-le.ply quad-be.ply quad-ascii.ply quad.obj; do
+    run 0 render --scene "$WORK/m/$f" $R
+done
+# glTF accessors against the spec: missing, wrong type or component, short stride, overruns.
+run 2 render --scene "$(gl noacc 's/"accessors": \[.*\]}$/"accessors": []}/')" $R
+run 2 render --scene "$(gl stride4 's/"byteStride": 12/"byteStride": 4/')" $R
+run 2 render --scene "$(gl idxfloat 's/5123/5126/')" $R
+for t in VEC2 VEC4 SCALAR MAT4; do
+    run 2 render --scene "$(gl "pos$t" "s/\"VEC3\", \"min\"/\"$t\", \"min\"/")" $R
+done
+for c in 5121 5123; do
+    run 2 render --scene "$(gl "posc$c" "s/\"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\"/\"componentType\": $c, \"count\": 4, \"type\": \"VEC3\", \"min\"/")" $R
+done
+run 2 render --scene "$(gl idxover 's/"count": 6/"count": 9/')" $R
+# Buffers only inside the mesh's folder: absolute, parent, device and scheme URIs refused.
+for uri in /etc/passwd ../quad.bin /dev/zero file:///etc/passwd "$WORK/quad.bin"; do
+    g=$(gl "uri$RANDOM" "s#\"uri\": \"quad.bin\"#\"uri\": \"$uri\"#" "$M/quad-file.gltf")
+    run 2 render --scene "$g" $R
+    if grep -q "root:" "$WORK/err"; then wrong=$((wrong + 1)); echo "WRONG (read outside the folder): $uri" >&2; fi
+done
+printf 'mtllib /dev/zero\nmtllib %s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' "$WORK/m/quad.bin" >"$WORK/m/mtl.obj"
+run 0 render --scene "$WORK/m/mtl.obj" $R
+for n in 3 5; do
+    sed "s/element vertex 4/element vertex $n/" "$M/quad-le.ply" >"$WORK/m/count$n.ply"
+    run 2 render --scene "$WORK/m/count$n.ply" $R
+done
+# Limits: the memory estimate (tessellation, size factor, engine) against RAM and ulimit -v,
+# the breadth-first budget, generation bounds, huge time budgets.
+run 2 render --scene balls --sf 1 --engine bvh4 --tessellate 1000 --size 8
+run 2 render --scene gears --sf 40 --engine bvh4 --size 8
+run 2 render --scene balls --sf 1 --engine breadth-first --set memory=4294967295 --size 8
+run 2 scene gen balls --sf 20
+run 2 scene store mount --sf 20 -o "$WORK/big"
+run 2 scene gen balls --sf 5 --max-bytes 100K
+run 0 scene store tetra --sf 3 --segment 16 --max-seconds 1e308 -o "$WORK/st3"
+run 2 render --scene tetra --sf 1 $R --threads 1000000
+# A compressed basic store's header.json is vouched for; a store directory without it is named.
+for c in gzip:1 zstd; do
+    rm -rf "$WORK/cs"
+    run 0 scene store balls --sf 1 --layout basic --compress $c -o "$WORK/cs"
+    printf ' ' >>"$WORK/cs/header.json"
+    run 2 render --scene "$WORK/cs" --engine breadth-first --set layout=basic --size 8
+done
+mkdir -p "$WORK/nohdr" && : >"$WORK/nohdr/bbox.bin"
+run 2 render --scene "$WORK/nohdr" --engine breadth-first --size 8
+# Plugins: answers held to the ABI, output kept off stdout, messages escaped.
+if command -v cc >/dev/null; then
+    for f in OK BARY PRIM0 STDOUT ESC; do
+        d=""; [ $f = OK ] || d="-DRTB_FAULT_$f"
+        cc -O2 -shared -fPIC -std=c99 -I"$ROOT/include" $d "$ROOT/examples/c-bvh/bvh.c" -o "$WORK/p$f.so" -lm
+    done
+    P="render --scene balls --sf 1 --size 16 --json --engine plugin:$WORK/p"
+    run 2 $P"BARY.so"
+    run 0 $P"STDOUT.so"
+    if grep -q "c-bvh" "$WORK/out" || [ "$(head -c 1 "$WORK/out")" != "{" ]; then wrong=$((wrong + 1)); echo "WRONG (plugin output in the JSON)" >&2; fi
+    run 2 $P"ESC.so"
+    if grep -q $'\x1b' "$WORK/err"; then wrong=$((wrong + 1)); echo "WRONG (raw escape from a plugin)" >&2; fi
+    run 2 $P"OK.so:abi_timing=bogus"
+    invocations=$((invocations + 1))
+    (ulimit -v $MEM_KB; timeout -s KILL $LIMIT_S "$B" check --scene balls --sf 1 --size 16 --engine "plugin:$WORK/pPRIM0.so" >"$WORK/out" 2>"$WORK/err")
+    rc=$?
+    if [ $rc = 1 ]; then refused=$((refused + 1)); else tally $rc 2 "check with a plugin naming primitive 0"; fi
+fi
+# Results: duplicates, an empty file, impossible times; merge of a shard holding a run twice.
+S="$ROOT/tests/fuzz/corpus/shard"
+mkdir -p "$WORK/sh" "$WORK/dup" "$WORK/empty" "$WORK/neg"
+cp "$S"/* "$WORK/sh/"
+run 0 merge "$WORK/sh" --out "$WORK/merged"
+head -1 "$S/results.jsonl" >>"$WORK/sh/results.jsonl"
+run 2 merge "$WORK/sh" --out "$WORK/merged2"
+cp "$WORK/sh/results.jsonl" "$WORK/dup/results.jsonl"
+run 2 compare "$WORK/merged" "$WORK/dup"
+: >"$WORK/empty/results.jsonl"
+run 2 compare "$WORK/merged" "$WORK/empty"
+run 2 report "$WORK/empty"
+sed 's/"median":\([0-9]\)/"median":-\1/' "$S/results.jsonl" >"$WORK/neg/results.jsonl"
+run 2 compare "$WORK/merged" "$WORK/neg"
+# Suites are checked whole before a night measures anything.
+for bad in 'engines = ["embree", "grid:simd=off"]' 'threads = [1000000]' 'sf = [40]'; do
+    { echo 'engines = ["embree", "grid"]'; echo 'scenes = ["gears"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; echo 'gate = ["counters"]'; } >"$WORK/suite.toml"
+    key=${bad%% =*}
+    sed -i "/^$key =/d" "$WORK/suite.toml"
+    echo "$bad" >>"$WORK/suite.toml"
+    run 2 nightly --suite "$WORK/suite.toml" --db "$WORK/suite.sqlite"
+    run 2 plan nightly --suite "$WORK/suite.toml"
+done
+# History: read commands never write, text is cut at characters, check sees what is missing.
+{ echo 'engines = ["embree", "grid"]'; echo 'scenes = ["tetra"]'; echo 'sf = [1]'; echo 'repeats = 2'; echo 'size = 8'; echo 'gate = ["counters"]'; } >"$WORK/night.toml"
+H="$WORK/hist/h.sqlite"
+mkdir -p "$WORK/hist"
+if timeout 300 "$B" nightly --suite "$WORK/night.toml" --db "$H" >/dev/null 2>&1 && command -v sqlite3 >/dev/null; then
+    sqlite3 "$H" "UPDATE runs SET git_commit='日日日日日', fingerprint='日日日日日日日日日日日日日';"
+    for c in list show "export --format csv" "export --format bmf" check; do run 0 history $c --db "$H"; done
+    run 2 history export --format bmf --run 99 --db "$H"
+    run 2 history dashboard --db "$H" --out /proc/none
+    chmod 555 "$WORK/hist"
+    for c in list show "export --format csv" check; do run 0 history $c --db "$H"; done
+    chmod 755 "$WORK/hist"
+    : >"$WORK/zero.sqlite"
+    run 2 history list --db "$WORK/zero.sqlite"
+    [ -s "$WORK/zero.sqlite" ] && { wrong=$((wrong + 1)); echo "WRONG (a read command wrote a schema)" >&2; }
+    for damage in "DROP TABLE samples" "ALTER TABLE findings RENAME COLUMN message TO msg" \
+                  "UPDATE metrics SET value = 'fast'" "DELETE FROM metrics WHERE run_id = 2 AND rowid % 2 = 0"; do
+        cp "$H" "$WORK/d.sqlite"
+        sqlite3 "$WORK/d.sqlite" "INSERT INTO runs SELECT id + 1, suite, suite_sha256, started_at, finished_at, git_commit, git_dirty, fingerprint, env_json, wall_s, regressions, note FROM runs WHERE id = 1; INSERT INTO metrics SELECT run_id + 1, name, kind, unit, value, gated FROM metrics WHERE run_id = 1; $damage;" 2>/dev/null
+        invocations=$((invocations + 1))
+        (timeout -s KILL $LIMIT_S "$B" history check --db "$WORK/d.sqlite" >"$WORK/out" 2>"$WORK/err")
+        rc=$?
+        if [ $rc = 1 ]; then refused=$((refused + 1)); else tally $rc 2 "history check after: $damage"; fi
+    done
+fi
 
 echo "hostile: $MUTATIONS mutated NFF files" >&2
 SEEDS=("$ROOT"/tests/fuzz/corpus/nff/*.nff)

@@ -9,7 +9,8 @@
  * Build by hand:
  *   cc -O2 -shared -fPIC -Iinclude examples/c-bvh/bvh.c -o libc_bvh.so -lm
  * The tests build it with the `cc` crate, and also build faulty variants of it
- * (-DRTB_FAULT_NAN, _SEGV, _ID, _T, _ABI) to check that rtbench catches each fault.
+ * (-DRTB_FAULT_NAN, _SEGV, _ID, _T, _ABI, _BARY, _PRIM0, _STDOUT, _ESC) to check that rtbench
+ * catches each fault.
  */
 #include "rtbench_engine.h"
 
@@ -177,6 +178,12 @@ static void build_node(bvh *b, const pbox *boxes, uint32_t ni, uint32_t first, u
 
 static void *bvh_build(const rtb_scene *s, char *error, size_t error_len) {
     uint32_t i, leaf = 4;
+#if defined(RTB_FAULT_STDOUT)
+    printf("c-bvh: building");
+#elif defined(RTB_FAULT_ESC)
+    snprintf(error, error_len, "\033[31mred\033[0m failure\a");
+    return NULL;
+#endif
     for (i = 0; i < s->setting_count; i++) {
         if (strcmp(s->settings[i].key, "leaf") == 0) {
             int v = atoi(s->settings[i].value);
@@ -387,6 +394,12 @@ static void bvh_intersect(const void *e, const rtb_ray *rays, rtb_hit *hits, siz
         if (hits[i].prim != RTB_MISS) hits[i].t = rays[i].tmin - 1.0f;
 #elif defined(RTB_FAULT_SEGV)
         if (i == count / 2) *(volatile int *)0 = 1;
+#elif defined(RTB_FAULT_BARY)
+        if (hits[i].prim != RTB_MISS) hits[i].u = i % 2 ? INFINITY : 1e30f;
+#elif defined(RTB_FAULT_PRIM0)
+        if (hits[i].prim != RTB_MISS) hits[i].prim = 0;
+#elif defined(RTB_FAULT_STDOUT)
+        if (i == 0) printf("c-bvh: %zu rays\n", count);
 #endif
     }
 }

@@ -432,6 +432,10 @@ pub enum SceneCommand {
         /// Output file (written atomically); stdout when absent.
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
+        /// Refuse a scene whose NFF would pass this many bytes (estimated before writing, and
+        /// held while writing): 1234, 512M, 8GiB …
+        #[arg(long, value_name = "BYTES", default_value = "4GiB")]
+        max_bytes: String,
     },
     /// Write a scene store for the breadth-first engine (bounding-box and geometry files,
     /// header.json), streaming from the generator without holding the scene.
@@ -471,6 +475,10 @@ pub enum SceneCommand {
         /// Stop at the first checkpoint after this many seconds (with --segment).
         #[arg(long, requires = "segment", value_name = "S")]
         max_seconds: Option<f64>,
+        /// Refuse a scene whose records (uncompressed) would pass this many bytes, estimated
+        /// before writing and held while writing: 1234, 512M, 8GiB …
+        #[arg(long, value_name = "BYTES", default_value = "16GiB")]
+        max_bytes: String,
         /// Print one JSON document on stdout (progress and logs stay on stderr).
         #[arg(long)]
         json: bool,

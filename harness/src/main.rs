@@ -33,6 +33,9 @@ mod source;
 mod suite;
 mod workload;
 
+#[cfg(test)]
+mod fuzz;
+
 use clap::Parser;
 use cli::{Cli, Command, SceneCommand};
 use error::Result;
@@ -45,9 +48,14 @@ fn run(cli: Cli) -> Result<()> {
     }
     match cli.command {
         Command::Scene(SceneCommand::List { json }) => commands::scene::list(json),
-        Command::Scene(SceneCommand::Gen { scene, output }) => commands::scene::gen(
+        Command::Scene(SceneCommand::Gen {
+            scene,
+            output,
+            max_bytes,
+        }) => commands::scene::gen(
             &Source::from_args(&scene.scene, &scene.opts)?,
             output.as_deref(),
+            commands::scene::max_bytes(&max_bytes)?,
         ),
         Command::Scene(SceneCommand::Store {
             scene,
@@ -58,6 +66,7 @@ fn run(cli: Cli) -> Result<()> {
             segment,
             resume,
             max_seconds,
+            max_bytes,
             json,
         }) => match segment {
             Some(segment) if hierarchy => Err(error::input(format!(
@@ -72,6 +81,7 @@ fn run(cli: Cli) -> Result<()> {
                     segment,
                     resume,
                     max_seconds,
+                    max_bytes: commands::scene::max_bytes(&max_bytes)?,
                     as_json: json,
                 },
             ),
@@ -81,6 +91,7 @@ fn run(cli: Cli) -> Result<()> {
                 &layout,
                 &compress,
                 hierarchy,
+                commands::scene::max_bytes(&max_bytes)?,
                 json,
             ),
         },

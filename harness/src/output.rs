@@ -5,6 +5,12 @@ use crate::error::{input, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The first `n` characters of `s`: text read from files and databases is cut at a character,
+/// never at a byte index (which panics inside a multi-byte character).
+pub fn head(s: &str, n: usize) -> &str {
+    s.char_indices().nth(n).map_or(s, |(i, _)| &s[..i])
+}
+
 /// Runs `write` on a temp file next to `path`, then renames it over `path`. On any error the
 /// temp file is removed and the error names `path`.
 pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
@@ -23,6 +29,7 @@ where
         name.to_string_lossy(),
         std::process::id()
     ));
+    let _guard = interrupt::remove_on_signal(&tmp);
     let result = (|| -> std::io::Result<()> {
         let f = std::fs::File::create(&tmp)?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
@@ -87,6 +94,69 @@ pub fn print_json(v: &serde_json::Value) {
         "{}",
         serde_json::to_string_pretty(v).expect("JSON values serialise")
     );
+}
+
+/// A temporary file being written is removed if the process is interrupted (SIGINT, SIGTERM,
+/// SIGHUP) before it is renamed into place: the handler unlinks it (async-signal-safe) and then
+/// dies of the signal as it would have. One file at a time, the latest registered.
+pub mod interrupt {
+    use std::ffi::{c_char, c_int, CString};
+    use std::path::Path;
+    use std::sync::atomic::{AtomicPtr, Ordering};
+    use std::sync::Once;
+
+    static TEMP: AtomicPtr<c_char> = AtomicPtr::new(std::ptr::null_mut());
+    static INSTALL: Once = Once::new();
+
+    extern "C" fn on_signal(sig: c_int) {
+        let p = TEMP.swap(std::ptr::null_mut(), Ordering::SeqCst);
+        // SAFETY: unlink, signal and raise are async-signal-safe; `p` is a leaked CString.
+        unsafe {
+            if !p.is_null() {
+                libc::unlink(p);
+            }
+            libc::signal(sig, libc::SIG_DFL);
+            libc::raise(sig);
+        }
+    }
+
+    /// Clears the registration when the write is over.
+    pub struct Guard(*mut c_char);
+
+    impl Drop for Guard {
+        fn drop(&mut self) {
+            if TEMP
+                .compare_exchange(
+                    self.0,
+                    std::ptr::null_mut(),
+                    Ordering::SeqCst,
+                    Ordering::SeqCst,
+                )
+                .is_ok()
+            {
+                // SAFETY: the pointer came from CString::into_raw and is no longer shared.
+                drop(unsafe { CString::from_raw(self.0) });
+            }
+        }
+    }
+
+    pub fn remove_on_signal(path: &Path) -> Guard {
+        use std::os::unix::ffi::OsStrExt;
+        INSTALL.call_once(|| {
+            for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+                // SAFETY: installing a handler that only calls async-signal-safe functions.
+                unsafe {
+                    libc::signal(sig, on_signal as extern "C" fn(c_int) as libc::sighandler_t);
+                }
+            }
+        });
+        let c = CString::new(path.as_os_str().as_bytes())
+            .unwrap_or_default()
+            .into_raw();
+        // The previous registration (a write still under way elsewhere) is left to its guard.
+        TEMP.store(c, Ordering::SeqCst);
+        Guard(c)
+    }
 }
 
 /// Bytes as lowercase hexadecimal (digests in results and manifests).

@@ -11,15 +11,26 @@ pub type Entry = (String, Vec<(String, String)>);
 /// force: hours on the standard scenes), `plugin` and the test-only ones; otherwise comma-separated
 /// entries, each a registered engine that can run here, with optional `:key=value` settings.
 /// `plugin:PATH[:key=value…]` is the engine `plugin` with the setting `path=PATH` first.
+/// The engines a command runs when none are named: every registered engine that can run here,
+/// but never `plugin` (a library must be named: `plugin:PATH`) nor the test-only ones, and
+/// `reference` (brute force) only when `with_reference`.
+pub fn default_engines(with_reference: bool) -> Vec<String> {
+    rtbench_engines::registry()
+        .iter()
+        .filter(|e| e.name != "plugin" && !e.name.starts_with("test-"))
+        .filter(|e| with_reference || e.name != "reference")
+        .filter(|e| (e.available)().is_ok())
+        .map(|e| e.name.to_string())
+        .collect()
+}
+
 pub fn engines(list: Option<&str>, flag: &str) -> Result<Vec<Entry>> {
     let registry = rtbench_engines::registry();
     let list = list.map(str::trim).filter(|l| *l != "all");
     let Some(list) = list else {
-        return Ok(registry
-            .iter()
-            .filter(|e| e.name != "reference" && e.name != "plugin" && !e.name.starts_with("test-"))
-            .filter(|e| (e.available)().is_ok())
-            .map(|e| (e.name.to_string(), Vec::new()))
+        return Ok(default_engines(false)
+            .into_iter()
+            .map(|e| (e, Vec::new()))
             .collect());
     };
     let mut out = Vec::new();
@@ -112,5 +123,22 @@ mod tests {
         assert!(engine_names(Some("grid:mailbox=off"), "--engine").is_err());
         let all = engines(None, "--engines").unwrap();
         assert!(all.iter().all(|(n, _)| n != "reference"));
+    }
+
+    /// No default list holds an engine that cannot be built without more to say (`plugin`
+    /// needs its library): `check --suite hard` without `--engine` builds every one.
+    #[test]
+    fn default_lists_build_as_they_come() {
+        let probe = crate::suite::probe_input();
+        for with_reference in [false, true] {
+            let list = default_engines(with_reference);
+            assert!(list.iter().any(|e| e == "bvh4"), "{list:?}");
+            assert_eq!(list.iter().any(|e| e == "reference"), with_reference);
+            for e in &list {
+                rtbench_engines::build_engine(e, &probe, vec![])
+                    .unwrap_or_else(|err| panic!("{e}: {err}"));
+            }
+        }
+        assert_eq!(crate::suite::engines(None).unwrap(), default_engines(true));
     }
 }

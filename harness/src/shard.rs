@@ -160,7 +160,7 @@ impl Manifest {
                     old.shard,
                     old.of,
                     old.kind,
-                    &old.plan_sha256[..12.min(old.plan_sha256.len())]
+                    crate::output::head(&old.plan_sha256, 12)
                 )));
             }
         }

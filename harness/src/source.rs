@@ -79,10 +79,21 @@ impl Source {
         match std::fs::metadata(&path) {
             Err(e) => return Err(input(format!("{}: {e}", nff::read::shown_upto(scene, 200)))),
             Ok(m) if m.is_dir() => {
-                return Err(input(format!(
-                    "{}: is a directory",
-                    nff::read::shown_upto(scene, 200)
-                )))
+                let shown = nff::read::shown_upto(scene, 200);
+                let store = rtbench_engines::store::HEADER_FILE;
+                let why = if path.join(rtbench_engines::store::SEGMENTS_FILE).is_file() {
+                    format!("a scene store still being written (no {store} yet: finish it with --resume)")
+                } else if ["bbox.bin", "objects.bin", "materials.bin", "geometry.bin"]
+                    .iter()
+                    .any(|f| path.join(f).exists())
+                {
+                    format!(
+                        "a scene store without its {store} (unfinished or damaged: write it again)"
+                    )
+                } else {
+                    format!("a directory, neither a scene file nor a scene store (no {store})")
+                };
+                return Err(input(format!("{shown}: {why}")));
             }
             Ok(m) if !m.is_file() => {
                 return Err(input(format!(

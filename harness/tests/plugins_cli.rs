@@ -57,6 +57,10 @@ fn plugins() -> &'static PathBuf {
             ("_id", "RTB_FAULT_ID"),
             ("_t", "RTB_FAULT_T"),
             ("_abi", "RTB_FAULT_ABI"),
+            ("_bary", "RTB_FAULT_BARY"),
+            ("_prim0", "RTB_FAULT_PRIM0"),
+            ("_stdout", "RTB_FAULT_STDOUT"),
+            ("_esc", "RTB_FAULT_ESC"),
         ] {
             compile(&dir, tag, Some(d));
         }
@@ -232,5 +236,73 @@ fn bad_plugin_entries_exit_2() {
             &format!("plugin:{}", plugin("_abi")),
         ],
         "ABI version",
+    );
+}
+
+/// A plugin's answers are held to the ABI beyond t and ids: barycentrics finite and inside the
+/// triangle; what it prints stays off rtbench's stdout; naming primitive 0 at the right
+/// distance does not pass `check` on the tie rule; its messages reach the terminal escaped.
+#[test]
+fn plugin_answers_output_and_messages_are_held_to_the_abi() {
+    let engine = |tag: &str| format!("plugin:{}", plugin(tag));
+    let render = |e: &str| {
+        rtbench(&[
+            "render", "--scene", "balls", "--sf", "1", "--engine", e, "--size", "24", "--json",
+        ])
+    };
+    let out = render(&engine("_bary"));
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("barycentrics"));
+    let out = render(&engine("_stdout"));
+    assert!(out.status.success(), "{out:?}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is the JSON");
+    assert!(v["rays_total"].as_u64().unwrap_or(0) > 0 || v.is_object());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("c-bvh:"));
+    let out = rtbench(&[
+        "check",
+        "--scene",
+        "balls",
+        "--sf",
+        "1",
+        "--engine",
+        &engine("_prim0"),
+        "--size",
+        "24",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert!(v["hit_agreement"].as_f64().unwrap() > 0.99, "{v}");
+    assert!(v["primitive_agreement"].as_f64().unwrap() < 0.99, "{v}");
+    assert_eq!(v["pass"], false);
+    let v = stdout_json(&[
+        "check",
+        "--scene",
+        "balls",
+        "--sf",
+        "1",
+        "--engine",
+        &engine(""),
+        "--size",
+        "24",
+        "--json",
+    ]);
+    assert!(v["primitive_agreement"].as_f64().unwrap() >= 0.99, "{v}");
+    let out = render(&engine("_esc"));
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains('\u{1b}') && !err.contains('\u{7}'), "{err:?}");
+    assert!(err.contains("\\u{1b}[31mred"), "{err}");
+    expect_input_error(
+        &[
+            "render",
+            "--scene",
+            "balls",
+            "--sf",
+            "1",
+            "--engine",
+            &format!("{}:abi_timing=bogus", engine("")),
+        ],
+        "abi_timing",
     );
 }

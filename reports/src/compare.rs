@@ -297,7 +297,9 @@ fn read_set(dir: &Path) -> Result<(Vec<RunRecord>, Option<Environment>), ReportE
             path: results.display().to_string(),
         });
     }
-    let records = latest_per_key(read_results(dir)?);
+    let records = read_results(dir)?;
+    crate::summary::check_records(&records, &results.display().to_string())?;
+    let records = latest_per_key(records);
     Ok((records, read_environment(dir)?))
 }
 

@@ -17,6 +17,8 @@ pub enum ReportError {
     Plot { path: String, message: String },
     #[error("{path}: cannot make the JSON document: {message}")]
     Json { path: String, message: String },
+    #[error("{path}: {message}")]
+    Invalid { path: String, message: String },
     #[error("threshold {0}%: must be a finite number of percent, 0 or more")]
     BadThreshold(f64),
     #[error("unknown report format `{0}` (known: md, csv, json, svg, png, html)")]

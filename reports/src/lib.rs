@@ -46,4 +46,4 @@ pub use results::{
     Sample, SceneInfo, Spread, Timings,
 };
 pub use scaling::ThreadScaling;
-pub use summary::{engine_label, Failure, Row, Summary};
+pub use summary::{check_records, duplicate, engine_label, latest_per_key, Failure, Row, Summary};

@@ -93,7 +93,9 @@ pub fn write_report(dir: &Path, formats: &[Format]) -> Result<Summary, ReportErr
     }
     let wants = |f: Format| formats.is_empty() || formats.contains(&f);
     let environment = read_environment(dir)?;
-    let records = latest_per_key(read_results(dir)?);
+    let records = read_results(dir)?;
+    crate::summary::check_records(&records, &dir.join("results.jsonl").display().to_string())?;
+    let records = latest_per_key(records);
     let mut summary = Summary::of(environment, records.clone());
     let mut files: Vec<String> = Vec::new();
 

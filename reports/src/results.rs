@@ -160,6 +160,9 @@ pub struct CheckResult {
     pub against: String,
     pub rays: u64,
     pub hit_agreement: f64,
+    /// Closest hits naming the same object, without the tie rule (absent in older results).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub primitive_agreement: Option<f64>,
     pub t_rel_err_median: f64,
     pub t_rel_err_p99: f64,
     pub t_rel_err_max: f64,

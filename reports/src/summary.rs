@@ -75,6 +75,52 @@ pub struct Failure {
     pub reason: String,
 }
 
+/// The first record that appears twice in `records` (same key, finished at the same moment):
+/// a copied line, not a re-run, which [`latest_per_key`] would otherwise count once silently or
+/// a merge twice.
+pub fn duplicate(records: &[RunRecord]) -> Option<&RunRecord> {
+    let mut seen = std::collections::BTreeSet::new();
+    records
+        .iter()
+        .find(|r| !seen.insert((r.key.as_str(), r.finished_at.as_str())))
+}
+
+/// What a report or a comparison needs of a results file: at least one run, no record twice
+/// ([`duplicate`]), and times that are times (finite and not negative; an ok run's trace took
+/// some time, or every ratio to it divides by zero).
+pub fn check_records(records: &[RunRecord], path: &str) -> Result<(), crate::error::ReportError> {
+    let bad = |message: String| crate::error::ReportError::Invalid {
+        path: path.to_string(),
+        message,
+    };
+    if records.is_empty() {
+        return Err(bad("holds no runs".into()));
+    }
+    if let Some(d) = duplicate(records) {
+        return Err(bad(format!(
+            "run {} appears twice (the same record)",
+            d.key
+        )));
+    }
+    for r in records.iter().filter(|r| r.status == "ok") {
+        let t = &r.time_s;
+        let all = [&t.build, &t.trace, &t.trace_cpu];
+        let wrong = all.iter().any(|s| {
+            [s.min, s.median, s.max]
+                .iter()
+                .chain(&s.samples)
+                .any(|x| !(x.is_finite() && *x >= 0.0))
+        });
+        if wrong || !(t.trace.median > 0.0) {
+            return Err(bad(format!(
+                "run {}: a time that is negative, zero or not a number",
+                r.key
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// One record per key: a later line replaces an earlier one (a re-run after `--resume`).
 pub fn latest_per_key(records: Vec<RunRecord>) -> Vec<RunRecord> {
     let mut index: BTreeMap<String, usize> = BTreeMap::new();

@@ -1,5 +1,5 @@
 //! The fuzzer at scale: `cargo run --release -p rtbench-tests --example fuzz -- [N] [SEED]
-//! [nff|store|results|all]` (default 1000000 inputs per reader, seed 1, all readers). Prints one
+//! [nff|store|results|gltf|ply|obj|all]` (default 1000000 inputs per reader, seed 1, all readers). Prints one
 //! line per reader; exits 1 when an input panicked (and writes it to fuzz-panic-READER.bin). Put
 //! TMPDIR on a tmpfs (e.g. /dev/shm): store inputs are files, 25 times slower on a disk.
 

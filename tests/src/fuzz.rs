@@ -1,5 +1,8 @@
-//! A seeded mutation fuzzer over rtbench's three readers of outside data: the NFF reader, the
-//! scene-store reader and the results reader. Each input is a seed from the corpus in
+//! A seeded mutation fuzzer over rtbench's readers of outside data: the NFF reader, the
+//! scene-store reader, the results reader and the mesh readers (glTF and GLB, PLY ASCII and
+//! binary, OBJ). The harness's own readers (history database, suite TOML, shard manifests) are
+//! fuzzed by the harness's tests with the same mutations (`mutate`). Each input is a seed from
+//! the corpus in
 //! `tests/fuzz/corpus/` (store seeds are written from the NFF seeds) with one to four mutations:
 //! bit flips, interesting bytes, tokens from a dictionary (`nan`, `1e308`, huge counts …),
 //! deleted, repeated or truncated spans. An input passes when the reader returns (a value or an
@@ -25,16 +28,39 @@ pub enum Target {
     Nff,
     Store,
     Results,
+    Gltf,
+    Ply,
+    Obj,
 }
 
 impl Target {
-    pub const ALL: [Target; 3] = [Target::Nff, Target::Store, Target::Results];
+    pub const ALL: [Target; 6] = [
+        Target::Nff,
+        Target::Store,
+        Target::Results,
+        Target::Gltf,
+        Target::Ply,
+        Target::Obj,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Target::Nff => "nff",
             Target::Store => "store",
             Target::Results => "results",
+            Target::Gltf => "gltf",
+            Target::Ply => "ply",
+            Target::Obj => "obj",
+        }
+    }
+
+    /// The mesh file extensions of a mesh target's seeds.
+    fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Target::Gltf => &["gltf", "glb"],
+            Target::Ply => &["ply"],
+            Target::Obj => &["obj"],
+            _ => &[],
         }
     }
 }
@@ -77,6 +103,22 @@ impl Rng {
 }
 
 const TOKENS: &[&str] = &[
+    "../",
+    "/etc/passwd",
+    "/dev/zero",
+    "data:;base64,",
+    "5126",
+    "5121",
+    "\"VEC4\"",
+    "\"MAT4\"",
+    "\"byteStride\":4,",
+    "\"accessors\":[],",
+    "\"children\":[0],",
+    "element vertex 4294967295\n",
+    "property list uchar int vertex_indices\n",
+    "\nmtllib /dev/zero\n",
+    "\nf 1 2 99999\n",
+    "日",
     " nan ",
     " inf ",
     " -inf ",
@@ -170,6 +212,17 @@ pub fn seeds(target: Target, corpus: &Path, work: &Path) -> Vec<Vec<(String, Vec
     match target {
         Target::Nff => files("nff").into_iter().map(|f| vec![f]).collect(),
         Target::Results => files("results").into_iter().map(|f| vec![f]).collect(),
+        Target::Gltf | Target::Ply | Target::Obj => files("mesh")
+            .into_iter()
+            .filter(|(name, _)| {
+                let ext = Path::new(name).extension().and_then(|e| e.to_str());
+                ext.is_some_and(|e| target.extensions().contains(&e))
+            })
+            .map(|(name, bytes)| {
+                let ext = Path::new(&name).extension().unwrap().to_string_lossy();
+                vec![(format!("fuzz.{ext}"), bytes)]
+            })
+            .collect(),
         Target::Store => {
             let mut out = Vec::new();
             for (i, (_, text)) in files("nff").into_iter().enumerate() {
@@ -230,6 +283,14 @@ fn feed(target: Target, files: &[(String, Vec<u8>)], dir: &Path) -> bool {
             }
             read_store(dir).is_ok()
         }
+        Target::Gltf | Target::Ply | Target::Obj => {
+            let (name, bytes) = &files[0];
+            let path = dir.join(name);
+            std::fs::write(&path, bytes).expect("fuzz dir is writable");
+            // Accepted meshes go on to the scene a run makes of them.
+            let mut c = SceneCollector::default();
+            rtbench_scenes::mesh::stream_mesh(&path, &mut c).is_ok()
+        }
     }
 }
 
@@ -257,6 +318,10 @@ pub fn run(target: Target, n: u64, seed: u64, corpus: &Path) -> Outcome {
     std::fs::create_dir_all(&work).expect("fuzz work dir");
     let seeds = seeds(target, corpus, &work);
     assert!(!seeds.is_empty(), "no seeds for {}", target.name());
+    if target == Target::Gltf {
+        // The external buffer `quad-file.gltf` names, beside every input.
+        std::fs::copy(corpus.join("mesh/quad.bin"), work.join("quad.bin")).expect("quad.bin");
+    }
     if target == Target::Store {
         // Every seed store reads as written: otherwise no mutation could be told from the seed.
         for files in &seeds {

@@ -1,4 +1,4 @@
-//! The fuzzer over the NFF, store and results readers at small scale (a few seconds); the large
+//! The fuzzer over the NFF, store, results and mesh readers at small scale (a few seconds); the large
 //! run is `cargo run --release -p rtbench-tests --example fuzz`.
 
 use rtbench_tests::fuzz::{corpus_dir, run, Target};
@@ -10,6 +10,9 @@ fn mutated_inputs_never_panic_nor_hang() {
         (Target::Nff, 5_000),
         (Target::Store, 400),
         (Target::Results, 800),
+        (Target::Gltf, 3_000),
+        (Target::Ply, 3_000),
+        (Target::Obj, 3_000),
     ] {
         let o = run(t, n, 14, &corpus_dir());
         assert_eq!(o.inputs, n);

@@ -311,6 +311,15 @@ impl BreadthFirstConfig {
                 ));
             }
         }
+        if let Some(left) = crate::usage::address_space_left() {
+            if memory > left {
+                return Err(bad(
+                    "memory",
+                    &format!("{memory}B"),
+                    &format!("more than the address space left under this process's limit (ulimit -v: {left} B)"),
+                ));
+            }
+        }
         if buffer.saturating_mul(2) > memory {
             return Err(bad(
                 "memory",

@@ -286,6 +286,11 @@ impl Work {
     /// Registers every ray in memory in up to `count` candidate voxels, from the one its walk
     /// stands on.
     fn register(&mut self, count: usize, c: &mut Counters) {
+        // A pass whose sweep failed (an I/O error returned to the caller) left its grouping
+        // behind; counting on top of it would index past the registrations.
+        if self.registered.count() > 0 {
+            self.registered.clear();
+        }
         let g = &self.voxels;
         let boundary = self.boundary;
         for (si, s) in self.slots.iter_mut().enumerate() {

@@ -107,6 +107,10 @@ use std::sync::Mutex;
 use std::time::Instant;
 use voxels::Voxels;
 
+/// Elements reserved up front in the per-ray arrays: they grow to what the memory budget allows
+/// as rays come, so a large budget is not mapped before it is used.
+pub(crate) const PREALLOCATE: usize = 1 << 16;
+
 pub fn info() -> EngineInfo {
     EngineInfo {
         name: "breadth-first",
@@ -417,7 +421,7 @@ impl BreadthFirst {
                     grid,
                     reg: hires::two_level::TwoLevel::new(p.upper, p.lower, pool),
                     blocks,
-                    walks: Vec::with_capacity(capacity),
+                    walks: Vec::with_capacity(capacity.min(PREALLOCATE)),
                     cands: Vec::new(),
                     io_reported: Default::default(),
                 })
@@ -486,7 +490,7 @@ impl BreadthFirst {
             },
             voxels,
             regs_capacity: capacity * initial as usize,
-            slots: Vec::with_capacity(capacity),
+            slots: Vec::with_capacity(capacity.min(PREALLOCATE)),
             capacity,
             initial_count: initial,
             inverse: matches!(

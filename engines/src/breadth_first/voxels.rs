@@ -158,9 +158,12 @@ pub struct Registrations {
 
 impl Registrations {
     pub fn new(voxels: usize, capacity: usize) -> Registrations {
+        // The budget bounds what these may grow to; reserving it all up front would map the
+        // whole budget before the first ray (and fail under an address-space limit).
+        let reserve = capacity.min(super::PREALLOCATE);
         Registrations {
-            regs: Vec::with_capacity(capacity),
-            slots: Vec::with_capacity(capacity),
+            regs: Vec::with_capacity(reserve),
+            slots: Vec::with_capacity(reserve),
             first: vec![0; voxels + 1],
         }
     }

@@ -27,6 +27,8 @@ pub const PRIM_TRIANGLES: u32 = 1;
 pub const PRIM_SPHERES: u32 = 2;
 pub const PRIM_CONES: u32 = 4;
 pub const MISS: u32 = u32::MAX;
+/// How far outside [0, 1] a triangle's barycentrics may fall (f32 rounding at an edge).
+const BARY_SLACK: f32 = 1e-3;
 
 /// `rtb_ray` and `rtb_hit` are rtbench's own [`Ray`] and [`Hit`]: batches cross without a copy.
 const _: () = assert!(std::mem::size_of::<Ray>() == 32 && std::mem::size_of::<Hit>() == 16);
@@ -125,12 +127,78 @@ fn err(path: &str, reason: impl Into<String>) -> EngineError {
     }
 }
 
+/// A string from the plugin, with control characters (terminal escapes among them) shown
+/// escaped rather than sent to the user's terminal.
 fn cstr(p: *const c_char) -> String {
     if p.is_null() {
         return String::new();
     }
     // SAFETY: the ABI requires NUL-terminated static strings; null was handled.
-    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    let s = unsafe { CStr::from_ptr(p) }.to_string_lossy();
+    printable(&s)
+}
+
+/// `s` with every control character but the newline escaped (`\u{1b}`).
+fn printable(s: &str) -> String {
+    s.chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() && c != '\n' {
+                c.escape_unicode().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
+}
+
+/// While any plugin function runs, file descriptor 1 points at stderr, so that what a plugin
+/// prints cannot reach rtbench's own output on stdout (`render --json`). C stdio buffers are
+/// flushed before the descriptor is given back. Calls may overlap (threads): the first in
+/// redirects, the last out restores.
+mod quiet_stdout {
+    use std::io::Write;
+    use std::sync::Mutex;
+
+    /// Calls under way, and the saved descriptor of the real stdout.
+    static STATE: Mutex<(usize, i32)> = Mutex::new((0, -1));
+
+    pub struct Guard;
+
+    pub fn enter() -> Guard {
+        let mut s = STATE.lock().unwrap_or_else(|p| p.into_inner());
+        if s.0 == 0 {
+            let _ = std::io::stdout().flush();
+            // SAFETY: plain descriptor calls; a failed dup leaves stdout as it was.
+            unsafe {
+                libc::fflush(std::ptr::null_mut());
+                let saved = libc::dup(1);
+                if saved >= 0 && libc::dup2(2, 1) >= 0 {
+                    s.1 = saved;
+                } else if saved >= 0 {
+                    libc::close(saved);
+                }
+            }
+        }
+        s.0 += 1;
+        Guard
+    }
+
+    impl Drop for Guard {
+        fn drop(&mut self) {
+            let mut s = STATE.lock().unwrap_or_else(|p| p.into_inner());
+            s.0 -= 1;
+            if s.0 == 0 && s.1 >= 0 {
+                // SAFETY: `s.1` is the descriptor saved by `enter`, still open.
+                unsafe {
+                    libc::fflush(std::ptr::null_mut());
+                    libc::dup2(s.1, 1);
+                    libc::close(s.1);
+                }
+                s.1 = -1;
+            }
+        }
+    }
 }
 
 /// Where a plugin counter goes.
@@ -160,6 +228,7 @@ unsafe impl Sync for Library {}
 impl Library {
     /// Loads the library, checks `rtbench_engine_abi_version()` and then the table.
     pub fn open(path: &Path) -> Result<Library, String> {
+        let _quiet = quiet_stdout::enter();
         // SAFETY: loading runs the library's initialisers: that is what a plugin is.
         let lib = unsafe { libloading::Library::new(path) }.map_err(|e| e.to_string())?;
         // SAFETY: the symbols' types are those of include/rtbench_engine.h.
@@ -358,7 +427,18 @@ fn build(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineE
         }
     };
     let timing: String = s.get("abi_timing", "off".to_string())?;
-    let timing = timing == "on";
+    let timing = match timing.as_str() {
+        "on" => true,
+        "off" => false,
+        _ => {
+            return Err(EngineError::BadValue {
+                engine: "plugin".into(),
+                key: "abi_timing".into(),
+                value: timing,
+                reason: "expected on or off".into(),
+            })
+        }
+    };
     let rest = s.into_rest();
     let path = resolve(&spec).map_err(|e| err(&spec, e))?;
     let lib = Library::open(&path).map_err(|e| err(&spec, e))?;
@@ -408,11 +488,14 @@ fn build(input: &BuildInput, mut s: Settings) -> Result<Box<dyn Engine>, EngineE
     let mut msg = vec![0 as c_char; 512];
     let start = Instant::now();
     // SAFETY: `scene` and its arrays live across the call; msg has msg.len() bytes.
-    let engine =
-        unsafe { (t.build.expect("checked in open"))(&scene, msg.as_mut_ptr(), msg.len()) };
+    let engine = {
+        let _quiet = quiet_stdout::enter();
+        unsafe { (t.build.expect("checked in open"))(&scene, msg.as_mut_ptr(), msg.len()) }
+    };
     let build_s = start.elapsed().as_secs_f64();
     if engine.is_null() {
         msg[511] = 0;
+        // The plugin's message: control characters shown escaped (cstr).
         let reason = cstr(msg.as_ptr());
         return Err(err(
             &spec,
@@ -514,6 +597,7 @@ impl Engine for PluginEngine {
         let whole = Instant::now();
         let mut raw = vec![0u64; self.slots.len()];
         let call = Instant::now();
+        let quiet = quiet_stdout::enter();
         // SAFETY: n rays in, n hits out, counter_count counters; the engine is live.
         unsafe {
             (self.intersect_fn)(
@@ -524,6 +608,7 @@ impl Engine for PluginEngine {
                 raw.as_mut_ptr(),
             )
         };
+        drop(quiet);
         self.time(c, "abi_inside_ns", call);
         self.add_counters(&raw, c);
         let np = self.prim_object.len() as u32;
@@ -545,8 +630,17 @@ impl Engine for PluginEngine {
                     "ray {i}: t = {} outside the ray's interval ({}, {})",
                     h.t, r.tmin, r.tmax
                 ))
-            } else if h.u.is_nan() || h.v.is_nan() {
-                Some(format!("ray {i}: NaN barycentrics"))
+            } else if !(h.u.is_finite() && h.v.is_finite()) {
+                Some(format!(
+                    "ray {i}: barycentrics ({}, {}) not finite",
+                    h.u, h.v
+                ))
+            } else if !(h.u >= -BARY_SLACK && h.v >= -BARY_SLACK && h.u + h.v <= 1.0 + BARY_SLACK) {
+                // Triangles' weights lie in the triangle; other kinds answer 0, 0.
+                Some(format!(
+                    "ray {i}: barycentrics ({}, {}) outside the triangle",
+                    h.u, h.v
+                ))
             } else {
                 None
             };
@@ -572,6 +666,7 @@ impl Engine for PluginEngine {
         let mut raw = vec![0u64; self.slots.len()];
         let mut out = vec![0u8; n];
         let call = Instant::now();
+        let quiet = quiet_stdout::enter();
         // SAFETY: n rays in, n bytes out, counter_count counters; the engine is live.
         unsafe {
             (self.occluded_fn)(
@@ -582,6 +677,7 @@ impl Engine for PluginEngine {
                 raw.as_mut_ptr(),
             )
         };
+        drop(quiet);
         self.time(c, "abi_inside_ns", call);
         self.add_counters(&raw, c);
         for (i, (o, &b)) in occluded[..n].iter_mut().zip(&out).enumerate() {

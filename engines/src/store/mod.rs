@@ -34,9 +34,11 @@
 //! size; `objects_bytes` stays the uncompressed one, and record offsets are uncompressed
 //! offsets). Or zstd-compressed: `objects.bin.zst`, `"compression": "zstd"` (zstd is offered
 //! beside the thesis's gzip: it compresses several times faster).
-//! The compressed file's header carries no checksum of `header.json` (it is written before the
-//! header is known); the codec's own checksum (gzip's CRC-32; zstd's frame checksum) and the
-//! records' checksums guard its bytes.
+//! The compressed file's header cannot carry the checksum of `header.json` (it is written,
+//! compressed, before the header is known), so `header.crc` does: 16 bytes, magic `RTHCRC\0\0`,
+//! u32 version, the CRC-32 of `header.json`, written right after it; a compressed basic store
+//! without it is refused. The codec's own checksum (gzip's CRC-32; zstd's frame checksum) and
+//! the records' checksums guard the data's bytes.
 //! [`SceneReader`] reads either layout as one stream of (id, box, geometry when read).
 //!
 //! A store too large to write in one sitting is written in segments ([`segments`]): while it
@@ -91,6 +93,7 @@ pub const FILE_HEADER: u64 = 16;
 
 pub const OBJECTS_MAGIC: &[u8; 8] = b"RTOBJS\0\0";
 pub const MATERIALS_MAGIC: &[u8; 8] = b"RTMATS\0\0";
+pub const HEADER_CRC_MAGIC: &[u8; 8] = b"RTHCRC\0\0";
 /// Bytes of a material record: 8 × f64.
 pub const MATERIAL_RECORD: usize = 64;
 /// Most lights a store holds (they stay in header.json, whose size this bounds).
@@ -138,6 +141,8 @@ pub const GEOMETRY_FILE: &str = "geometry.bin";
 pub const BBOX_INDEX: &str = "bbox.bin.idx";
 pub const GEOMETRY_INDEX: &str = "geometry.bin.idx";
 pub const MATERIALS_FILE: &str = "materials.bin";
+/// The checksum of `header.json` of a compressed basic store (module docs).
+pub const HEADER_CRC_FILE: &str = "header.crc";
 
 #[cfg(test)]
 mod blocks_tests;

@@ -248,6 +248,9 @@ impl StoreHeader {
             Layout::Basic => &[(self.codec.objects_file(), self.stored_bytes)],
         };
         let compressed = self.codec != Codec::None;
+        if compressed {
+            self.check_header_crc(crc)?;
+        }
         for &(name, want) in files {
             let path = dir.join(name);
             let mut f = std::fs::File::open(&path)
@@ -272,6 +275,34 @@ impl StoreHeader {
                     format!("{name} does not match header.json (checksum)"),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// `header.crc` of a compressed basic store against header.json (module docs of `store`).
+    fn check_header_crc(&self, crc: u32) -> io::Result<()> {
+        let path = self.dir.join(super::HEADER_CRC_FILE);
+        let h = read_bounded_bytes(&path, FILE_HEADER).map_err(|e| {
+            bad(
+                &self.dir,
+                format!(
+                    "{}: {} (a compressed store's header.json must be vouched for: write the store again)",
+                    super::HEADER_CRC_FILE,
+                    e.kind().to_string().to_lowercase()
+                ),
+            )
+        })?;
+        if h.len() as u64 != FILE_HEADER || &h[..8] != super::HEADER_CRC_MAGIC {
+            return Err(bad(
+                &self.dir,
+                format!("{} is not a header checksum", super::HEADER_CRC_FILE),
+            ));
+        }
+        if u32::from_le_bytes(h[12..16].try_into().unwrap()) != crc {
+            return Err(bad(
+                &self.dir,
+                "header.json does not match header.crc (checksum): it was changed after writing",
+            ));
         }
         Ok(())
     }
@@ -511,6 +542,14 @@ fn read_bounded(path: &Path, max: u64) -> io::Result<String> {
     let mut text = String::new();
     std::io::Read::read_to_string(&mut std::io::Read::take(f, max), &mut text).map_err(shown)?;
     Ok(text)
+}
+
+/// At most `max` bytes of `path`.
+fn read_bounded_bytes(path: &Path, max: u64) -> io::Result<Vec<u8>> {
+    let f = std::fs::File::open(path)?;
+    let mut out = Vec::new();
+    std::io::Read::read_to_end(&mut std::io::Read::take(f, max + 1), &mut out)?;
+    Ok(out)
 }
 
 fn check_file_header(f: &mut IoFile, magic: &[u8; 8], path: &Path) -> io::Result<()> {

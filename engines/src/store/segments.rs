@@ -191,7 +191,8 @@ impl SegmentedWriter {
 
     /// Stop at the first checkpoint after `budget` from now.
     pub fn with_budget(mut self, budget: Duration) -> SegmentedWriter {
-        self.deadline = Some(Instant::now() + budget);
+        // A budget past what an Instant reaches is no deadline.
+        self.deadline = Instant::now().checked_add(budget);
         self
     }
 

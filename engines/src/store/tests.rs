@@ -277,6 +277,23 @@ fn compressed_store_round_trips_and_refuses_damage(codec: Codec) {
         StoreWriter::create_with(&gz.0.join("s"), "x", Layout::Split, codec).is_err(),
         matches!(codec, Codec::Gzip(_))
     );
+    // header.json edited (a light moved): header.crc no longer vouches for it; without
+    // header.crc the store is refused too.
+    let hj = gz.0.join(HEADER_FILE);
+    let text = std::fs::read_to_string(&hj).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let x = v["lights"][0]["position"][0].as_f64().unwrap();
+    v["lights"][0]["position"][0] = serde_json::json!(x + 1.0);
+    let moved = serde_json::to_string_pretty(&v).unwrap();
+    std::fs::write(&hj, &moved).unwrap();
+    let e = StoreHeader::read(&gz.0).unwrap_err().to_string();
+    assert!(e.contains("header.crc"), "{e}");
+    std::fs::write(&hj, &text).unwrap();
+    StoreHeader::read(&gz.0).unwrap();
+    let crc = std::fs::read(gz.0.join(HEADER_CRC_FILE)).unwrap();
+    std::fs::remove_file(gz.0.join(HEADER_CRC_FILE)).unwrap();
+    assert!(StoreHeader::read(&gz.0).is_err());
+    std::fs::write(gz.0.join(HEADER_CRC_FILE), crc).unwrap();
     // Truncated: the size no longer matches the header.
     let f = gz.0.join(codec.objects_file());
     let bytes = std::fs::read(&f).unwrap();

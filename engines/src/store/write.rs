@@ -223,6 +223,11 @@ impl StoreWriter {
         self.objects
     }
 
+    /// Bytes of records written so far (uncompressed streams, file headers included).
+    pub fn written(&self) -> u64 {
+        self.bbox.as_ref().map_or(0, |b| b.written()) + self.geometry.written()
+    }
+
     /// Makes the store written so far durable and complete up to the last object
     /// ([`IoFile::checkpoint`] on every binary file: a gzip member ends) and returns where it
     /// stands, for [`StoreWriter::resume`] in another process. The first error of the stream is
@@ -470,8 +475,16 @@ impl StoreWriter {
             Layout::Split if split_zstd => &[BBOX_INDEX, GEOMETRY_INDEX],
             Layout::Split => &[BBOX_FILE, GEOMETRY_FILE],
             Layout::Basic if self.codec == Codec::None => &[OBJECTS_FILE],
-            // Written compressed: its header cannot be patched in place.
-            Layout::Basic => &[],
+            // Written compressed: its header cannot be patched in place; header.crc holds it.
+            Layout::Basic => {
+                let path = self.dir.join(super::HEADER_CRC_FILE);
+                let h = file_header(super::HEADER_CRC_MAGIC, u32::from_le_bytes(crc));
+                std::fs::write(&path, h)?;
+                std::fs::File::open(&path)?.sync_all()?;
+                io.bytes_written += h.len() as u64;
+                io.write_calls += 1;
+                &[]
+            }
         };
         for name in files {
             use std::os::unix::fs::FileExt;

@@ -42,9 +42,12 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let settings = workload::parse_settings(&a.set)?;
     workload::check_json_settings(a.json, &settings)?;
     let src = Source::from_args(scene, &a.opts)?;
-    workload::check_scene_fits(&src, a.opts.force)?;
+    workload::check_scene_fits(&src, &[engine, against], a.opts.force)?;
     let pool = crate::measure::threads::pool(a.threads.count())?;
     let prepared = workload::prepare(&src)?;
+    if let Some(w) = workload::precision_warning(&prepared.input.scene) {
+        eprintln!("rtbench: warning: {w}");
+    }
     let (tested, _) = workload::build(engine, &prepared.input, settings)?;
     let (yardstick, _) = workload::build(against, &prepared.input, vec![])?;
     let c = pool.install(|| {
@@ -59,6 +62,8 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         return Err(input(f));
     }
     let agreement = c.agreement();
+    let primitive = c.primitive_agreement();
+    let pass = agreement >= threshold && primitive >= crosscheck::MIN_PRIMITIVE_AGREEMENT;
     let v = json!({
         "engine": engine,
         "against": against,
@@ -67,6 +72,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         "closest_rays": c.closest_rays,
         "any_rays": c.any_rays,
         "hit_agreement": agreement,
+        "primitive_agreement": primitive,
         "disagreements": c.rays() - c.agree,
         "t_rel_err": c.t_rel_err.to_json(),
         "t_rel_err_raw": c.t_rel_err_raw.to_json(),
@@ -77,20 +83,21 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             "max_abs_diff": c.pixels_same_hits_max_diff,
         },
         "threshold": threshold,
-        "pass": agreement >= threshold,
+        "pass": pass,
         "mismatches": c.mismatches,
     });
     if a.json {
         print_json(&v);
     } else {
         println!(
-            "{} vs {} on {}: {} rays, agreement {:.6} ({} differ), t rel err p99 {:.2e} max {:.2e}, image PSNR {}",
+            "{} vs {} on {}: {} rays, agreement {:.6} ({} differ), primitive agreement {:.6}, t rel err p99 {:.2e} max {:.2e}, image PSNR {}",
             engine,
             against,
             src.label(),
             c.rays(),
             agreement,
             c.rays() - c.agree,
+            primitive,
             c.t_rel_err.p99,
             c.t_rel_err.max,
             c.image_psnr_db.map(|p| format!("{p:.1} dB")).unwrap_or_else(|| "inf (identical)".into())
@@ -104,6 +111,16 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             src.label(),
             agreement,
             threshold
+        )));
+    }
+    if primitive < crosscheck::MIN_PRIMITIVE_AGREEMENT {
+        return Err(Failure::Check(format!(
+            "{} vs {} on {}: primitive agreement {:.6} is under {} (hits at the right distance on the wrong object)",
+            engine,
+            against,
+            src.label(),
+            primitive,
+            crosscheck::MIN_PRIMITIVE_AGREEMENT
         )));
     }
     Ok(())

@@ -13,7 +13,7 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
     use crate::cli::HistoryCommand as H;
     match c {
         H::List { db, json } => {
-            let h = History::open(db, false)?;
+            let h = History::open_read(db)?;
             let runs = h.runs(None, None)?;
             if *json {
                 crate::output::print_json(&serde_json::to_value(&runs).expect("rows serialise"));
@@ -26,9 +26,9 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
                         r.id,
                         r.started_at,
                         r.suite,
-                        &r.git_commit[..r.git_commit.len().min(10)],
+                        crate::output::head(&r.git_commit, 10),
                         if r.git_dirty { "+" } else { "" },
-                        &r.fingerprint[..r.fingerprint.len().min(10)],
+                        crate::output::head(&r.fingerprint, 10),
                         r.metrics,
                         r.regressions,
                         fmt_secs(r.wall_s),
@@ -39,7 +39,7 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
             Ok(())
         }
         H::Show { db, run, json } => {
-            let h = History::open(db, false)?;
+            let h = History::open_read(db)?;
             let id = resolve_run(&h, run.as_deref(), db)?;
             let row = h
                 .run(id)?
@@ -76,7 +76,7 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
             Ok(())
         }
         H::Export { db, format, run } => {
-            let h = History::open(db, false)?;
+            let h = History::open_read(db)?;
             match format.as_str() {
                 "csv" => print!("{}", crate::history::export::csv(&h)?),
                 "bmf" => {
@@ -89,25 +89,30 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
         }
         H::Replay { db, suite, json } => replay(db, suite, *json),
         H::Check { db } => {
-            let h = History::open(db, false)?;
-            let verdict = h.integrity()?;
+            let h = History::open_read(db)?;
+            let problems = h.problems()?;
             let runs = h.runs(None, None)?;
-            let samples: usize = runs.iter().map(|r| r.metrics as usize).sum();
-            println!(
-                "{}: integrity_check {verdict}; {} nights, {samples} metrics",
-                db.display(),
-                runs.len()
-            );
-            if verdict != "ok" {
-                return Err(Failure::Check(format!(
-                    "{}: integrity_check: {verdict}",
-                    db.display()
-                )));
+            let metrics: usize = runs.iter().map(|r| r.metrics as usize).sum();
+            if problems.is_empty() {
+                println!(
+                    "{}: whole (integrity_check ok, schema {}, every table and column, every night's metrics); {} nights, {metrics} metrics",
+                    db.display(),
+                    crate::history::SCHEMA,
+                    runs.len()
+                );
+                return Ok(());
             }
-            Ok(())
+            for p in &problems {
+                println!("{}: {p}", db.display());
+            }
+            Err(Failure::Check(format!(
+                "{}: not whole: {}",
+                db.display(),
+                problems[0]
+            )))
         }
         H::Dashboard { db, out } => {
-            let h = History::open(db, false)?;
+            let h = History::open_read(db)?;
             crate::history::dashboard::write(&h, out)?;
             eprintln!("dashboard: {}", out.join("index.html").display());
             Ok(())
@@ -119,7 +124,7 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
 /// `rtbench nightly` compares) with the nights of the same machine before it.
 fn replay(db: &std::path::Path, suite_file: &std::path::Path, json: bool) -> Result<()> {
     let s = suite::load(suite_file)?;
-    let h = History::open(db, false)?;
+    let h = History::open_read(db)?;
     let runs = h.runs(None, Some(&s.name))?;
     if runs.is_empty() {
         return Err(input(format!(
@@ -213,8 +218,14 @@ fn resolve_run(h: &History, run: Option<&str>, db: &std::path::Path) -> Result<i
             .last()
             .map(|r| r.id)
             .ok_or_else(|| input(format!("{}: the history holds no night", db.display()))),
-        Some(s) => s
-            .parse::<i64>()
-            .map_err(|_| input(format!("--run '{s}': expected a night's id or 'latest'"))),
+        Some(s) => {
+            let id = s
+                .parse::<i64>()
+                .map_err(|_| input(format!("--run '{s}': expected a night's id or 'latest'")))?;
+            // A night that is not there is an error, not an empty answer.
+            h.run(id)?
+                .map(|r| r.id)
+                .ok_or_else(|| input(format!("{}: no night {id}", db.display())))
+        }
     }
 }

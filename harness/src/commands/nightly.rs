@@ -14,7 +14,7 @@ use std::time::Instant;
 
 /// `rtbench nightly`.
 pub fn run(a: &NightlyArgs) -> Result<()> {
-    let suite = suite::load(&a.suite)?;
+    let suite = suite::load_runnable(&a.suite)?;
     let spec = a
         .shard
         .as_deref()
@@ -43,6 +43,20 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         None => measure(&suite, a, None, a.out.as_deref())?,
     };
     let prev = history.runs(Some(&fp), Some(&suite.name))?;
+    if let Some(dir) = &a.from {
+        // A merged night is one night: recording it again would count it twice.
+        if let Some(r) = prev
+            .iter()
+            .find(|r| r.started_at == started_at && r.git_commit == env.git_commit)
+        {
+            return Err(input(format!(
+                "{}: this night (started {started_at}) is already night {} of {}",
+                dir.display(),
+                r.id,
+                db.display()
+            )));
+        }
+    }
     let window: Vec<_> = prev
         .iter()
         .rev()

@@ -22,7 +22,7 @@ pub fn run(a: &PlanCmdArgs) -> Result<()> {
             ("run", items)
         }
         PlanWhat::Nightly(n) => {
-            let suite = crate::nightly::suite::load(&n.suite)?;
+            let suite = crate::nightly::suite::load_runnable(&n.suite)?;
             let items = crate::nightly::jobs(&suite)
                 .iter()
                 .map(|j| (j.key(), format!("{:?}", run_group(j))))

@@ -25,10 +25,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         )));
     }
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
-    workload::check_scene_fits(&src, a.scene.opts.force)?;
+    workload::check_scene_fits(&src, &[&a.engine], a.scene.opts.force)?;
     let pool = crate::measure::threads::pool(a.threads.count())?;
     memory::phase("start");
     let prepared = workload::prepare(&src)?;
+    if let Some(w) = workload::precision_warning(&prepared.input.scene) {
+        eprintln!("rtbench: warning: {w}");
+    }
     memory::phase("scene");
     let (engine, build_s) = workload::build(&a.engine, &prepared.input, settings)?;
     memory::phase("build");

@@ -4,6 +4,8 @@ use crate::error::{input, Result};
 use crate::output::{print_json, write_atomic};
 use crate::source::Source;
 use rtbench_engines::store::{Codec, Layout, StoreHeader, StoreWriter};
+use rtbench_scenes::Sink;
+use std::io::Write;
 
 use rtbench_scenes::nff::NffWriter;
 use rtbench_scenes::spd::Program;
@@ -64,11 +66,81 @@ pub fn list(as_json: bool) -> Result<()> {
     Ok(())
 }
 
-pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
+/// `--max-bytes`: bytes, at least 1.
+pub fn max_bytes(s: &str) -> Result<u64> {
+    match super::runs::parse_bytes(s) {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(input(format!(
+            "--max-bytes '{s}': expected bytes, e.g. 512M or 8GiB"
+        ))),
+    }
+}
+
+/// Refuses up front a program's scene whose output the census puts over `max`.
+pub fn check_output_bound(
+    src: &Source,
+    max: u64,
+    what: &str,
+    per_object: u64,
+    per_vertex: u64,
+) -> Result<()> {
+    let Source::Program(p, o) = src else {
+        return Ok(());
+    };
+    let c = crate::workload::footprint::Census::of(*p, o);
+    let at_least = c
+        .objects
+        .saturating_mul(per_object)
+        .saturating_add(c.vertices.saturating_mul(per_vertex));
+    if at_least > max {
+        return Err(input(format!(
+            "{}: {} objects make about {:.1} GB of {what}, past --max-bytes {max} (raise it to write them)",
+            src.label(),
+            c.objects,
+            at_least as f64 / 1e9
+        )));
+    }
+    Ok(())
+}
+
+/// A writer that fails once more than `max` bytes went through it.
+struct Bounded<W> {
+    inner: W,
+    written: u64,
+    max: u64,
+}
+
+impl<W: Write> Write for Bounded<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.written + buf.len() as u64 > self.max {
+            return Err(std::io::Error::other(format!(
+                "past --max-bytes {} (raise it to write more)",
+                self.max
+            )));
+        }
+        let n = self.inner.write(buf)?;
+        self.written += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// Lower bounds of NFF bytes per object and per polygon vertex (a sphere line; a vertex line).
+const NFF_PER_OBJECT: u64 = 24;
+const NFF_PER_VERTEX: u64 = 20;
+
+pub fn gen(src: &Source, out: Option<&Path>, max: u64) -> Result<()> {
+    check_output_bound(src, max, "NFF", NFF_PER_OBJECT, NFF_PER_VERTEX)?;
     match out {
         None => {
             let stdout = std::io::stdout();
-            let mut w = NffWriter::new(std::io::BufWriter::with_capacity(1 << 20, stdout.lock()));
+            let mut w = NffWriter::new(Bounded {
+                inner: std::io::BufWriter::with_capacity(1 << 20, stdout.lock()),
+                written: 0,
+                max,
+            });
             src.stream(&mut w)?;
             w.finish()
                 .map_err(|e| input(format!("stdout: cannot write: {e}")))?;
@@ -78,7 +150,11 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
             let mut result = Ok(());
             let mut bytes = 0;
             write_atomic(path, |f| {
-                let mut w = NffWriter::new(f);
+                let mut w = NffWriter::new(Bounded {
+                    inner: f,
+                    written: 0,
+                    max,
+                });
                 result = src.stream(&mut w);
                 bytes = w.bytes();
                 w.finish().map(|_| ())
@@ -98,6 +174,50 @@ pub fn gen(src: &Source, out: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
+/// Lower bounds of store bytes per object (box record, geometry record) and per vertex.
+pub const STORE_PER_OBJECT: u64 = 36 + 17;
+pub const STORE_PER_VERTEX: u64 = 12;
+
+/// A store being written that stops taking objects once its records pass `max` bytes.
+pub struct CappedStore<'a, S: Sink> {
+    pub w: &'a mut S,
+    pub max: u64,
+    pub over: bool,
+}
+
+impl<S: Sink + StoreBytes> Sink for CappedStore<'_, S> {
+    fn background(&mut self, c: glam::DVec3) {
+        self.w.background(c)
+    }
+    fn view(&mut self, v: &rtbench_scenes::View) {
+        self.w.view(v)
+    }
+    fn light(&mut self, l: &rtbench_scenes::Light) {
+        self.w.light(l)
+    }
+    fn material(&mut self, m: &rtbench_scenes::Material) {
+        self.w.material(m)
+    }
+    fn shape(&mut self, s: rtbench_scenes::ShapeRef<'_>) {
+        if self.over || self.w.record_bytes() > self.max {
+            self.over = true;
+            return;
+        }
+        self.w.shape(s)
+    }
+}
+
+/// Bytes of records a store writer has taken so far.
+pub trait StoreBytes {
+    fn record_bytes(&self) -> u64;
+}
+
+impl StoreBytes for StoreWriter {
+    fn record_bytes(&self) -> u64 {
+        self.written()
+    }
+}
+
 /// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
 /// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
 /// so a failure (bad input, full disk) leaves nothing behind.
@@ -107,8 +227,16 @@ pub fn store(
     layout: &str,
     compress: &str,
     hierarchy: bool,
+    max: u64,
     as_json: bool,
 ) -> Result<()> {
+    check_output_bound(
+        src,
+        max,
+        "store records",
+        STORE_PER_OBJECT,
+        STORE_PER_VERTEX,
+    )?;
     let layout: Layout = layout
         .parse()
         .map_err(|e| input(format!("--layout {layout}: {e}")))?;
@@ -153,9 +281,21 @@ pub fn store(
     };
     let mut w = StoreWriter::create_with(&tmp, &src.label(), layout, codec)
         .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
-    if let Err(e) = src.stream(&mut w) {
+    let mut capped = CappedStore {
+        w: &mut w,
+        max,
+        over: false,
+    };
+    if let Err(e) = src.stream(&mut capped) {
         let _ = std::fs::remove_dir_all(&tmp);
         return Err(e);
+    }
+    if capped.over {
+        drop(w);
+        return Err(cleanup(format!(
+            "{}: the store passed --max-bytes {max} (raise it to write more)",
+            out.display()
+        )));
     }
     let mut io = w
         .finish()

@@ -20,6 +20,7 @@ pub struct SegmentArgs<'a> {
     pub segment: u64,
     pub resume: bool,
     pub max_seconds: Option<f64>,
+    pub max_bytes: u64,
     pub as_json: bool,
 }
 
@@ -40,11 +41,19 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
         return Err(input("--segment 0: a segment holds at least one object"));
     }
     let budget = match a.max_seconds {
-        Some(s) if !(s.is_finite() && s > 0.0) => {
+        Some(s) if !(s > 0.0) => {
             return Err(input(format!("--max-seconds {s}: expected seconds > 0")))
         }
-        s => s.map(Duration::from_secs_f64),
+        // Longer than a Duration holds (1e308, inf): no limit.
+        s => s.map(|s| Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX)),
     };
+    super::scene::check_output_bound(
+        src,
+        a.max_bytes,
+        "store records",
+        super::scene::STORE_PER_OBJECT,
+        super::scene::STORE_PER_VERTEX,
+    )?;
     let label = src.label();
     let cannot = |e: std::io::Error| input(format!("{}: {e}", out.display()));
     let before = SegmentLog::read(out).map_err(cannot)?;

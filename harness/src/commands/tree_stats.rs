@@ -24,7 +24,7 @@ pub fn run(a: &TreeStatsArgs) -> Result<()> {
     let config = Config::parse(a.width, Settings::new(&format!("bvh{}", a.width), pairs))
         .map_err(|e| input(e.to_string()))?;
     let src = Source::from_args(&a.scene.scene, &a.scene.opts)?;
-    workload::check_scene_fits(&src, a.scene.opts.force)?;
+    workload::check_scene_fits(&src, &[&format!("bvh{}", a.width)], a.scene.opts.force)?;
     let prepared = workload::prepare(&src)?;
     let g = &prepared.input.geometry;
     if g.prims.is_empty() {

@@ -141,8 +141,8 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
         esc(&last.suite),
         last.id,
         esc(&last.started_at),
-        esc(&last.git_commit[..last.git_commit.len().min(12)]),
-        esc(&last.fingerprint[..last.fingerprint.len().min(12)]),
+        esc(crate::output::head(&last.git_commit, 12)),
+        esc(crate::output::head(&last.fingerprint, 12)),
         last_metrics.len(),
         mine.len()
     ));
@@ -263,8 +263,8 @@ pub fn write(h: &History, dir: &Path) -> Result<()> {
             "<tr><td>{}</td><td>{}</td><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{:.0}</td><td>{}</td></tr>\n",
             r.id,
             esc(&r.started_at),
-            esc(&r.git_commit[..r.git_commit.len().min(10)]),
-            esc(&r.fingerprint[..r.fingerprint.len().min(10)]),
+            esc(crate::output::head(&r.git_commit, 10)),
+            esc(crate::output::head(&r.fingerprint, 10)),
             r.metrics,
             r.regressions,
             r.wall_s,

@@ -30,7 +30,7 @@ pub fn csv(h: &History) -> Result<String> {
                 r.id,
                 r.started_at,
                 r.git_commit,
-                &r.fingerprint[..r.fingerprint.len().min(16)],
+                crate::output::head(&r.fingerprint, 16),
                 csv_field(&r.suite),
                 csv_field(&m.name),
                 m.kind,

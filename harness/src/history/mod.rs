@@ -68,6 +68,92 @@ CREATE INDEX IF NOT EXISTS runs_fp ON runs(fingerprint, suite, id);
 CREATE INDEX IF NOT EXISTS metrics_name ON metrics(name, run_id);
 ";
 
+/// Every table's columns and declared types, as [`CREATE`] makes them (`history check`).
+const COLUMNS: [(&str, &[(&str, &str)]); 4] = [
+    (
+        "runs",
+        &[
+            ("id", "INTEGER"),
+            ("suite", "TEXT"),
+            ("suite_sha256", "TEXT"),
+            ("started_at", "TEXT"),
+            ("finished_at", "TEXT"),
+            ("git_commit", "TEXT"),
+            ("git_dirty", "INTEGER"),
+            ("fingerprint", "TEXT"),
+            ("env_json", "TEXT"),
+            ("wall_s", "REAL"),
+            ("regressions", "INTEGER"),
+            ("note", "TEXT"),
+        ],
+    ),
+    (
+        "metrics",
+        &[
+            ("run_id", "INTEGER"),
+            ("name", "TEXT"),
+            ("kind", "TEXT"),
+            ("unit", "TEXT"),
+            ("value", "REAL"),
+            ("gated", "INTEGER"),
+        ],
+    ),
+    (
+        "samples",
+        &[
+            ("run_id", "INTEGER"),
+            ("name", "TEXT"),
+            ("idx", "INTEGER"),
+            ("value", "REAL"),
+        ],
+    ),
+    (
+        "findings",
+        &[
+            ("run_id", "INTEGER"),
+            ("name", "TEXT"),
+            ("verdict", "TEXT"),
+            ("baseline", "REAL"),
+            ("value", "REAL"),
+            ("change_pct", "REAL"),
+            ("message", "TEXT"),
+        ],
+    ),
+];
+
+/// Columns that hold numbers.
+const NUMERIC: [(&str, &str); 9] = [
+    ("runs", "wall_s"),
+    ("runs", "git_dirty"),
+    ("runs", "regressions"),
+    ("metrics", "value"),
+    ("metrics", "gated"),
+    ("samples", "value"),
+    ("findings", "baseline"),
+    ("findings", "value"),
+    ("findings", "change_pct"),
+];
+
+/// `file:` URI of `path` (RFC 3986 escapes), `immutable=1` when asked.
+fn file_uri(path: &Path, immutable: bool) -> String {
+    use std::os::unix::ffi::OsStrExt;
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut uri = String::from("file:");
+    for &b in abs.as_os_str().as_bytes() {
+        if b.is_ascii_alphanumeric() || b"/-._~".contains(&b) {
+            uri.push(b as char);
+        } else {
+            uri.push_str(&format!("%{b:02X}"));
+        }
+    }
+    uri.push_str(if immutable {
+        "?mode=ro&immutable=1"
+    } else {
+        "?mode=ro"
+    });
+    uri
+}
+
 /// One metric of a night.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Metric {
@@ -190,6 +276,159 @@ impl History {
             .map_err(e)?;
         }
         Ok(History { conn, path: p })
+    }
+
+    /// Opens a history for reading only: nothing is written, not even a schema into an empty
+    /// file, and a history in a read-only directory reads (as an immutable file when SQLite
+    /// cannot make its shared-memory file beside it).
+    pub fn open_read(path: &Path) -> Result<History> {
+        let p = path.display().to_string();
+        if !path.is_file() {
+            return Err(input(format!("{p}: no such history file")));
+        }
+        let flags = OpenFlags::SQLITE_OPEN_READ_ONLY
+            | OpenFlags::SQLITE_OPEN_NO_MUTEX
+            | OpenFlags::SQLITE_OPEN_URI;
+        let header = |conn: &Connection| -> rusqlite::Result<(i64, i64, i64)> {
+            conn.busy_timeout(std::time::Duration::from_secs(60))?;
+            Ok((
+                conn.query_row("PRAGMA user_version", [], |r| r.get(0))?,
+                conn.query_row("PRAGMA application_id", [], |r| r.get(0))?,
+                conn.query_row("SELECT count(*) FROM sqlite_master", [], |r| r.get(0))?,
+            ))
+        };
+        let plain = Connection::open_with_flags(file_uri(path, false), flags)
+            .and_then(|c| header(&c).map(|h| (c, h)));
+        let (conn, (version, app, tables)) = match plain {
+            Ok(x) => x,
+            Err(first) => Connection::open_with_flags(file_uri(path, true), flags)
+                .and_then(|c| header(&c).map(|h| (c, h)))
+                .map_err(|_| db_err(&p, first))?,
+        };
+        if tables == 0 {
+            return Err(input(format!("{p}: holds no history (no tables)")));
+        }
+        if app != APP_ID {
+            return Err(input(format!(
+                "{p}: an SQLite file but not an rtbench history (application_id {app:#x})"
+            )));
+        }
+        if version != SCHEMA {
+            return Err(input(format!(
+                "{p}: history schema {version}; this rtbench reads schema {SCHEMA}"
+            )));
+        }
+        Ok(History { conn, path: p })
+    }
+
+    /// What keeps the history from being whole, one line each (empty when whole): SQLite's
+    /// integrity check, the schema version and application id, every table with exactly its
+    /// columns, numbers where numbers belong, and every night holding as many metrics (measured
+    /// or recorded as failed) as the other nights of the same suite file.
+    pub fn problems(&self) -> Result<Vec<String>> {
+        let q = |sql: &str| -> Result<i64> {
+            self.conn
+                .query_row(sql, [], |r| r.get(0))
+                .map_err(|e| self.err(e))
+        };
+        let mut out = Vec::new();
+        let verdict: String = self
+            .conn
+            .query_row("PRAGMA integrity_check", [], |r| r.get(0))
+            .map_err(|e| self.err(e))?;
+        if verdict != "ok" {
+            out.push(format!(
+                "integrity_check: {}",
+                crate::output::head(&verdict, 200)
+            ));
+        }
+        let version = q("PRAGMA user_version")?;
+        if version != SCHEMA {
+            out.push(format!("schema version {version}, expected {SCHEMA}"));
+        }
+        let app = q("PRAGMA application_id")?;
+        if app != APP_ID {
+            out.push(format!("application_id {app:#x}, expected {APP_ID:#x}"));
+        }
+        let mut tables_ok = true;
+        for (table, want) in COLUMNS {
+            let mut st = self
+                .conn
+                .prepare("SELECT name, type FROM pragma_table_info(?1) ORDER BY cid")
+                .map_err(|e| self.err(e))?;
+            let have: Vec<(String, String)> = st
+                .query_map([table], |r| Ok((r.get(0)?, r.get(1)?)))
+                .and_then(|rows| rows.collect())
+                .map_err(|e| self.err(e))?;
+            if have.is_empty() {
+                out.push(format!("table {table} is missing"));
+                tables_ok = false;
+                continue;
+            }
+            let want: Vec<(String, String)> = want
+                .iter()
+                .map(|(n, t)| (n.to_string(), t.to_string()))
+                .collect();
+            if have != want {
+                let show = |v: &[(String, String)]| {
+                    v.iter()
+                        .map(|(n, t)| format!("{n} {t}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                out.push(format!(
+                    "table {table} has columns ({}), expected ({})",
+                    crate::output::head(&show(&have), 300),
+                    show(&want)
+                ));
+                tables_ok = false;
+            }
+        }
+        if !tables_ok {
+            return Ok(out);
+        }
+        for (table, col) in NUMERIC {
+            let bad = q(&format!(
+                "SELECT count(*) FROM {table} WHERE {col} IS NOT NULL AND typeof({col}) NOT IN ('real', 'integer')"
+            ))?;
+            if bad > 0 {
+                out.push(format!("{table}.{col}: {bad} values that are not numbers"));
+            }
+        }
+        let orphans = q("SELECT (SELECT count(*) FROM metrics WHERE run_id NOT IN (SELECT id FROM runs)) + (SELECT count(*) FROM samples WHERE run_id NOT IN (SELECT id FROM runs)) + (SELECT count(*) FROM findings WHERE run_id NOT IN (SELECT id FROM runs))")?;
+        if orphans > 0 {
+            out.push(format!("{orphans} rows belong to no night"));
+        }
+        // Each night's metrics, measured or failed, against the most any night of its suite file
+        // holds: a night cut short holds fewer.
+        let mut st = self
+            .conn
+            .prepare(
+                "SELECT r.id, r.suite_sha256,
+                    (SELECT count(*) FROM metrics m WHERE m.run_id = r.id)
+                  + (SELECT count(*) FROM findings f WHERE f.run_id = r.id AND f.verdict = 'failed'
+                       AND f.name NOT IN (SELECT name FROM metrics m2 WHERE m2.run_id = r.id))
+                 FROM runs r ORDER BY r.id",
+            )
+            .map_err(|e| self.err(e))?;
+        let nights: Vec<(i64, String, i64)> = st
+            .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)))
+            .and_then(|rows| rows.collect())
+            .map_err(|e| self.err(e))?;
+        let mut most: std::collections::HashMap<&str, i64> = Default::default();
+        for (_, sha, n) in &nights {
+            let m = most.entry(sha.as_str()).or_insert(0);
+            *m = (*m).max(*n);
+        }
+        for (id, sha, n) in &nights {
+            let want = most[sha.as_str()];
+            if *n < want {
+                out.push(format!(
+                    "night {id} holds {n} of its suite's {want} metrics"
+                ));
+            }
+        }
+        Ok(out)
     }
 
     fn err(&self, e: rusqlite::Error) -> crate::error::Failure {
@@ -380,13 +619,6 @@ impl History {
         rows.collect::<std::result::Result<Vec<_>, _>>()
             .map_err(|e| self.err(e))
     }
-
-    /// `PRAGMA integrity_check`'s answer ("ok" when whole).
-    pub fn integrity(&self) -> Result<String> {
-        self.conn
-            .query_row("PRAGMA integrity_check", [], |r| r.get(0))
-            .map_err(|e| self.err(e))
-    }
 }
 
 #[cfg(test)]
@@ -434,7 +666,7 @@ mod tests {
         assert_eq!(m, night("a").metrics);
         assert_eq!(h.runs(Some("fp"), Some("s")).unwrap().len(), 1);
         assert_eq!(h.runs(Some("other"), None).unwrap().len(), 0);
-        assert_eq!(h.integrity().unwrap(), "ok");
+        assert!(h.problems().unwrap().is_empty());
     }
 
     #[test]
@@ -480,5 +712,71 @@ mod tests {
         }
         let h = History::open(&p, false).unwrap();
         assert_eq!(h.runs(None, None).unwrap().len(), 40);
+    }
+
+    /// Read commands open read-only: an empty file is refused and stays empty, and a history
+    /// reads from a read-only directory.
+    #[test]
+    fn reading_never_writes() {
+        let p = tmp("ro");
+        std::fs::write(&p, b"").unwrap();
+        let e = History::open_read(&p).err().unwrap().to_string();
+        assert!(e.contains("no history"), "{e}");
+        assert_eq!(std::fs::metadata(&p).unwrap().len(), 0);
+        std::fs::remove_file(&p).unwrap();
+        History::open(&p, true)
+            .unwrap()
+            .append(&night("a"))
+            .unwrap();
+        let dir = p.parent().unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+        let h = History::open_read(&p);
+        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let h = h.unwrap();
+        assert_eq!(h.runs(None, None).unwrap().len(), 1);
+        assert!(h.problems().unwrap().is_empty());
+    }
+
+    /// `history check` finds what integrity_check does not: a dropped table, a renamed column,
+    /// text among numbers, a night cut short.
+    #[test]
+    fn check_sees_schema_types_and_short_nights() {
+        let damage = |tag: &str, sql: &str, needle: &str| {
+            let p = tmp(tag);
+            let mut h = History::open(&p, true).unwrap();
+            let mut full = night("full");
+            full.metrics.push(Metric {
+                name: "counter:grid tetra1@1/nodes".into(),
+                kind: "counter".into(),
+                unit: "1".into(),
+                value: 7.0,
+                gated: true,
+                samples: vec![7.0],
+            });
+            h.append(&full).unwrap();
+            h.append(&night("short")).unwrap();
+            drop(h);
+            let c = Connection::open(&p).unwrap();
+            c.execute_batch(sql).unwrap();
+            drop(c);
+            let problems = History::open_read(&p).unwrap().problems().unwrap();
+            assert!(
+                problems.iter().any(|l| l.contains(needle)),
+                "{tag}: {problems:?}"
+            );
+        };
+        damage("short", "", "night 2 holds 1 of its suite's 2 metrics");
+        damage("drop", "DROP TABLE samples;", "table samples is missing");
+        damage(
+            "rename",
+            "ALTER TABLE findings RENAME COLUMN message TO msg;",
+            "table findings has columns",
+        );
+        damage(
+            "text",
+            "UPDATE metrics SET value = 'fast' WHERE run_id = 1;",
+            "metrics.value",
+        );
     }
 }

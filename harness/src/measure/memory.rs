@@ -64,20 +64,16 @@ pub fn release_free_heap() {
 }
 
 /// Memory this process can still have: the smaller of the machine's available memory
-/// (`MemAvailable`) and the address-space limit (`ulimit -v`). None when neither is known.
+/// (`MemAvailable`) and the address space left under its limit (`ulimit -v`, less what is
+/// mapped already). None when neither is known.
 pub fn memory_available() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
         let line = t.lines().find(|l| l.starts_with("MemAvailable:"))?;
         line.split_whitespace().nth(1)?.parse::<u64>().ok()
     });
     let mem = meminfo.map(|kb| kb.saturating_mul(1024));
-    let mut lim = libc::rlimit {
-        rlim_cur: 0,
-        rlim_max: 0,
-    };
-    // SAFETY: getrlimit writes only into `lim`, which we own.
-    let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) };
-    let limit = (rc == 0 && lim.rlim_cur != libc::RLIM_INFINITY).then_some(lim.rlim_cur);
+    // The limit less what is mapped already: what an allocation may still take.
+    let limit = rtbench_engines::usage::address_space_left();
     match (mem, limit) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),

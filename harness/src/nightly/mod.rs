@@ -567,7 +567,7 @@ pub fn summary_markdown(
     let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
     s.push_str(&format!(
         "# Nightly `{suite}` at `{}`: {}\n\n{} metrics ({gated} gated), {}, {}.\n\n",
-        &commit[..commit.len().min(12)],
+        crate::output::head(&commit, 12),
         if bad.is_empty() {
             "no regression".to_string()
         } else {
@@ -727,7 +727,7 @@ pub fn measure(
         suite.name,
         jobs.len(),
         suite.repeats,
-        &fp[..12],
+        crate::output::head(&fp, 12),
         spec.map(|s| format!(", shard {}/{}", s.k, s.n))
             .unwrap_or_default()
     );

@@ -149,8 +149,8 @@ pub fn load_merged(dir: &Path, suite: &Suite) -> Result<Measured> {
             "{}: measured with another suite file than {} (suite SHA-256 {}…, this one {}…)",
             dir.display(),
             suite.name,
-            &m.suite_sha256[..12.min(m.suite_sha256.len())],
-            &sha[..12]
+            crate::output::head(&m.suite_sha256, 12),
+            crate::output::head(&sha, 12)
         )));
     }
     if dir.join(crate::shard::MANIFEST_FILE).is_file() {

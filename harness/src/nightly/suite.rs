@@ -207,6 +207,50 @@ fn positive(file: &str, what: &str, v: f64) -> Result<f64> {
     }
 }
 
+/// Reads a suite file and checks that it can run here, before anything is measured: every
+/// variant builds (its engine is available and takes its settings), the thread counts are ones
+/// this machine runs, and each scene at each size factor fits in memory with its engine and
+/// Embree (the estimate of `workload::footprint`).
+pub fn load_runnable(path: &Path) -> Result<Suite> {
+    let s = load(path)?;
+    check_runnable(&path.display().to_string(), &s)?;
+    Ok(s)
+}
+
+pub fn check_runnable(file: &str, s: &Suite) -> Result<()> {
+    let probe = crate::suite::probe_input();
+    let instr = s.instructions.iter().flat_map(|i| &i.variants);
+    for v in s.variants.iter().chain(instr) {
+        rtbench_engines::build_engine(&v.engine, &probe, v.settings.clone())
+            .map_err(|e| input(format!("{file}: variant '{}': {e}", v.label())))?;
+    }
+    let most = crate::measure::threads::thread_limit();
+    if let Some(n) = s.threads.iter().flatten().find(|&&n| n > most) {
+        return Err(input(format!(
+            "{file}: threads = {n}: more than the {most} this machine runs at once"
+        )));
+    }
+    for &scene in &s.scenes {
+        for &sf in &s.sf {
+            let o = rtbench_scenes::spd::Options {
+                size_factor: sf,
+                ..rtbench_scenes::spd::Options::standard(scene)
+            };
+            let src = crate::source::Source::Program(scene, o);
+            for v in &s.variants {
+                let engines: &[&str] = if v.engine == "embree" {
+                    &["embree"]
+                } else {
+                    &[&v.engine, "embree"]
+                };
+                crate::workload::check_scene_fits(&src, engines, false)
+                    .map_err(|e| input(format!("{file}: sf = {sf}: {e}")))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Reads and checks a suite file.
 pub fn load(path: &Path) -> Result<Suite> {
     let file = path.display().to_string();

@@ -368,7 +368,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                         "image-equal",
                         &subject,
                         "equal",
-                        format!("{}… vs {}…", &b.sha256[..12], &a.sha256[..12]),
+                        format!("{}… vs {}…", crate::output::head(&b.sha256, 12), crate::output::head(&a.sha256, 12)),
                         Kind::Count,
                         Verdict::of(a.sha256 == b.sha256),
                     )

@@ -376,7 +376,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .number::<u32>(SIZE.key, 1)?
         .unwrap_or(if ctx.quick { 64 } else { 512 });
     workload::check_size(size)?;
-    let memory = ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string();
+    let memory = ctx.params.bytes(MEMORY.key, "256MiB")?;
     let cache = ctx.params.raw(CACHE.key).unwrap_or("cold").to_string();
     let setup = Setup {
         size,
@@ -542,9 +542,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "equal",
                 format!(
                     "{}… / {}… / {}…",
-                    &m.basic.sha256[..12],
-                    &m.sg.sha256[..12],
-                    &m.sgb.sha256[..12]
+                    crate::output::head(&m.basic.sha256, 12),
+                    crate::output::head(&m.sg.sha256, 12),
+                    crate::output::head(&m.sgb.sha256, 12)
                 ),
                 Kind::Count,
                 Verdict::of(same),

@@ -199,7 +199,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .unwrap_or(if ctx.quick { 32 } else { 128 });
     let setup = Setup {
         size,
-        memory: ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string(),
+        memory: ctx.params.bytes(MEMORY.key, "256MiB")?,
         cache: ctx.params.raw(CACHE.key).unwrap_or("cold").to_string(),
         spill: ctx.params.raw(SPILL.key).map(str::to_string),
     };
@@ -324,9 +324,9 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "equal",
                 format!(
                     "{}… / {}… / {}…",
-                    &m.single.sha256[..12],
-                    &m.half.sha256[..12],
-                    &m.quarter.sha256[..12]
+                    crate::output::head(&m.single.sha256, 12),
+                    crate::output::head(&m.half.sha256, 12),
+                    crate::output::head(&m.quarter.sha256, 12)
                 ),
                 Kind::Count,
                 Verdict::of(same),

@@ -895,6 +895,10 @@ fn run(ctx: &Ctx) -> Result<Output> {
             .map_err(|e| input(format!("nakamaru-4.3: split-compress={c}: {e}")))?,
     };
     let max_seconds = ctx.params.number::<f64>(MAX_SECONDS.key, 0.0)?;
+    // A budget longer than an Instant reaches (1e308, inf) is no deadline.
+    let deadline = max_seconds
+        .and_then(|x| Duration::try_from_secs_f64(x).ok())
+        .and_then(|d| Instant::now().checked_add(d));
     let segment = ctx
         .params
         .number::<u64>(SEGMENT.key, 1)?
@@ -907,12 +911,12 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .unwrap_or_else(|| ctx.checkpoint.dir().join("stores"));
     let s = Setup {
         size,
-        memory: ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string(),
+        memory: ctx.params.bytes(MEMORY.key, "256MiB")?,
         cache: ctx.params.raw(CACHE.key).unwrap_or("cold").to_string(),
         spill: ctx.params.raw(SPILL.key).map(str::to_string),
         stores: out_stores,
         segment,
-        deadline: max_seconds.map(|x| Instant::now() + Duration::from_secs_f64(x)),
+        deadline,
         fraction,
         passes,
         subspaces,
@@ -1282,9 +1286,9 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     format!(
                         "{}{} / {} / {}",
                         if model { "(basic: a model, not compared) " } else { "" },
-                        &b.sha256[..12.min(b.sha256.len())],
-                        &sg.sha256[..12.min(sg.sha256.len())],
-                        &sgb.sha256[..12.min(sgb.sha256.len())]
+                        crate::output::head(&b.sha256, 12),
+                        crate::output::head(&sg.sha256, 12),
+                        crate::output::head(&sgb.sha256, 12)
                     ),
                     Kind::Count,
                     Verdict::of(same),
@@ -1488,7 +1492,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                     format!("{} of {}", r.rows_traced, s.size + 1),
                     format!("{:.2}", r.scale),
                     r.rays.to_string(),
-                    format!("{}…", &r.sha256[..12.min(r.sha256.len())]),
+                    format!("{}…", crate::output::head(&r.sha256, 12)),
                     // A run that waited for a core or for the disk shows well under 100%.
                     super::grid_runs::cpu_share(r.cpu_s, r.preprocess_s - r.earlier_s + r.trace_s),
                     r.load_average.clone(),

@@ -175,7 +175,7 @@ fn run(ctx: &Ctx) -> Result<Output> {
         .unwrap_or(if ctx.quick { 16 } else { p.cap });
     let setup = Setup {
         size,
-        memory: ctx.params.raw(MEMORY.key).unwrap_or("256MiB").to_string(),
+        memory: ctx.params.bytes(MEMORY.key, "256MiB")?,
         cache: ctx.params.raw(CACHE.key).unwrap_or("cold").to_string(),
         spill: ctx.params.raw(SPILL.key).map(str::to_string),
     };
@@ -342,7 +342,7 @@ fn rows(p: &Published, measured: &[Point_], slopes: &[Slopes]) -> Vec<Row> {
             "image-equal",
             format!("{}{}", m.scene, m.sf),
             "equal",
-            format!("{}… / {}…", &m.capped.sha256[..12], &m.high_res.sha256[..12]),
+            format!("{}… / {}…", crate::output::head(&m.capped.sha256, 12), crate::output::head(&m.high_res.sha256, 12)),
             Kind::Count,
             Verdict::of(m.capped.sha256 == m.high_res.sha256),
         ));

@@ -74,6 +74,16 @@ impl Params {
         self.pairs.get(key).map(String::as_str)
     }
 
+    /// A byte size as the engines take it (`256MiB`), `default` when absent; checked here, before
+    /// anything is written, not when the first engine is built.
+    pub fn bytes(&self, key: &str, default: &str) -> Result<String> {
+        let v = self.raw(key).unwrap_or(default);
+        v.trim()
+            .parse::<rtbench_engines::breadth_first::config::Bytes>()
+            .map_err(|e| input(format!("{}: {key} '{v}': {e}", self.id)))?;
+        Ok(v.trim().to_string())
+    }
+
     /// A number, or `None` when absent; a value that does not parse, or is below `min`, is refused.
     pub fn number<T: FromStr + PartialOrd + std::fmt::Display + Copy>(
         &self,

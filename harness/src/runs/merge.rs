@@ -21,7 +21,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 fn short(s: &str) -> &str {
-    &s[..s.len().min(12)]
+    crate::output::head(s, 12)
 }
 
 /// Reads the manifests and checks that they are the N finished shards of one plan at one commit.
@@ -205,8 +205,22 @@ pub fn merged_records(shards: &[Shard]) -> Result<Vec<RunRecord>> {
         .map(|(i, k)| (k.as_str(), i))
         .collect();
     let mut all: Vec<(usize, u32, RunRecord)> = Vec::new();
+    // A run (its key, at its size factor) once across all shards: a shard holding one twice, or
+    // two shards holding the same, would count it twice.
+    let mut runs: BTreeSet<(String, u32)> = BTreeSet::new();
     for s in shards {
         let records = read_results(&s.dir).map_err(|e| input(e.to_string()))?;
+        if let Some(d) = rtbench_reports::duplicate(&records) {
+            return Err(input(format!(
+                "{}: shard {}/{} holds run {} twice (the same record)",
+                s.dir.display(),
+                s.m.shard,
+                s.m.of,
+                crate::output::head(&d.key, 120)
+            )));
+        }
+        // A run re-run in the shard (same key, later line) replaces the earlier, as in reports.
+        let records = rtbench_reports::latest_per_key(records);
         let mine: BTreeSet<&str> = s.m.jobs.iter().map(|k| k.as_str()).collect();
         // run and nightly: one record per job key; sweep: records per (engine, scene) unit.
         let unit_of = |r: &RunRecord| -> String {
@@ -230,6 +244,15 @@ pub fn merged_records(shards: &[Shard]) -> Result<Vec<RunRecord>> {
                     s.m.shard,
                     s.m.of,
                     r.key
+                )));
+            }
+            if !runs.insert((r.key.clone(), r.scene.sf.unwrap_or(0))) {
+                return Err(input(format!(
+                    "{}: shard {}/{} holds run {} a second time",
+                    s.dir.display(),
+                    s.m.shard,
+                    s.m.of,
+                    crate::output::head(&r.key, 120)
                 )));
             }
             seen.insert(unit.clone());

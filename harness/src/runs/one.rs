@@ -231,6 +231,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             against: "embree".into(),
             rays: c.rays(),
             hit_agreement: c.agreement(),
+            primitive_agreement: Some(c.primitive_agreement()),
             t_rel_err_median: c.t_rel_err.median,
             t_rel_err_p99: c.t_rel_err.p99,
             t_rel_err_max: c.t_rel_err.max,

@@ -23,7 +23,7 @@ mod truth;
 
 use crate::error::Result;
 use rtbench_engines::geometry::Geometry;
-use rtbench_engines::{build_engine, registry, BuildInput, EngineError};
+use rtbench_engines::{build_engine, BuildInput, EngineError};
 use rtbench_scenes::{Material, Object, Scene, Shape};
 use std::sync::Arc;
 
@@ -70,16 +70,13 @@ impl Variant {
 const ALTERNATIVES: &[(&str, &str)] = &[("triangle", "moller"), ("robust", "on")];
 
 /// The engines to run: `--engine a,b` (each must exist and be available) or every available
-/// engine of the registry but the test-only ones.
+/// engine of the registry but the test-only ones and `plugin` (which needs a library).
 pub fn engines(arg: Option<&str>) -> Result<Vec<String>> {
     if arg.is_some() {
         return crate::select::engine_names(arg, "--engine");
     }
-    Ok(registry()
-        .into_iter()
-        .filter(|e| !e.name.starts_with("test-") && (e.available)().is_ok())
-        .map(|e| e.name.to_string())
-        .collect())
+    // The suites are small: the reference engine runs too.
+    Ok(crate::select::default_engines(true))
 }
 
 /// Each engine as it comes, and with each alternative kernel setting it accepts (tried by

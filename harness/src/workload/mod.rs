@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod crosscheck;
+pub mod footprint;
 pub mod frustum;
 pub mod out_of_core;
 pub mod surface;
@@ -94,10 +95,6 @@ pub fn build(
 /// (breadth-first) at --size 2048 (corners, rays, hits, paths, shading records), rounded up.
 pub const BYTES_PER_CORNER: u64 = 256;
 
-/// Bytes an in-memory run holds per scene object, at least: measured 330 (embree, spheres) to
-/// 1,640 (bvh8, gears' polygons) at 0.1 to 1 million objects; the lower figure, rounded down.
-pub const BYTES_PER_OBJECT: u64 = 300;
-
 fn gib(b: u64) -> String {
     format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
 }
@@ -120,25 +117,130 @@ pub fn check_size(size: u32) -> Result<()> {
     Ok(())
 }
 
-/// A generated scene about to be held in memory fits in the memory available, by the estimate
-/// [`BYTES_PER_OBJECT`] (`--sf 40` of tree ran the machine out of memory); `force` skips this.
-pub fn check_scene_fits(src: &Source, force: bool) -> Result<()> {
+/// A generated scene about to be held in memory, and the structures of `engines` over it, fit in
+/// the memory available (RAM and the address-space limit), by the estimate of [`footprint`];
+/// `force` skips this (`--sf 40` of tree ran the machine out of memory, `--tessellate 1000`
+/// and an address-space limit aborted).
+pub fn check_scene_fits(src: &Source, engines: &[&str], force: bool) -> Result<()> {
     let Source::Program(p, o) = src else {
         return Ok(());
     };
     if force {
         return Ok(());
     }
-    let objects = p.object_count(o.size_factor).unwrap_or(u64::MAX);
-    let need = objects.saturating_mul(BYTES_PER_OBJECT);
+    let f = footprint::Census::of(*p, o);
+    let need = f.bytes(engines);
     if let Some(have) = crate::measure::memory::memory_available().filter(|&have| need > have) {
         return Err(input(format!(
-            "{}: {objects} objects need at least {} in memory, {} is available (--force to \
-             try anyway)",
+            "{}: {} objects ({} primitives to build over) need about {} in memory with {}, {} is \
+             available (--force to try anyway)",
             src.label(),
+            f.objects,
+            f.primitives(),
             gib(need),
+            engines.join(" and "),
             gib(have)
         )));
     }
     Ok(())
+}
+
+/// Feature sizes below this share of the scene's scale (its largest coordinate, the camera's
+/// included) are not resolved by the `f32` engines: f32 keeps 24 bits, so at 1e5 a feature
+/// spans fewer than 200 representable steps and hit tests on it come apart from the `f64`
+/// reference (a triangle of ±1e-5 seen from 5 units; a cone whose radii differ by 10^6).
+pub const F32_FEATURE_RATIO: f64 = 1e5;
+
+/// A one-line warning when the scene holds a feature the `f32` engines cannot represent at the
+/// scene's scale ([`F32_FEATURE_RATIO`]); render and check print it.
+pub fn precision_warning(scene: &rtbench_scenes::Scene) -> Option<String> {
+    use rtbench_scenes::Shape;
+    let mut scale = scene.view.from.abs().max_element();
+    let mut smallest = f64::INFINITY;
+    for o in &scene.objects {
+        let b = o.shape.bounds();
+        scale = scale
+            .max(b.min.abs().max_element())
+            .max(b.max.abs().max_element());
+        let feature = match &o.shape {
+            Shape::Sphere { radius, .. } => *radius,
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+            } => {
+                let radii = [*base_radius, *apex_radius]
+                    .into_iter()
+                    .filter(|r| *r > 0.0)
+                    .fold(f64::INFINITY, f64::min);
+                radii.min((*apex - *base).length())
+            }
+            // A polygon's size, not its shortest edge: a sliver is still where it is.
+            Shape::Polygon(_) | Shape::Patch { .. } => {
+                let d = (b.max - b.min).length();
+                if d > 0.0 {
+                    d
+                } else {
+                    f64::INFINITY
+                }
+            }
+        };
+        smallest = smallest.min(feature);
+    }
+    (smallest.is_finite() && smallest > 0.0 && scale / smallest > F32_FEATURE_RATIO).then(|| {
+        format!(
+            "{}: a feature of {smallest:.3e} at a scale of {scale:.3e} (ratio {:.1e} > {F32_FEATURE_RATIO:e}): the f32 engines cannot resolve it and may miss hits the f64 reference sees",
+            scene.name,
+            scale / smallest
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(objects: Vec<rtbench_scenes::Shape>) -> rtbench_scenes::Scene {
+        let mut s = rtbench_scenes::generate_scene(
+            rtbench_scenes::spd::Program::Tetra,
+            &rtbench_scenes::spd::Options::standard(rtbench_scenes::spd::Program::Tetra),
+        )
+        .unwrap();
+        s.objects = objects
+            .into_iter()
+            .map(|shape| rtbench_scenes::Object { material: 0, shape })
+            .collect();
+        s
+    }
+
+    /// Features the f32 engines cannot resolve are named; ordinary scenes pass silently.
+    #[test]
+    fn tiny_features_are_warned_of() {
+        use glam::DVec3;
+        use rtbench_scenes::Shape;
+        let tri = |r: f64| {
+            Shape::Polygon(vec![
+                DVec3::new(-r, -r, 0.0),
+                DVec3::new(r, -r, 0.0),
+                DVec3::new(0.0, r, 0.0),
+            ])
+        };
+        assert!(precision_warning(&scene(vec![tri(1.0)])).is_none());
+        assert!(precision_warning(&scene(vec![tri(1e-5)])).is_some());
+        assert!(precision_warning(&scene(vec![tri(1e-20)])).is_some());
+        let cone = Shape::Cone {
+            base: DVec3::ZERO,
+            base_radius: 1.0,
+            apex: DVec3::new(0.0, 1.0, 0.0),
+            apex_radius: 1e-6,
+        };
+        assert!(precision_warning(&scene(vec![cone])).is_some());
+        let tetra = rtbench_scenes::generate_scene(
+            rtbench_scenes::spd::Program::Tetra,
+            &rtbench_scenes::spd::Options::standard(rtbench_scenes::spd::Program::Tetra),
+        )
+        .unwrap();
+        assert!(precision_warning(&tetra).is_none());
+    }
 }

@@ -56,6 +56,7 @@ pub fn run(engine: &str, program: &str, sf: u32, trace: f64) -> RunRecord {
         against: "embree".to_string(),
         rays: rays_total,
         hit_agreement: if engine == "grid" { 1.0 } else { 0.99998 },
+        primitive_agreement: None,
         t_rel_err_median: 1e-8,
         t_rel_err_p99: if engine == "grid" { 0.0 } else { 2e-6 },
         t_rel_err_max: 1e-4,
