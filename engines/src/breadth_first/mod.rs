@@ -105,11 +105,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
-use voxels::Voxels;
-
-/// Elements reserved up front in the per-ray arrays: they grow to what the memory budget allows
-/// as rays come, so a large budget is not mapped before it is used.
-pub(crate) const PREALLOCATE: usize = 1 << 16;
+use voxels::{Voxels, PREALLOCATE};
 
 pub fn info() -> EngineInfo {
     EngineInfo {

@@ -15,6 +15,10 @@ use crate::grid::config::Resolution;
 use crate::grid::resolution::cells_per_axis;
 use glam::Vec3;
 
+/// Elements reserved up front in the per-ray arrays: they grow to what the memory budget allows
+/// as rays come, so a large budget is not mapped before it is used.
+pub(crate) const PREALLOCATE: usize = 1 << 16;
+
 pub const MARKED: u8 = 1;
 
 /// Bit of the face on the `max` (true) or `min` side of `axis`.
@@ -160,7 +164,7 @@ impl Registrations {
     pub fn new(voxels: usize, capacity: usize) -> Registrations {
         // The budget bounds what these may grow to; reserving it all up front would map the
         // whole budget before the first ray (and fail under an address-space limit).
-        let reserve = capacity.min(super::PREALLOCATE);
+        let reserve = capacity.min(PREALLOCATE);
         Registrations {
             regs: Vec::with_capacity(reserve),
             slots: Vec::with_capacity(reserve),
