@@ -471,6 +471,7 @@ mod tie_tests {
     use super::*;
     use crate::geometry::dda::Lattice;
     use crate::geometry::Prim;
+    use glam::Vec3;
 
     /// Of two objects hit at the same t, the one with the smaller id is kept whichever is met
     /// first; a nearer hit still wins over a smaller id, and an object met again keeps its hit.
