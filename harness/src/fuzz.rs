@@ -87,7 +87,7 @@ fn seeds(r: Reader, work: &Path) -> Vec<Vec<(String, Vec<u8>)>> {
         }
         Reader::Suite => {
             let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../suites/nightly.toml");
-            let extra = "name = \"s\"\nengines = [\"embree\", \"grid\"]\nvariants = [\"bvh4:simd=off\"]\nscenes = [\"tetra\"]\nsf = [1, 2]\nthreads = [1, 0]\nrepeats = 3\ngate = [\"counters\"]\n[instructions]\nengines = [\"grid\"]\nscenes = [\"tetra\"]\n";
+            let extra = "name = \"s\"\nengines = [\"embree\", \"grid\"]\nvariants = [\"bvh4:simd=off\"]\nscenes = [\"tetra\"]\nsf = [1, 2]\nthreads = [1, \"all\"]\nrepeats = 3\ngate = [\"counters\"]\n[instructions]\nengines = [\"grid\"]\nscenes = [\"tetra\"]\n";
             vec![
                 vec![("s.toml".into(), std::fs::read(repo).unwrap())],
                 vec![("s.toml".into(), extra.as_bytes().to_vec())],
