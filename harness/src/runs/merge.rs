@@ -257,7 +257,17 @@ pub fn merged_records(shards: &[Shard]) -> Result<Vec<RunRecord>> {
             }
             seen.insert(unit.clone());
             r.machine = Some(s.m.hostname.clone());
-            all.push((order[unit.as_str()], r.scene.sf.unwrap_or(0), r));
+            // A manifest whose jobs are not the plan's (an edited shard.json) has no place in it.
+            let Some(&at) = order.get(unit.as_str()) else {
+                return Err(input(format!(
+                    "{}: shard {}/{} lists job {} that its plan does not hold",
+                    s.dir.display(),
+                    s.m.shard,
+                    s.m.of,
+                    crate::output::head(&unit, 120)
+                )));
+            };
+            all.push((at, r.scene.sf.unwrap_or(0), r));
         }
         let lacking: Vec<&str> = mine
             .iter()
