@@ -172,8 +172,16 @@ fn run(r: Reader, n: u64, seed: u64) -> Outcome {
         elapsed: Duration::ZERO,
     };
     let start = Instant::now();
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
+    // Silence only this thread's panics (the fuzz counts them): tests running beside it keep
+    // their messages.
+    let hook = std::sync::Arc::new(std::panic::take_hook());
+    let me = std::thread::current().id();
+    let others = hook.clone();
+    std::panic::set_hook(Box::new(move |info| {
+        if std::thread::current().id() != me {
+            others(info)
+        }
+    }));
     for _ in 0..n {
         let s = &seeds[rng.below(seeds.len())];
         let mut files = s.clone();
@@ -201,7 +209,8 @@ fn run(r: Reader, n: u64, seed: u64) -> Outcome {
             }
         }
     }
-    std::panic::set_hook(hook);
+    let _ = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| hook(info)));
     o.elapsed = start.elapsed();
     let _ = std::fs::remove_dir_all(&work);
     o

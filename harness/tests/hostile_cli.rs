@@ -222,7 +222,7 @@ fn errors_show_tokens_short_and_escaped_and_name_what_a_path_is() {
     let f = d.file("ctl.nff", "s 0 0 \u{1b}[31m 1\n");
     let out = rtbench(&["scene", "stats", &f]);
     assert!(!out.stderr.contains(&0x1b), "raw escape echoed");
-    expect_input_error(&["scene", "stats", d.0.to_str().unwrap()], "is a directory");
+    expect_input_error(&["scene", "stats", d.0.to_str().unwrap()], "a directory");
     expect_input_error(&["scene", "stats", "/dev/null"], "not a regular file");
     let empty = d.file("empty.nff", "# nothing\n");
     expect_input_error(&["scene", "stats", &empty], "no objects");

@@ -68,7 +68,7 @@ fn malformed_mesh_files_exit_2() {
             "bad.ply",
         ),
         ("bad.gltf", "{ not json", "glTF"),
-        ("bad.glb", "glTF", "glTF"),
+        ("bad.glb", "glTF", "GLB"),
     ];
     for (name, body, needle) in cases {
         let p = tmp(name, body);

@@ -210,7 +210,7 @@ fn options_that_leave_nothing_to_run_are_refused() {
             &["kimura-3.3", "--engines", "bogus"][..],
             "option 'engines' does not apply",
         ),
-        (&["spd-stats", "--threads", "0"][..], "threads '0'"),
+        (&["spd-stats", "--threads", "0"][..], "'0' for '--threads"),
         (&["yamauchi-static-lb", "--size", "0"][..], "size '0'"),
     ] {
         let out = rtbench(&[&["reproduce"][..], args, &["--out", "/nonexistent/x"][..]].concat());

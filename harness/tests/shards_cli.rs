@@ -48,6 +48,8 @@ fn comparable(dir: &Path) -> Vec<(String, Value)> {
                 "paired_ratio",
                 "thread_scaling",
                 "machine",
+                "samples",
+                "ratio_to_embree",
             ] {
                 o.remove(k);
             }

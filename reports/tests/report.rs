@@ -3,7 +3,7 @@
 mod common;
 
 use common::{failed, run, write_set, TempDir};
-use rtbench_reports::{write_report, Format, ReportError};
+use rtbench_reports::{write_report, Format, ReportError, RunRecord};
 
 /// balls at SF 3, 4, 5 with embree, bvh2 (2.5× Embree's trace time) and grid (0.8×); teapot at SF 3
 /// with bvh2 only (no yardstick); one failed run.
@@ -228,7 +228,10 @@ fn a_later_line_replaces_an_earlier_one_with_the_same_key() {
         &[
             run("embree", "balls", 3, 1.0),
             failed("bvh2", "balls", 3, "killed"),
-            run("bvh2", "balls", 3, 3.0),
+            RunRecord {
+                finished_at: "2026-01-01T00:10:00Z".into(),
+                ..run("bvh2", "balls", 3, 3.0)
+            },
         ],
     );
     let summary = write_report(dir.path(), &[Format::Md]).unwrap();
@@ -258,14 +261,12 @@ fn errors_name_the_file() {
 }
 
 #[test]
-fn empty_results_make_an_empty_report() {
+fn empty_results_are_refused() {
     let dir = TempDir::new("none");
     std::fs::write(dir.path().join("results.jsonl"), "").unwrap();
-    let summary = write_report(dir.path(), &Format::ALL).unwrap();
-    assert_eq!(summary.runs, 0);
-    let md = read(&dir.path().join("report.md"));
-    assert!(md.contains("environment not recorded"));
-    assert!(md.contains("0 ok, 0 failed"));
+    let e = write_report(dir.path(), &Format::ALL).unwrap_err();
+    assert!(e.to_string().contains("holds no runs"), "{e}");
+    assert!(!dir.path().join("report.md").exists());
 }
 
 #[test]

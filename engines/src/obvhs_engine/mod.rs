@@ -275,10 +275,16 @@ impl Obvhs {
         r.tmax = oray.tmax;
         c.primitive_tests += 1;
         match self.prims[id].intersect(&r, self.triangle, wt) {
-            Some((t, u, v)) => {
+            // obvhs keeps a hit only when it is strictly nearer than its best so far; a tie at
+            // exactly that t keeps the earlier primitive, so its barycentrics must stay too.
+            Some((t, u, v)) if t < oray.tmax => {
                 c.primitive_hits += 1;
                 *last = (id, u, v);
                 t
+            }
+            Some(_) => {
+                c.primitive_hits += 1;
+                f32::INFINITY
             }
             None => f32::INFINITY,
         }

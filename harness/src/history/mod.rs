@@ -308,6 +308,12 @@ impl History {
         if tables == 0 {
             return Err(input(format!("{p}: holds no history (no tables)")));
         }
+        // As the writing open says it: a newer rtbench's history is named as such first.
+        if version > SCHEMA {
+            return Err(input(format!(
+                "{p}: history schema {version} is newer than this rtbench's ({SCHEMA}); use a newer rtbench"
+            )));
+        }
         if app != APP_ID {
             return Err(input(format!(
                 "{p}: an SQLite file but not an rtbench history (application_id {app:#x})"
