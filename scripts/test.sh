@@ -15,3 +15,5 @@ if ! command -v chromium >/dev/null; then
     $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium >/dev/null
 fi
 cargo test --workspace "$@"
+# A test that must run in a process of its own (see its comment in harness/src/reproduce/invocation.rs).
+cargo test -p rtbench --bin rtbench -- --ignored --exact reproduce::invocation::tests::an_invocation_keeps_its_cpu_and_wall_seconds
