@@ -7,6 +7,9 @@ use rtbench_scenes::validate::Validating;
 use rtbench_scenes::{nff, room, Scene, SceneCollector, Sink};
 use std::path::PathBuf;
 
+/// Hex digits of a scene file's content hash in its run label.
+pub const FILE_HASH_DIGITS: usize = 12;
+
 /// `<program|FILE.nff> [--sf N] [--tessellate [RES]] [--hash …]`, resolved.
 #[derive(Clone, Debug)]
 pub enum Source {
@@ -161,6 +164,37 @@ impl Source {
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
         }
+    }
+
+    /// SHA-256 of a scene file's content: the file, and for a glTF the buffers it names (each
+    /// resolved inside the mesh's folder, as reading does). `None` for generated scenes.
+    pub fn file_sha256(&self) -> Result<Option<String>> {
+        let Source::File(path) = self else {
+            return Ok(None);
+        };
+        let files = match rtbench_scenes::mesh::Format::of(path) {
+            Some(_) => rtbench_scenes::mesh::files_read(path).map_err(|e| input(e.to_string()))?,
+            None => vec![path.clone()],
+        };
+        use sha2::Digest;
+        let mut h = sha2::Sha256::new();
+        for f in &files {
+            let mut file = std::fs::File::open(f)
+                .map_err(|e| input(format!("{}: cannot read: {e}", f.display())))?;
+            std::io::copy(&mut file, &mut h)
+                .map_err(|e| input(format!("{}: cannot read: {e}", f.display())))?;
+        }
+        Ok(Some(crate::output::hex(&h.finalize())))
+    }
+
+    /// The scene's name in run keys and reports: [`Source::label`], and for a file its name with
+    /// the first 12 hex digits of its content hash (`bunny.obj-3f9a1c2b7d4e`), so that a changed
+    /// file is never taken for the same scene.
+    pub fn run_label(&self) -> Result<String> {
+        Ok(match self.file_sha256()? {
+            Some(h) => format!("{}-{}", self.label(), &h[..FILE_HASH_DIGITS]),
+            None => self.label(),
+        })
     }
 
     pub fn program(&self) -> Option<Program> {

@@ -116,7 +116,8 @@ impl Spread {
 /// The scene a run traced.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct SceneInfo {
-    /// `balls4`, `mount6-jenkins`, `balls4-tess3`, or a file name.
+    /// `balls4`, `mount6-jenkins`, `balls4-tess3`, or a file's name and the first 12 hex digits
+    /// of its content hash (`bunny.obj-3f9a1c2b7d4e`).
     pub name: String,
     pub program: Option<String>,
     pub sf: Option<u32>,
@@ -124,6 +125,11 @@ pub struct SceneInfo {
     pub objects: u64,
     /// Primitives the engines see (polygons cut into triangles).
     pub primitives: u64,
+    /// A scene file's path as given, and the SHA-256 of its content (with a glTF's buffers).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
 }
 
 /// Timings of the phases, in seconds, over the repeats.

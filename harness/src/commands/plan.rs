@@ -31,23 +31,10 @@ pub fn run(a: &PlanCmdArgs) -> Result<()> {
         }
         PlanWhat::Sweep(s) => {
             let engines = crate::select::engines(Some(&s.plan.engines), "--engines")?;
-            let programs: Vec<String> = if s.plan.scenes.trim() == "standard" {
-                rtbench_scenes::spd::Program::STANDARD
-                    .iter()
-                    .map(|p| p.name().to_string())
-                    .collect()
-            } else {
-                s.plan
-                    .scenes
-                    .split(',')
-                    .map(|x| {
-                        x.trim()
-                            .parse::<rtbench_scenes::spd::Program>()
-                            .map(|p| p.name().to_string())
-                            .map_err(input)
-                    })
-                    .collect::<Result<_>>()?
-            };
+            let programs: Vec<String> = crate::commands::runs::plan_scenes(&s.plan)?
+                .iter()
+                .map(crate::runs::plan::PlanScene::name)
+                .collect();
             let items = programs
                 .iter()
                 .flat_map(|p| {

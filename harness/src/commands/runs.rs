@@ -5,11 +5,10 @@ use crate::error::{input, Failure, Result};
 use crate::measure::threads::Threads;
 use crate::output::print_json;
 use crate::runs::one::{run_one, OneSpec};
-use crate::runs::plan::{self, plan_text, run_group, Common, Job, ResultsDir};
+use crate::runs::plan::{self, plan_text, run_group, Common, Job, PlanScene, ResultsDir};
 use crate::shard::{group_count, Manifest, ShardSpec};
 use crate::source::Source;
 use crate::workload;
-use rtbench_scenes::spd::Program;
 
 /// `4`, `4,5,6` or `4..8`.
 pub fn parse_sf_list(s: &str) -> Result<Vec<u32>> {
@@ -104,14 +103,9 @@ fn shard_of(p: &PlanArgs) -> Result<Option<ShardSpec>> {
         .transpose()
 }
 
-fn plan_programs(p: &PlanArgs) -> Result<Vec<Program>> {
-    if p.scenes.trim() == "standard" {
-        return Ok(Program::STANDARD.to_vec());
-    }
-    p.scenes
-        .split(',')
-        .map(|s| s.trim().parse::<Program>().map_err(input))
-        .collect()
+/// `--scenes`: SPD programs and scene files (OBJ, PLY, glTF, NFF), or `standard`.
+pub fn plan_scenes(p: &PlanArgs) -> Result<Vec<PlanScene>> {
+    PlanScene::parse_list(&p.scenes)
 }
 
 fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
@@ -158,12 +152,32 @@ fn common(p: &PlanArgs) -> Result<Common> {
 /// The jobs of `rtbench run` in plan order (scene by scene, Embree where listed), and what they share.
 pub fn run_plan(a: &RunArgs) -> Result<(Vec<Job>, Common)> {
     let engines = plan_engines(&a.plan)?;
-    let programs = plan_programs(&a.plan)?;
+    let scenes = plan_scenes(&a.plan)?;
     let threads = plan_threads(&a.plan)?;
     let common = common(&a.plan)?;
     let sfs = a.sf.as_deref().map(parse_sf_list).transpose()?;
     let mut jobs = Vec::new();
-    for p in &programs {
+    for scene in &scenes {
+        let p = match scene {
+            PlanScene::Program(p) => p,
+            // A file is traced as it is: once, whatever --sf and --tessellate say of programs.
+            PlanScene::File(f) => {
+                for t in &threads {
+                    for (e, s) in &engines {
+                        jobs.push(Job {
+                            engine: e.clone(),
+                            settings: s.clone(),
+                            program: f.label.clone(),
+                            sf: 0,
+                            tessellate: None,
+                            threads: *t,
+                            file: Some(f.clone()),
+                        });
+                    }
+                }
+                continue;
+            }
+        };
         for sf in sfs.clone().unwrap_or_else(|| vec![p.standard_sf()]) {
             let opts = rtbench_scenes::spd::Options {
                 size_factor: sf,
@@ -180,6 +194,7 @@ pub fn run_plan(a: &RunArgs) -> Result<(Vec<Job>, Common)> {
                         sf,
                         tessellate: a.tessellate,
                         threads: *t,
+                        file: None,
                     });
                 }
             }
@@ -240,10 +255,7 @@ pub fn run(a: &RunArgs) -> Result<()> {
 
 pub fn sweep(a: &SweepArgs) -> Result<()> {
     let engines = plan_engines(&a.plan)?;
-    let programs: Vec<String> = plan_programs(&a.plan)?
-        .iter()
-        .map(|p| p.name().to_string())
-        .collect();
+    let programs = plan_scenes(&a.plan)?;
     let threads = plan_threads(&a.plan)?;
     if threads.len() != 1 {
         return Err(input("sweep: give one --threads value"));
@@ -262,8 +274,9 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     }
     // A sweep's unit of work is (engine, scene): its SFs rise until the limit. Shards take whole
     // scenes, so the stop rule holds per scene.
-    let units = |ps: &[String]| -> Vec<String> {
+    let units = |ps: &[PlanScene]| -> Vec<String> {
         ps.iter()
+            .map(PlanScene::name)
             .flat_map(|p| {
                 engines.iter().map(move |(e, s)| {
                     format!(
@@ -284,7 +297,7 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     let manifest = match shard {
         Some(spec) => {
             let plan_units = units(&programs);
-            let mine = spec.select(&programs, |p| p.clone());
+            let mine = spec.select(&programs, PlanScene::name);
             let text = format!(
                 "{}\nsf {}..{} threads {:?}",
                 plan_text("sweep", &common, &plan_units),
@@ -301,7 +314,10 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
                 if mine.is_empty() {
                     "none".to_string()
                 } else {
-                    mine.join(",")
+                    mine.iter()
+                        .map(PlanScene::name)
+                        .collect::<Vec<_>>()
+                        .join(",")
                 },
                 programs.len()
             );
@@ -395,9 +411,10 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
     let c = rtbench_reports::compare(&a.a, &a.b, a.threshold).map_err(|e| input(e.to_string()))?;
     if c.matched == 0 {
         return Err(input(format!(
-            "{} and {}: no run of A is in B, nothing compared",
+            "{} and {}: no run of A is in B, nothing compared{}",
             a.a.display(),
-            a.b.display()
+            a.b.display(),
+            changed_files(&a.a, &a.b)
         )));
     }
     if a.json {
@@ -416,4 +433,27 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// `; FILE changed (…)` for each scene file both sides ran whose content differs: a changed file
+/// is another scene, so its runs are never matched.
+fn changed_files(a: &std::path::Path, b: &std::path::Path) -> String {
+    let files = |d: &std::path::Path| -> std::collections::BTreeMap<String, String> {
+        rtbench_reports::read_results(d)
+            .unwrap_or_default()
+            .into_iter()
+            .filter_map(|r| Some((r.scene.file?, r.scene.sha256?)))
+            .collect()
+    };
+    let (fa, fb) = (files(a), files(b));
+    fa.iter()
+        .filter_map(|(f, ha)| {
+            let hb = fb.get(f).filter(|hb| *hb != ha)?;
+            Some(format!(
+                "; {f} changed (content {} in A, {} in B): a changed file is another scene",
+                crate::output::head(ha, crate::source::FILE_HASH_DIGITS),
+                crate::output::head(hb, crate::source::FILE_HASH_DIGITS)
+            ))
+        })
+        .collect()
 }

@@ -50,8 +50,24 @@ pub fn jobs(s: &Suite) -> Vec<Job> {
                         sf,
                         tessellate: None,
                         threads,
+                        file: None,
                     });
                 }
+            }
+        }
+    }
+    for f in &s.files {
+        for &threads in &s.threads {
+            for v in &s.variants {
+                out.push(Job {
+                    engine: v.engine.clone(),
+                    settings: v.settings.clone(),
+                    program: f.label.clone(),
+                    sf: 0,
+                    tessellate: None,
+                    threads,
+                    file: Some(f.clone()),
+                });
             }
         }
     }

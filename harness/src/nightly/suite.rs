@@ -4,8 +4,8 @@
 //! name = "nightly"
 //! engines = ["embree", "grid", "bvh4"]     # Embree is the yardstick of the time ratios: required
 //! variants = ["bvh4:simd=off"]              # an engine with its settings, run beside the others
-//! scenes = ["tetra", "balls"]
-//! sf = [2, 3]
+//! scenes = ["tetra", "balls", "models/bunny.ply"] # SPD programs, or scene files (OBJ, PLY, glTF, NFF)
+//! sf = [2, 3]                               # size factors of the programs; a file runs as it is
 //! threads = [1]                             # counts or "all" (default [1])
 //! repeats = 5
 //! paired = 8                                # engine/Embree pairs timed back to back per run
@@ -116,6 +116,8 @@ pub struct Suite {
     pub text: String,
     pub variants: Vec<Variant>,
     pub scenes: Vec<Program>,
+    /// Scene files (OBJ, PLY, glTF, NFF) of `scenes`, each run once (no size factor).
+    pub files: Vec<crate::runs::plan::SceneFile>,
     pub sf: Vec<u32>,
     /// `None`: all cores.
     pub threads: Vec<Option<usize>>,
@@ -290,11 +292,22 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
     if raw.scenes.is_empty() || raw.sf.is_empty() {
         return Err(input(format!("{file}: scenes and sf must not be empty")));
     }
-    let scenes = raw
-        .scenes
-        .iter()
-        .map(|s| program(file, s))
-        .collect::<Result<Vec<_>>>()?;
+    let (mut scenes, mut files) = (Vec::new(), Vec::new());
+    for s in &raw.scenes {
+        if s.trim().parse::<Program>().is_ok() {
+            scenes.push(program(file, s)?);
+            continue;
+        }
+        // Not a program: a scene file (a path from where rtbench runs), keyed by its content.
+        match crate::runs::plan::PlanScene::parse(s) {
+            Ok(crate::runs::plan::PlanScene::File(f)) => files.push(f),
+            Ok(crate::runs::plan::PlanScene::Program(p)) => scenes.push(p),
+            Err(e) => {
+                let msg = e.to_string().replace("SPD program", "scene");
+                return Err(input(format!("{file}: {msg}")));
+            }
+        }
+    }
     if raw.sf.contains(&0) {
         return Err(input(format!("{file}: sf: size factors start at 1")));
     }
@@ -425,6 +438,7 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         text: text.to_string(),
         variants,
         scenes,
+        files,
         sf: raw.sf,
         threads,
         repeats,

@@ -252,20 +252,26 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         Source::File(_) | Source::Room(_) => (None, None, None),
     };
     let pixels = render.pixels();
+    let name = spec.source.run_label()?;
     use sha2::Digest;
     Ok(RunRecord {
-        key: run_key(&spec.engine, &settings, &spec.source.label(), threads),
+        key: run_key(&spec.engine, &settings, &name, threads),
         status: "ok".into(),
         reason: None,
         engine: spec.engine.clone(),
         settings,
         scene: SceneInfo {
-            name: spec.source.label(),
+            name,
             program,
             sf,
             tessellate,
             objects: scene.objects.len() as u64,
             primitives: prepared.input.geometry.prims.len() as u64,
+            file: match &spec.source {
+                Source::File(p) => Some(p.display().to_string()),
+                _ => None,
+            },
+            sha256: spec.source.file_sha256()?,
         },
         threads,
         repeats: spec.repeats.max(1),

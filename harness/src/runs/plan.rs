@@ -15,16 +15,89 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// A scene file a plan traces (OBJ, PLY, glTF or NFF): the path as given, and its run label,
+/// the file's name with its content hash ([`crate::source::Source::run_label`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneFile {
+    pub path: String,
+    pub label: String,
+}
+
+/// One scene of a plan's `--scenes` (or a suite's `scenes`): an SPD program, traced at each
+/// size factor, or a scene file, traced once as it is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PlanScene {
+    Program(rtbench_scenes::spd::Program),
+    File(SceneFile),
+}
+
+impl PlanScene {
+    /// `standard`, or a program name, or a path to a scene file; a bad name or path is one line.
+    pub fn parse(s: &str) -> Result<PlanScene> {
+        let s = s.trim();
+        if let Ok(p) = s.parse::<rtbench_scenes::spd::Program>() {
+            return Ok(PlanScene::Program(p));
+        }
+        let source = crate::source::Source::resolve(s, None, None, None)?;
+        match &source {
+            crate::source::Source::File(_) => {
+                // Read once here, so a malformed file is one line and exit 2 before any run,
+                // not a failed run per engine.
+                source.load()?;
+                Ok(PlanScene::File(SceneFile {
+                    path: s.to_string(),
+                    label: source.run_label()?,
+                }))
+            }
+            // `room`, `roomN`: no size factor to plan.
+            _ => Err(input(format!(
+                "{s}: not an SPD program nor a scene file (the room runs with render or reproduce)"
+            ))),
+        }
+    }
+
+    /// A comma-separated list: `standard` is the seven standard programs.
+    pub fn parse_list(list: &str) -> Result<Vec<PlanScene>> {
+        if list.trim() == "standard" {
+            return Ok(rtbench_scenes::spd::Program::STANDARD
+                .iter()
+                .map(|&p| PlanScene::Program(p))
+                .collect());
+        }
+        let out = list
+            .split(',')
+            .filter(|x| !x.trim().is_empty())
+            .map(PlanScene::parse)
+            .collect::<Result<Vec<_>>>()?;
+        if out.is_empty() {
+            return Err(input(format!("--scenes '{list}': no scene named")));
+        }
+        Ok(out)
+    }
+
+    /// The program's name, or the file's run label.
+    pub fn name(&self) -> String {
+        match self {
+            PlanScene::Program(p) => p.name().to_string(),
+            PlanScene::File(f) => f.label.clone(),
+        }
+    }
+}
+
 /// One planned run.
 #[derive(Clone, Debug)]
 pub struct Job {
     pub engine: String,
     pub settings: Vec<(String, String)>,
+    /// The SPD program's name, or for a scene file its run label.
     pub program: String,
+    /// The size factor (unused for a scene file).
     pub sf: u32,
     pub tessellate: Option<u32>,
     /// `None`: all cores.
     pub threads: Option<usize>,
+    /// The scene file traced instead of a program.
+    pub file: Option<SceneFile>,
 }
 
 /// The group a job of `run` is sharded with: its scene (program, SF, tessellation) and threads, so
@@ -54,6 +127,9 @@ pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
 
 impl Job {
     fn scene_label(&self) -> String {
+        if let Some(f) = &self.file {
+            return f.label.clone();
+        }
         let mut s = format!("{}{}", self.program, self.sf);
         if let Some(r) = self.tessellate {
             s.push_str(&format!("-tess{r}"));
@@ -167,12 +243,19 @@ fn failed(job: &Job, common: &Common, reason: String, wall_s: f64) -> RunRecord 
         reason: Some(reason),
         engine: job.engine.clone(),
         settings: job.settings.iter().cloned().collect(),
-        scene: SceneInfo {
-            name: job.scene_label(),
-            program: Some(job.program.clone()),
-            sf: Some(job.sf),
-            tessellate: job.tessellate,
-            ..Default::default()
+        scene: match &job.file {
+            Some(f) => SceneInfo {
+                name: f.label.clone(),
+                file: Some(f.path.clone()),
+                ..Default::default()
+            },
+            None => SceneInfo {
+                name: job.scene_label(),
+                program: Some(job.program.clone()),
+                sf: Some(job.sf),
+                tessellate: job.tessellate,
+                ..Default::default()
+            },
         },
         threads: job.threads_count(),
         repeats: common.repeats,
@@ -197,17 +280,17 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
         }
     };
     let mut cmd = Command::new(exe);
-    cmd.args([
-        "run-one",
-        "--engine",
-        &job.engine,
-        "--scene",
-        &job.program,
-        "--sf",
-        &job.sf.to_string(),
-    ]);
-    if let Some(r) = job.tessellate {
-        cmd.args(["--tessellate", &r.to_string()]);
+    cmd.args(["run-one", "--engine", &job.engine]);
+    match &job.file {
+        Some(f) => {
+            cmd.args(["--scene", &f.path]);
+        }
+        None => {
+            cmd.args(["--scene", &job.program, "--sf", &job.sf.to_string()]);
+            if let Some(r) = job.tessellate {
+                cmd.args(["--tessellate", &r.to_string()]);
+            }
+        }
     }
     for (k, v) in &job.settings {
         cmd.args(["--set", &format!("{k}={v}")]);
@@ -438,11 +521,12 @@ pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) ->
 }
 
 /// `rtbench sweep`: for each scene and engine, raise the SF from `sf_start` until a run fails
-/// (time or memory limit, crash) or takes longer than the time limit.
+/// (time or memory limit, crash) or takes longer than the time limit. A scene file has no size
+/// factor to raise: it is run once.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep(
     engines: &[(String, Vec<(String, String)>)],
-    programs: &[String],
+    scenes: &[PlanScene],
     sf_start: u32,
     sf_max: u32,
     threads: Option<usize>,
@@ -452,9 +536,14 @@ pub fn sweep(
 ) -> Result<usize> {
     let mut runs = 0;
     let start = Instant::now();
-    for program in programs {
+    for scene in scenes {
+        let (file, sfs) = match scene {
+            PlanScene::Program(_) => (None, sf_start..=sf_max),
+            PlanScene::File(f) => (Some(f.clone()), sf_start..=sf_start),
+        };
+        let program = scene.name();
         for (engine, settings) in engines {
-            for sf in sf_start..=sf_max {
+            for sf in sfs.clone() {
                 let job = Job {
                     engine: engine.clone(),
                     settings: settings.clone(),
@@ -462,6 +551,7 @@ pub fn sweep(
                     sf,
                     tessellate: None,
                     threads,
+                    file: file.clone(),
                 };
                 let key = job.key();
                 let rec = if resume && out.has(&key) {
@@ -482,7 +572,8 @@ pub fn sweep(
                     format!("FAILED ({})", rec.reason.as_deref().unwrap_or(""))
                 };
                 eprintln!(
-                    "sweep {engine} {program}{sf}: {verdict} (elapsed {})",
+                    "sweep {engine} {}: {verdict} (elapsed {})",
+                    job.scene_label(),
                     fmt_secs(start.elapsed().as_secs_f64())
                 );
                 let over_time = common.max_seconds.is_some_and(|m| rec.wall_s > m);

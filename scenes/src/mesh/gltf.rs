@@ -425,6 +425,24 @@ fn add_mesh(
     Ok(())
 }
 
+/// The files besides `path` that reading it would open: its external buffers, each resolved
+/// inside the mesh's folder as [`read`] resolves them (data URIs and the GLB chunk open none).
+pub(super) fn external_files(path: &Path, bytes: &[u8]) -> Result<Vec<std::path::PathBuf>, String> {
+    let json = if bytes.starts_with(b"glTF") {
+        split_glb(bytes)?.0
+    } else {
+        bytes
+    };
+    let root = Root::from_slice(json).map_err(|e| format!("glTF: {e}"))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    root.buffers
+        .iter()
+        .filter_map(|b| b.uri.as_deref())
+        .filter(|uri| !uri.starts_with("data:"))
+        .map(|uri| folder::resolve(dir, uri).map_err(|e| format!("glTF: {e}")))
+        .collect()
+}
+
 pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<Mesh, String> {
     let (json, bin) = if bytes.starts_with(b"glTF") {
         split_glb(bytes)?

@@ -151,6 +151,24 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
     Ok(mesh)
 }
 
+/// Every file reading `path` opens, the mesh file first: what a scene's content hash must cover
+/// (a glTF's external buffers are part of its scene). Never a file outside the mesh's folder.
+pub fn files_read(path: &Path) -> Result<Vec<std::path::PathBuf>, MeshError> {
+    let e = |message: String| MeshError {
+        file: path.display().to_string(),
+        message,
+    };
+    let mut out = vec![path.to_path_buf()];
+    if Format::of(path) == Some(Format::Gltf) {
+        let bytes = std::fs::read(path).map_err(|err| e(format!("cannot read: {err}")))?;
+        let more = std::panic::catch_unwind(|| gltf::external_files(path, &bytes))
+            .map_err(|_| e("the file's parser failed on it (malformed file)".into()))?
+            .map_err(e)?;
+        out.extend(more);
+    }
+    Ok(out)
+}
+
 /// The default view of a model with bounds `lo`…`hi` (module docs).
 pub fn framing_view(lo: DVec3, hi: DVec3) -> View {
     let c = (lo + hi) * 0.5;
