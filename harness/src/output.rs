@@ -1,9 +1,9 @@
-//! Writing results: atomically (a temp file beside the target, then rename), so an interrupted
-//! or failed write never leaves a half-written file.
+//! Writing results: atomically (a temp file beside the target, then rename: `tempfile`'s
+//! persist), so an interrupted or failed write never leaves a half-written file.
 
 use crate::error::{input, Result};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The first `n` characters of `s`: text read from files and databases is cut at a character,
 /// never at a byte index (which panics inside a multi-byte character).
@@ -24,26 +24,41 @@ where
     let name = path
         .file_name()
         .ok_or_else(|| input(format!("{}: not a file name", path.display())))?;
-    let tmp: PathBuf = dir.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let cannot = |e: std::io::Error| input(format!("{}: cannot write: {e}", path.display()));
+    let (file, tmp) = temp_file_beside(dir, &name.to_string_lossy())
+        .map_err(cannot)?
+        .into_parts();
     let _guard = interrupt::remove_on_signal(&tmp);
-    let result = (|| -> std::io::Result<()> {
-        let f = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
-        write(&mut w)?;
-        w.flush()?;
-        let f = w.into_inner().map_err(|e| e.into_error())?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(input(format!("{}: cannot write: {e}", path.display())));
-    }
+    // On an error `tmp` is dropped, which removes the temp file.
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    write(&mut w).map_err(cannot)?;
+    w.flush().map_err(cannot)?;
+    let f = w.into_inner().map_err(|e| cannot(e.into_error()))?;
+    f.sync_all().map_err(cannot)?;
+    tmp.persist(path).map_err(|e| cannot(e.error))?;
     Ok(())
+}
+
+/// A new temp file `.NAME.tmp-XXXXXX` in `dir`, with the permissions `File::create` would give
+/// (the temp file's own default is owner-only, which a result file shared with others must not
+/// get).
+pub fn temp_file_beside(dir: &Path, name: &str) -> std::io::Result<tempfile::NamedTempFile> {
+    use std::os::unix::fs::PermissionsExt;
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}.tmp-"))
+        .permissions(std::fs::Permissions::from_mode(0o666))
+        .tempfile_in(dir)
+}
+
+/// A duration for people (`1m 20s`, `4s 200ms`): whole seconds from a minute up, tenths below.
+pub fn fmt_secs(s: f64) -> String {
+    let s = if s.is_finite() { s.max(0.0) } else { 0.0 };
+    let d = if s >= 60.0 {
+        std::time::Duration::from_secs(s.round() as u64)
+    } else {
+        std::time::Duration::from_millis((s * 10.0).round() as u64 * 100)
+    };
+    humantime::format_duration(d).to_string()
 }
 
 /// Writes a square RGB8 image (`size`² pixels, rows top down) as a PNG, atomically.

@@ -53,13 +53,13 @@ pub fn results(records: &[RunRecord]) -> String {
         .iter()
         .flat_map(|r| r.counters.keys().map(String::as_str))
         .collect();
-    let mut out = String::new();
+    let mut out = ::csv::Writer::from_writer(Vec::new());
     let header: Vec<String> = FIXED
         .iter()
         .map(|h| h.to_string())
         .chain(counters.iter().map(|c| format!("counter.{c}")))
         .collect();
-    push_line(&mut out, &header);
+    out.write_record(&header).expect("writing to memory");
     for r in records {
         let opt = |v: Option<String>| v.unwrap_or_default();
         let settings: Vec<String> = r.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
@@ -110,35 +110,24 @@ pub fn results(records: &[RunRecord]) -> String {
                 .iter()
                 .map(|name| opt(r.counters.get(*name).map(|v| v.to_string()))),
         );
-        push_line(&mut out, &cells);
+        out.write_record(&cells).expect("writing to memory");
     }
-    out
-}
-
-fn push_line(out: &mut String, cells: &[String]) {
-    let quoted: Vec<String> = cells.iter().map(|c| quote(c)).collect();
-    out.push_str(&quoted.join(","));
-    out.push('\n');
-}
-
-/// RFC 4180: a field with a comma, quote or line break is quoted, its quotes doubled.
-fn quote(field: &str) -> String {
-    if field.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", field.replace('"', "\"\""))
-    } else {
-        field.to_string()
-    }
+    String::from_utf8(out.into_inner().expect("writing to memory")).expect("the cells are text")
 }
 
 #[cfg(test)]
 mod tests {
+    /// RFC 4180 through the `csv` crate: a field with a comma, quote or line break (`\n` or
+    /// `\r`) is quoted, its quotes doubled.
     #[test]
     fn quoting() {
+        let mut w = ::csv::Writer::from_writer(Vec::new());
+        w.write_record(["grid[a=1,b=2]/balls4@1", "say \"hi\"", "plain", "a\rb", ""])
+            .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
         assert_eq!(
-            super::quote("grid[a=1,b=2]/balls4@1"),
-            "\"grid[a=1,b=2]/balls4@1\""
+            text,
+            "\"grid[a=1,b=2]/balls4@1\",\"say \"\"hi\"\"\",plain,\"a\rb\",\n"
         );
-        assert_eq!(super::quote("say \"hi\""), "\"say \"\"hi\"\"\"");
-        assert_eq!(super::quote("plain"), "plain");
     }
 }

@@ -80,24 +80,22 @@ pub struct Outcome {
     pub elapsed: Duration,
 }
 
-/// xorshift64*: small, seeded, the same sequence everywhere.
-pub struct Rng(u64);
+/// The fuzzers' generator (`fastrand`'s), seeded: a seed replays its inputs.
+pub struct Rng(fastrand::Rng);
 
 impl Rng {
     pub fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+        Rng(fastrand::Rng::with_seed(seed))
     }
     pub fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        self.0.u64(..)
     }
+    /// Below `n` (0 when `n` is 0).
     pub fn below(&mut self, n: usize) -> usize {
         if n == 0 {
             0
         } else {
-            (self.next_u64() % n as u64) as usize
+            self.0.usize(..n)
         }
     }
 }

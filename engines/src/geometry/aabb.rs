@@ -230,13 +230,8 @@ mod tests {
     /// directions that enter the box: every one must find the box (the conservative bound).
     #[test]
     fn rays_through_corners_and_edges_find_the_box() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut f = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = fastrand::Rng::with_seed(0x2545_f491_4f6c_dd1d);
+        let mut f = || rng.f32();
         let mut missed = 0;
         for _ in 0..20_000 {
             let lo = Vec3::new(f() * 4.0 - 2.0, f() * 4.0 - 2.0, f() * 4.0 - 2.0);

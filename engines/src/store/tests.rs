@@ -124,14 +124,9 @@ fn every_bit_flip_is_refused() {
     let dir = TempDir::new("flips");
     write_store(&dir, Program::Tree, 2);
     assert!(open_and_verify(&dir.0).is_ok());
-    // A fixed pseudo-random sequence (xorshift), so that a failure reproduces.
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
+    // A seeded pseudo-random sequence, so that a failure reproduces.
+    let mut rng = fastrand::Rng::with_seed(0x9e37_79b9_7f4a_7c15);
+    let mut next = || rng.u64(..);
     for k in 0..300 {
         let name = [HEADER_FILE, BBOX_FILE, GEOMETRY_FILE, MATERIALS_FILE][k % 4];
         let path = dir.0.join(name);

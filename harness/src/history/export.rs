@@ -9,41 +9,50 @@ use super::{History, Metric};
 use crate::error::Result;
 use serde_json::{json, Map, Value};
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-/// Every night's metrics, one line per (night, metric), with the samples' min and max.
+/// Every night's metrics, one line per (night, metric), with the samples' min and max. Every
+/// field goes through the `csv` crate's quoting (a name or suite with a comma, quote or line
+/// break stays one field).
 pub fn csv(h: &History) -> Result<String> {
-    let mut out = String::from(
-        "run_id,started_at,git_commit,fingerprint,suite,metric,kind,unit,value,gated,samples,min,max\n",
-    );
+    let mut out = ::csv::Writer::from_writer(Vec::new());
+    let mem = "writing CSV to memory";
+    out.write_record([
+        "run_id",
+        "started_at",
+        "git_commit",
+        "fingerprint",
+        "suite",
+        "metric",
+        "kind",
+        "unit",
+        "value",
+        "gated",
+        "samples",
+        "min",
+        "max",
+    ])
+    .expect(mem);
     for r in h.runs(None, None)? {
         for m in h.metrics(r.id)? {
             let (lo, hi) = range(&m);
-            out.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-                r.id,
-                r.started_at,
-                r.git_commit,
-                crate::output::head(&r.fingerprint, 16),
-                csv_field(&r.suite),
-                csv_field(&m.name),
-                m.kind,
-                m.unit,
-                m.value,
-                u8::from(m.gated),
-                m.samples.len(),
+            out.write_record([
+                r.id.to_string(),
+                r.started_at.clone(),
+                r.git_commit.clone(),
+                crate::output::head(&r.fingerprint, 16).to_string(),
+                r.suite.clone(),
+                m.name.clone(),
+                m.kind.clone(),
+                m.unit.clone(),
+                m.value.to_string(),
+                u8::from(m.gated).to_string(),
+                m.samples.len().to_string(),
                 lo.map(|v| v.to_string()).unwrap_or_default(),
                 hi.map(|v| v.to_string()).unwrap_or_default(),
-            ));
+            ])
+            .expect(mem);
         }
     }
-    Ok(out)
+    Ok(String::from_utf8(out.into_inner().expect(mem)).expect("the fields are text"))
 }
 
 fn range(m: &Metric) -> (Option<f64>, Option<f64>) {

@@ -548,13 +548,7 @@ pub fn gates_clause(findings: &[Finding]) -> String {
     }
 }
 
-pub fn fmt_secs(s: f64) -> String {
-    if s >= 60.0 {
-        format!("{}m{:02}s", (s / 60.0) as u64, (s % 60.0) as u64)
-    } else {
-        format!("{s:.1}s")
-    }
-}
+pub use crate::output::fmt_secs;
 
 /// The metrics a night found changed for the first time (verdict `suspect`).
 pub fn suspects_of(findings: &[Finding]) -> std::collections::BTreeSet<String> {

@@ -60,11 +60,8 @@ impl Checkpoint {
         std::fs::create_dir_all(&self.dir)
             .map_err(|e| input(format!("{}: {e}", self.dir.display())))?;
         let f = self.file(key);
-        let tmp = self.dir.join(format!(".{key}.json.tmp"));
         let text = serde_json::to_vec_pretty(step).expect("steps serialise");
-        std::fs::write(&tmp, text)
-            .and_then(|_| std::fs::rename(&tmp, &f))
-            .map_err(|e| input(format!("{}: {e}", f.display())))
+        crate::output::write_atomic(&f, |w| std::io::Write::write_all(w, &text))
     }
 }
 

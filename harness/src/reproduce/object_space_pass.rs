@@ -469,9 +469,10 @@ fn machine_key(t: &Traced, m: &Machine, fb: &FrameBuffer) -> String {
 /// algorithm may change between Rust versions, which would orphan every saved step). Keys made
 /// with it are marked `-f` where the `DefaultHasher` ones were marked `-c`.
 pub fn stable_hash(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+    use std::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    h.write(bytes);
+    h.finish()
 }
 
 /// [`run_all`] without saving: every machine simulated.

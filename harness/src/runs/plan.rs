@@ -7,7 +7,7 @@
 //! already holds. `DIR/env.json` records the environment.
 
 use crate::error::{input, Result};
-use crate::output::write_atomic;
+use crate::output::{fmt_secs, write_atomic};
 use rtbench_reports::{read_results, run_key, RunRecord, SceneInfo};
 use std::collections::BTreeMap;
 use std::io::Read;
@@ -434,35 +434,34 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     }
 }
 
-fn fmt_secs(s: f64) -> String {
-    if s >= 60.0 {
-        format!("{}m{:02}s", (s / 60.0) as u64, (s % 60.0) as u64)
-    } else {
-        format!("{s:.1}s")
-    }
-}
-
-/// Progress on stderr: `[3/42] bvh4 balls4 @1: ok 1.2 s (left ~1m20s)`.
+/// Progress on stderr: a bar with the runs done and indicatif's estimate of the time left, drawn
+/// only when stderr is a terminal, and one line per finished run
+/// (`[3/42] bvh4 balls4 @1: ok, … (elapsed 12s, left ~1m 20s)`) above it, or alone in a log.
 pub struct Progress {
-    total: usize,
-    done: usize,
-    start: Instant,
+    bar: indicatif::ProgressBar,
 }
 
 impl Progress {
     pub fn new(total: usize) -> Progress {
-        Progress {
-            total,
-            done: 0,
-            start: Instant::now(),
-        }
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(total as u64),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "[{pos}/{len}] {wide_bar} elapsed {elapsed}, left ~{eta}",
+            )
+            .expect("the template is valid"),
+        );
+        Progress { bar }
     }
 
     pub fn finish(&mut self, job: &Job, rec: &RunRecord, skipped: bool) {
-        self.done += 1;
-        let elapsed = self.start.elapsed().as_secs_f64();
-        let left = if self.done < self.total {
-            elapsed / self.done as f64 * (self.total - self.done) as f64
+        self.bar.inc(1);
+        let (done, total) = (self.bar.position(), self.bar.length().unwrap_or(0));
+        let elapsed = self.bar.elapsed().as_secs_f64();
+        let left = if done < total {
+            self.bar.eta().as_secs_f64()
         } else {
             0.0
         };
@@ -481,16 +480,22 @@ impl Progress {
         } else {
             format!("FAILED ({})", rec.reason.as_deref().unwrap_or(""))
         };
-        eprintln!(
-            "[{}/{}] {} {} @{}: {what} (elapsed {}, left ~{})",
-            self.done,
-            self.total,
+        let line = format!(
+            "[{done}/{total}] {} {} @{}: {what} (elapsed {}, left ~{})",
             job.label(),
             job.scene_label(),
             job.threads_count(),
             fmt_secs(elapsed),
             fmt_secs(left)
         );
+        if self.bar.is_hidden() {
+            eprintln!("{line}");
+        } else {
+            self.bar.println(line);
+        }
+        if done >= total {
+            self.bar.finish_and_clear();
+        }
     }
 }
 

@@ -191,13 +191,8 @@ mod tests {
     #[test]
     fn fast_path_agrees_with_the_exact_one() {
         // Pseudo-random doubles over the ranges SPD prints, plus exact ties and their neighbours.
-        let mut state = 0x9E3779B97F4A7C15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = fastrand::Rng::with_seed(0x9E3779B97F4A7C15);
+        let mut next = || rng.u64(..);
         let mut checked = 0;
         for i in 0..400_000 {
             let r = next();
