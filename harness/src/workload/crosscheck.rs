@@ -189,19 +189,17 @@ pub fn cross_check(
     // render got the same answers, query for query, as in the yardstick's (same objects hit,
     // same shadow verdicts, in the same order).
     let w = size as usize + 1;
+    // FNV per corner: only compared for equality between the two renders, never stored.
     let tree_hash = |r: &trace::Recording| {
-        let mut h = vec![0xcbf2_9ce4_8422_2325u64; w * w];
-        let mut mix = |c: u32, v: u64| {
-            let x = &mut h[c as usize];
-            *x = (*x ^ v).wrapping_mul(0x0100_0000_01b3);
-        };
+        use std::hash::Hasher;
+        let mut h: Vec<fnv::FnvHasher> = (0..w * w).map(|_| fnv::FnvHasher::default()).collect();
         for ((_, hit), c) in r.closest.iter().zip(&r.closest_corner) {
-            mix(*c, hit.object as u64);
+            h[*c as usize].write_u64(hit.object as u64);
         }
         for ((_, b), c) in r.any.iter().zip(&r.any_corner) {
-            mix(*c, 1 << 40 | *b as u64);
+            h[*c as usize].write_u64(1 << 40 | *b as u64);
         }
-        h
+        h.iter().map(Hasher::finish).collect::<Vec<u64>>()
     };
     let (hw, hg) = (tree_hash(&rec), tree_hash(&own_rec));
     let same_corner: Vec<bool> = hw.iter().zip(&hg).map(|(a, b)| a == b).collect();
