@@ -56,19 +56,20 @@ impl PlanScene {
         }
     }
 
-    /// A comma-separated list: `standard` is the seven standard programs.
+    /// A comma-separated list; `standard` in it is the seven standard programs.
     pub fn parse_list(list: &str) -> Result<Vec<PlanScene>> {
-        if list.trim() == "standard" {
-            return Ok(rtbench_scenes::spd::Program::STANDARD
-                .iter()
-                .map(|&p| PlanScene::Program(p))
-                .collect());
+        let mut out = Vec::new();
+        for item in list.split(',').filter(|x| !x.trim().is_empty()) {
+            if item.trim() == "standard" {
+                out.extend(
+                    rtbench_scenes::spd::Program::STANDARD
+                        .iter()
+                        .map(|&p| PlanScene::Program(p)),
+                );
+            } else {
+                out.push(PlanScene::parse(item)?);
+            }
         }
-        let out = list
-            .split(',')
-            .filter(|x| !x.trim().is_empty())
-            .map(PlanScene::parse)
-            .collect::<Result<Vec<_>>>()?;
         if out.is_empty() {
             return Err(input(format!("--scenes '{list}': no scene named")));
         }
