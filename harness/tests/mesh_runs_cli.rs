@@ -206,7 +206,7 @@ fn sweep_runs_a_mesh_once_and_suites_take_mesh_paths() {
     std::fs::write(
         &suite,
         format!(
-            "engines = [\"embree\", \"bvh8\"]\nscenes = [\"tetra\", {file:?}]\nsf = [1]\nrepeats = 2\nsize = 16\n"
+            "engines = [\"embree\", \"bvh8\"]\nscenes = [\"tetra\", {file:?}]\nsf = [1]\nrepeats = 2\nsize = 16\ngate = [\"counters\"]\n"
         ),
     )
     .unwrap();
@@ -255,7 +255,7 @@ fn bad_mesh_paths_are_one_line_and_exit_2() {
     let suite = d.join("suite.toml");
     std::fs::write(
         &suite,
-        "engines = [\"embree\"]\nscenes = [\"nowhere.glb\"]\nsf = [1]\n",
+        "engines = [\"embree\"]\nscenes = [\"nowhere.glb\"]\nsf = [1]\ngate = []\n",
     )
     .unwrap();
     expect_input_error(&["plan", "nightly", "--suite", &suite], "nowhere.glb");
