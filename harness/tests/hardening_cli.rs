@@ -275,3 +275,45 @@ fn check_suite_hard_runs_with_its_default_engines() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(!err.contains("plugin"), "{err}");
 }
+
+#[test]
+fn an_interrupted_store_leaves_no_temporary_directory() {
+    let d = dir("sigterm");
+    let out = d.join("st");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtbench"))
+        .args(["scene", "store", "tetra", "--sf", "9", "-o"])
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("rtbench starts");
+    // Wait until the temporary directory exists, then interrupt the write.
+    let started = std::time::Instant::now();
+    let tmp_exists = || {
+        std::fs::read_dir(&d).unwrap().any(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(".st.tmp-")
+        })
+    };
+    while !tmp_exists() && started.elapsed().as_secs() < 60 {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    // SAFETY: sending a signal to our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    let left: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    if status.success() {
+        // Finished before the signal: the store is whole and nothing else is left.
+        assert_eq!(left, ["st"], "{left:?}");
+    } else {
+        assert!(left.is_empty(), "left behind: {left:?}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
