@@ -328,6 +328,15 @@ mod tests {
         assert!(parse(8, &[("leaf", "17")]).is_err());
         assert!(parse(8, &[("builder", "kd")]).is_err());
         assert!(parse(2, &[("simd", "on")]).is_err());
+        assert_eq!(parse(8, &[]).unwrap().isa, Isa::Auto);
+        for (v, isa) in [
+            ("auto", Isa::Auto),
+            ("avx2", Isa::Avx2),
+            ("avx512", Isa::Avx512),
+        ] {
+            assert_eq!(parse(4, &[("isa", v)]).unwrap().isa, isa);
+        }
+        assert!(parse(8, &[("isa", "sse9")]).is_err());
         assert_eq!((c.packets, c.split_leaves), (true, false));
         let c = parse(4, &[("packets", "off")]).unwrap();
         assert_eq!((c.packets, c.split_leaves), (false, true));
