@@ -13,7 +13,7 @@
 
   function fmt(v) {
     if (v == null || !isFinite(v)) return "–";
-    if (Math.abs(v) >= 1e4 && Math.round(v) === v) return v.toLocaleString("en-US");
+    if (Number.isInteger(v)) return v.toLocaleString("en-US");
     if (Math.abs(v) >= 100) return v.toFixed(1);
     return v.toFixed(4);
   }

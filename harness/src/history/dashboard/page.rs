@@ -170,3 +170,85 @@ pub fn render(b: &Board) -> String {
     };
     markup.into_string()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::board::Mark;
+    use super::*;
+    use crate::history::Finding;
+
+    fn night(id: i64, url: Option<&str>) -> NightInfo {
+        NightInfo {
+            id,
+            started_at: "2026-01-01T00:00:00Z".into(),
+            commit: "cd8e501".into(),
+            dirty: false,
+            machine: "m".into(),
+            url: url.map(String::from),
+            regressions: 1,
+            metrics: 1,
+            wall_s: 1.0,
+            note: "<b>note</b>".into(),
+            plotted: true,
+        }
+    }
+
+    #[test]
+    fn text_from_the_history_is_escaped_and_links_are_kept() {
+        let evil = "grid <script>alert(1)</script>/counter.x\"";
+        let b = Board {
+            suite: "s&<".into(),
+            fingerprint: "fp".into(),
+            latest: night(2, Some("https://example.org/c/cd8e501")),
+            nights: vec![
+                night(2, Some("https://example.org/c/cd8e501")),
+                night(1, None),
+            ],
+            gates: vec!["counters: active <since> night 2".into()],
+            findings: vec![Finding {
+                name: evil.into(),
+                verdict: "regression".into(),
+                baseline: Some(1.0),
+                value: Some(2.0),
+                change_pct: Some(100.0),
+                message: "a <i>message</i>".into(),
+            }],
+            compared: 0,
+            plots: vec![Plot {
+                name: evil.into(),
+                kind: "counter".into(),
+                unit: "count".into(),
+                gated: true,
+                x: vec![1, 2],
+                y: vec![1.0, 2.0],
+                lo: vec![None, None],
+                hi: vec![None, None],
+                n: vec![0, 0],
+                marks: vec![Mark {
+                    night: 2,
+                    verdict: "regression".into(),
+                    message: "</section>".into(),
+                }],
+                change_points: vec![],
+                compared: None,
+                gate: None,
+            }],
+        };
+        let html = render(&b);
+        assert!(!html.contains("<script>alert"));
+        assert!(!html.contains("<b>note</b>") && !html.contains("<i>message"));
+        assert!(html.contains("grid &lt;script&gt;alert(1)&lt;/script&gt;/counter.x&quot;"));
+        assert!(html.contains("rtbench nightly: s&amp;&lt;"));
+        // The one plot's section holds its mark; the message is an attribute, not markup.
+        assert_eq!(html.matches("<section class=\"plot\"").count(), 1);
+        assert!(html.contains(
+            "<span class=\"mark regression\" title=\"&lt;/section&gt;\">regression night 2</span>"
+        ));
+        assert!(html.contains("<a class=\"commit\" href=\"https://example.org/c/cd8e501\""));
+        // The board travels in an attribute: its JSON is escaped there, and whole.
+        let at = html.find("data-board=\"").unwrap() + "data-board=\"".len();
+        let raw = &html[at..at + html[at..].find('"').unwrap()];
+        assert!(!raw.contains('<'));
+        assert!(raw.contains("&lt;script&gt;"));
+    }
+}
