@@ -97,6 +97,20 @@ impl Grid {
         })
     }
 
+    /// The mailbox's stamps and current stamp, and the culling boxes, each as long as the
+    /// primitives (`n`) where its switch is on (else empty, and never read).
+    #[inline(always)]
+    fn per_prim<'a, const MB: bool, const CULL: bool>(
+        &'a self,
+        mb: &'a mut Mailbox,
+        n: usize,
+    ) -> (&'a mut [u32], u32, &'a [[Vec3; 2]]) {
+        let stamp = mb.ray;
+        let stamps: &mut [u32] = if MB { &mut mb.stamps[..n] } else { &mut [] };
+        let bounds: &[[Vec3; 2]] = if CULL { &self.prim_bounds[..n] } else { &[] };
+        (stamps, stamp, bounds)
+    }
+
     /// The nearest hit of one ray. `MB`: mailboxes on (`mb` then holds one); `CULL`: voxel
     /// culling on. Each switch is a constant of the instance, so the loop over a cell's
     /// references tests neither.
@@ -128,7 +142,7 @@ impl Grid {
                 mb.next_ray();
             }
             let g = &self.cells;
-            let bounds = &self.prim_bounds;
+            let (stamps, stamp, bounds) = self.per_prim::<MB, CULL>(mb, prims.len());
             let mut n = WalkCounts::default();
             let mut hits = 0;
             // The walk covers the segment left after the floor.
@@ -146,7 +160,10 @@ impl Grid {
                     (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
-                    if MB && mb.tested(p) {
+                    // Indexed once here: `stamps` and `bounds` have this length, so their own
+                    // checks fold into this one.
+                    let prim = &prims[p as usize];
+                    if MB && stamps[p as usize] == stamp {
                         n.mailbox_skips += 1;
                         continue;
                     }
@@ -158,10 +175,10 @@ impl Grid {
                         }
                     }
                     if MB {
-                        mb.mark(p);
+                        stamps[p as usize] = stamp;
                     }
                     n.tests += 1;
-                    if let Some((t, u, v)) = prims[p as usize].intersect(&r, test, &s.wt) {
+                    if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
                         hits += 1;
                         (r.tmax, best, bu, bv) = (t, p, u, v);
                     }
@@ -229,7 +246,7 @@ impl Grid {
         }
         if blocker == u32::MAX && !self.cells.refs.is_empty() {
             let g = &self.cells;
-            let bounds = &self.prim_bounds;
+            let (stamps, stamp, bounds) = self.per_prim::<MB, CULL>(mb, prims.len());
             let mut n = WalkCounts::default();
             self.walk(ray, |cell, t_enter, t_exit| {
                 n.cells += 1;
@@ -244,7 +261,10 @@ impl Grid {
                     (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
-                    if MB && mb.tested(p) {
+                    // Indexed once here: `stamps` and `bounds` have this length, so their own
+                    // checks fold into this one.
+                    let prim = &prims[p as usize];
+                    if MB && stamps[p as usize] == stamp {
                         n.mailbox_skips += 1;
                         continue;
                     }
@@ -256,10 +276,10 @@ impl Grid {
                         }
                     }
                     if MB {
-                        mb.mark(p);
+                        stamps[p as usize] = stamp;
                     }
                     n.tests += 1;
-                    if prims[p as usize].intersect(ray, test, &s.wt).is_some() {
+                    if prim.intersect(ray, test, &s.wt).is_some() {
                         blocker = p;
                         return true;
                     }
