@@ -240,10 +240,12 @@ pub struct PlanArgs {
     /// Skip the cross-check against Embree.
     #[arg(long)]
     pub no_check: bool,
-    /// In every run, also time N back-to-back pairs of the engine and Embree in one process
-    /// (alternating which goes first); `compare` then uses these ratios, which a burst of load
-    /// on a shared machine moves far less than the ratio of two separate runs.
-    #[arg(long, default_value_t = 0)]
+    /// In every run of an engine other than Embree, also time N back-to-back pairs of the engine
+    /// and Embree in one process (alternating which goes first); `report` shows their ratio and
+    /// `compare` judges on it: load on the machine and the state of one process move it far less
+    /// than the ratio of two separate runs. 0 turns pairs off (and with --no-check, Embree is not
+    /// built at all).
+    #[arg(long, default_value_t = 5)]
     pub paired: u32,
     /// In every run at more than one thread, also time N back-to-back pairs of the same trace at
     /// one thread and at the run's threads in one process (alternating which goes first), and

@@ -47,6 +47,12 @@ fn plant(spec: &str) -> bool {
                     && !s.is_empty()
                     && f.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)
             }
+            ["time", e, s, f] => {
+                !e.is_empty()
+                    && !s.is_empty()
+                    && f.parse::<f64>()
+                        .is_ok_and(|f| f.is_finite() && f > 0.0 && f <= 10.0)
+            }
             ["counter", e, s] => !e.is_empty() && !s.is_empty(),
             _ => false,
         }
@@ -95,8 +101,9 @@ pub const VARS: &[Var] = &[
     },
     Var {
         name: "RTBENCH_PLANT",
-        forms: "work:ENGINE:SCENE:FRACTION or counter:ENGINE:SCENE, several joined by ';' \
-                (SCENE a program or *, FRACTION above 0)",
+        forms:
+            "work:ENGINE:SCENE:FRACTION, time:ENGINE:SCENE:FRACTION or counter:ENGINE:SCENE, \
+                several joined by ';' (SCENE a program or *; FRACTION above 0, for time at most 10)",
         about: "plants a regression in an engine, to measure whether compare and the nightly \
                 find it",
         check: plant,
