@@ -30,7 +30,7 @@ use crate::engine::Counters;
 use crate::geometry::dda;
 use crate::geometry::kernels::f32::WatertightRay;
 use crate::ray::{Hit, Ray};
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 /// Per-ray set-up shared by every primitive test.
 pub(super) struct RaySetup {
@@ -71,13 +71,18 @@ impl WalkCounts {
     }
 }
 
-/// Whether the box `b` lies apart from `piece` along some axis: `Vec3::cmpgt(..).any()` of
-/// either side, the same answer (a NaN compares false either way), as two four-wide compares
-/// and one mask rather than six scalar compares.
+/// Whether the box `b` lies apart from `piece` along some axis (`Vec3::cmpgt(..).any()` of
+/// either side, the same answer: a NaN compares false either way), without the six
+/// short-circuit branches `any() || any()` compiled to.
 #[inline(always)]
-fn apart(b: &[Vec3; 2], piece: &(Vec3A, Vec3A)) -> bool {
-    let (lo, hi) = (Vec3A::from(b[0]), Vec3A::from(b[1]));
-    (lo.cmpgt(piece.1) | hi.cmplt(piece.0)).any()
+fn apart(b: &[Vec3; 2], piece: &(Vec3, Vec3)) -> bool {
+    let ([lo, hi], (plo, phi)) = (b, piece);
+    (lo.x > phi.x)
+        | (lo.y > phi.y)
+        | (lo.z > phi.z)
+        | (hi.x < plo.x)
+        | (hi.y < plo.y)
+        | (hi.z < plo.z)
 }
 
 impl Grid {
@@ -152,7 +157,7 @@ impl Grid {
                 let piece = if CULL {
                     segment_box(&r, t_enter, t_exit.min(r.tmax), g.pad)
                 } else {
-                    (Vec3A::ZERO, Vec3A::ZERO)
+                    (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
                     // Indexed once here: `stamps` and `bounds` have this length, so their own
@@ -253,7 +258,7 @@ impl Grid {
                 let piece = if CULL {
                     segment_box(ray, t_enter, t_exit, g.pad)
                 } else {
-                    (Vec3A::ZERO, Vec3A::ZERO)
+                    (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
                     // Indexed once here: `stamps` and `bounds` have this length, so their own
@@ -296,13 +301,12 @@ impl Grid {
     }
 }
 
-/// The bounding box of the ray's piece from `t0` to `t1`, grown by `pad` against rounding
-/// (computed in `Vec3`, then widened for [`apart`]'s four-wide compares).
+/// The bounding box of the ray's piece from `t0` to `t1`, grown by `pad` against rounding.
 #[inline(always)]
-fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3A, Vec3A) {
+fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3, Vec3) {
     let a = ray.at(t0);
     let b = ray.at(t1);
-    (Vec3A::from(a.min(b) - pad), Vec3A::from(a.max(b) + pad))
+    (a.min(b) - pad, a.max(b) + pad)
 }
 
 /// The cells a ray visits, in order, as (x, y, z): for tests and debugging (seed 002 §1.7's
