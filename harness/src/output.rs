@@ -96,9 +96,11 @@ pub fn print_json(v: &serde_json::Value) {
     );
 }
 
-/// A temporary file being written is removed if the process is interrupted (SIGINT, SIGTERM,
-/// SIGHUP) before it is renamed into place: the handler unlinks it (async-signal-safe) and then
-/// dies of the signal as it would have. One file at a time, the latest registered.
+/// A temporary file or directory being written is removed if the process is interrupted (SIGINT,
+/// SIGTERM, SIGHUP) before it is renamed into place: the handler unlinks the file, or runs
+/// `rm -rf` on the directory (fork, execve and waitpid are async-signal-safe where walking a
+/// directory is not), and then dies of the signal as it would have. One file and one directory at
+/// a time, the latest registered.
 pub mod interrupt {
     use std::ffi::{c_char, c_int, CString};
     use std::path::Path;
@@ -106,14 +108,37 @@ pub mod interrupt {
     use std::sync::Once;
 
     static TEMP: AtomicPtr<c_char> = AtomicPtr::new(std::ptr::null_mut());
+    static TEMP_DIR: AtomicPtr<c_char> = AtomicPtr::new(std::ptr::null_mut());
     static INSTALL: Once = Once::new();
 
     extern "C" fn on_signal(sig: c_int) {
         let p = TEMP.swap(std::ptr::null_mut(), Ordering::SeqCst);
-        // SAFETY: unlink, signal and raise are async-signal-safe; `p` is a leaked CString.
+        let d = TEMP_DIR.swap(std::ptr::null_mut(), Ordering::SeqCst);
+        // SAFETY: unlink, fork, execve, _exit, waitpid, signal and raise are async-signal-safe;
+        // `p` and `d` are leaked CStrings, and the argument vector lives on this stack frame.
         unsafe {
             if !p.is_null() {
                 libc::unlink(p);
+            }
+            if !d.is_null() {
+                let argv: [*const c_char; 5] = [
+                    c"rm".as_ptr(),
+                    c"-rf".as_ptr(),
+                    c"--".as_ptr(),
+                    d,
+                    std::ptr::null(),
+                ];
+                let env: [*const c_char; 1] = [std::ptr::null()];
+                match libc::fork() {
+                    0 => {
+                        libc::execve(c"/bin/rm".as_ptr(), argv.as_ptr(), env.as_ptr());
+                        libc::_exit(127);
+                    }
+                    pid if pid > 0 => {
+                        libc::waitpid(pid, std::ptr::null_mut(), 0);
+                    }
+                    _ => {}
+                }
             }
             libc::signal(sig, libc::SIG_DFL);
             libc::raise(sig);
@@ -121,11 +146,12 @@ pub mod interrupt {
     }
 
     /// Clears the registration when the write is over.
-    pub struct Guard(*mut c_char);
+    pub struct Guard(*mut c_char, &'static AtomicPtr<c_char>);
 
     impl Drop for Guard {
         fn drop(&mut self) {
-            if TEMP
+            if self
+                .1
                 .compare_exchange(
                     self.0,
                     std::ptr::null_mut(),
@@ -140,7 +166,18 @@ pub mod interrupt {
         }
     }
 
+    /// Removes the file `path` if a signal ends the process before the guard is dropped.
     pub fn remove_on_signal(path: &Path) -> Guard {
+        register(path, &TEMP)
+    }
+
+    /// Removes the directory `path` and everything in it if a signal ends the process before the
+    /// guard is dropped.
+    pub fn remove_dir_on_signal(path: &Path) -> Guard {
+        register(path, &TEMP_DIR)
+    }
+
+    fn register(path: &Path, slot: &'static AtomicPtr<c_char>) -> Guard {
         use std::os::unix::ffi::OsStrExt;
         INSTALL.call_once(|| {
             for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
@@ -154,8 +191,8 @@ pub mod interrupt {
             .unwrap_or_default()
             .into_raw();
         // The previous registration (a write still under way elsewhere) is left to its guard.
-        TEMP.store(c, Ordering::SeqCst);
-        Guard(c)
+        slot.store(c, Ordering::SeqCst);
+        Guard(c, slot)
     }
 }
 

@@ -275,3 +275,110 @@ fn check_suite_hard_runs_with_its_default_engines() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(!err.contains("plugin"), "{err}");
 }
+
+#[test]
+fn an_interrupted_store_leaves_no_temporary_directory() {
+    let d = dir("sigterm");
+    let out = d.join("st");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtbench"))
+        .args(["scene", "store", "tetra", "--sf", "9", "-o"])
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("rtbench starts");
+    // Wait until the temporary directory exists, then interrupt the write.
+    let started = std::time::Instant::now();
+    let tmp_exists = || {
+        std::fs::read_dir(&d).unwrap().any(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(".st.tmp-")
+        })
+    };
+    while !tmp_exists() && started.elapsed().as_secs() < 60 {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    // SAFETY: sending a signal to our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    let left: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    if status.success() {
+        // Finished before the signal: the store is whole and nothing else is left.
+        assert_eq!(left, ["st"], "{left:?}");
+    } else {
+        assert!(left.is_empty(), "left behind: {left:?}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_merged_night_is_recorded_once() {
+    let d = dir("from-twice");
+    let suite = d.join("tiny.toml");
+    std::fs::write(
+        &suite,
+        "name = \"tiny\"\nengines = [\"embree\", \"grid\"]\nscenes = [\"tetra\"]\nsf = [1]\n\
+         repeats = 2\npaired = 2\nsize = 16\ngate = [\"counters\", \"time_ratio\"]\n",
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_rtbench"))
+            .args(args)
+            .env_remove("RTBENCH_PLANT")
+            .output()
+            .expect("rtbench runs")
+    };
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    for k in ["1/2", "2/2"] {
+        let out = d.join(format!("shard{}", &k[..1]));
+        let o = run(&[
+            "nightly",
+            "--suite",
+            &s(&suite),
+            "--shard",
+            k,
+            "--out",
+            &s(&out),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let merged = d.join("merged");
+    let o = run(&[
+        "merge",
+        &s(&d.join("shard1")),
+        &s(&d.join("shard2")),
+        "--out",
+        &s(&merged),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let db = d.join("h.sqlite");
+    let record = || {
+        run(&[
+            "nightly",
+            "--suite",
+            &s(&suite),
+            "--from",
+            &s(&merged),
+            "--db",
+            &s(&db),
+        ])
+    };
+    let first = record();
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    one_line_exit_2(&record(), "is already night 1");
+    let list = run(&["history", "list", "--db", &s(&db), "--json"]);
+    let nights: serde_json::Value = serde_json::from_slice(&list.stdout).unwrap();
+    assert_eq!(nights.as_array().map(Vec::len), Some(1), "{nights}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -279,6 +279,7 @@ pub fn store(
         let _ = std::fs::remove_dir_all(&tmp);
         input(e)
     };
+    let _interrupted = crate::output::interrupt::remove_dir_on_signal(&tmp);
     let mut w = StoreWriter::create_with(&tmp, &src.label(), layout, codec)
         .map_err(|e| cleanup(format!("{}: cannot write: {e}", out.display())))?;
     let mut capped = CappedStore {
