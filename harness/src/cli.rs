@@ -211,6 +211,10 @@ pub enum HistoryCommand {
         /// The folder the dashboard (index.html) is written to.
         #[arg(long)]
         out: PathBuf,
+        /// Link each commit id through this URL, `{commit}` replaced by the id (none by default;
+        /// a suite's `commit_url` does the same for the nightly's copy).
+        #[arg(long, value_name = "TEMPLATE")]
+        commit_url: Option<String>,
     },
 }
 

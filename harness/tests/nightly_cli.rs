@@ -1,6 +1,7 @@
 //! `rtbench nightly` and `rtbench history` as a nightly job uses them: a tiny suite over a few
 //! nights, bad suites and bad databases (exit 2, one line), a planted counter change (exit 1,
-//! named), exports, and the dashboard loaded in headless Chromium without console messages.
+//! named), exports, and the dashboard loaded in headless Chromium: its plots, links and a
+//! regression mark.
 
 mod common;
 
@@ -222,15 +223,44 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
         "{text}"
     );
 
-    // The dashboard, in headless Chromium.
+    // The dashboard, in headless Chromium, after a fifth night with a planted counter change
+    // (recorded: a regression on night 5).
+    let o = nightly(&suite, &db, &[], Some("counter:grid:tetra"));
+    assert_eq!(o.status.code(), Some(1));
+    let list = rtbench(&["history", "list", "--db", db.to_str().unwrap(), "--json"]);
+    let runs: Value = serde_json::from_slice(&list.stdout).unwrap();
+    let commit = runs[4]["git_commit"].as_str().unwrap().to_string();
+    let night = runs[4]["id"].as_i64().unwrap();
     let out = d.join("dash");
-    let o = rtbench(&[
-        "history",
-        "dashboard",
-        "--db",
-        db.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
+    let dash = |extra: &[&str]| {
+        let mut args = vec![
+            "history",
+            "dashboard",
+            "--db",
+            db.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        rtbench(&args)
+    };
+    // A template that cannot make a link is refused.
+    expect_input_error(
+        &[
+            "history",
+            "dashboard",
+            "--db",
+            db.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--commit-url",
+            "https://example.org/commit/",
+        ],
+        "expected an http(s) URL holding {commit}",
+    );
+    let o = dash(&[
+        "--commit-url",
+        "https://git.example.org/rtbench/commit/{commit}",
     ]);
     assert_eq!(
         o.status.code(),
@@ -238,7 +268,11 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    dashboard_loads_without_console_messages(&out.join("index.html"), &d);
+    let page = out.join("index.html");
+    let show = rtbench(&["history", "show", "--db", db.to_str().unwrap(), "--json"]);
+    let v: Value = serde_json::from_slice(&show.stdout).unwrap();
+    let metrics = v["metrics"].as_array().unwrap().len();
+    dashboard_in_chromium(&page, &d, metrics, &commit, night);
 }
 
 /// Loads a page in headless Chromium; returns its DOM and the console lines Chromium logged.
@@ -267,7 +301,10 @@ fn chromium(page: &Path, profile: &Path) -> Option<(String, Vec<String>)> {
     Some((String::from_utf8_lossy(&o.stdout).into_owned(), console))
 }
 
-fn dashboard_loads_without_console_messages(page: &Path, dir: &Path) {
+/// The dashboard in headless Chromium: no console message; one drawn plot per metric, every kind
+/// among them; the planted counter's plot marked as that night's regression; commit ids linked
+/// through the template, in the nights table and in the hover line of a night named in the address.
+fn dashboard_in_chromium(page: &Path, dir: &Path, metrics: usize, commit: &str, night: i64) {
     if std::env::var_os("RTBENCH_SKIP_CHROMIUM").is_some() {
         eprintln!("RTBENCH_SKIP_CHROMIUM set: the dashboard was not loaded in Chromium");
         return;
@@ -287,11 +324,45 @@ fn dashboard_loads_without_console_messages(page: &Path, dir: &Path) {
         msgs.iter().any(|m| m.contains("canary")),
         "the canary error was not seen: {msgs:?}"
     );
-    let (dom, msgs) = chromium(page, &dir.join("profile")).unwrap();
+    let address = format!("{}?night={night}", page.display());
+    let (dom, msgs) = chromium(Path::new(&address), &dir.join("profile")).unwrap();
     assert!(msgs.is_empty(), "console messages: {msgs:?}");
-    assert!(
-        dom.contains("rtbench nightly") && dom.contains("<svg"),
-        "{}",
-        &dom[..dom.len().min(400)]
+    let head = &dom[..dom.len().min(400)];
+    assert!(dom.contains("rtbench nightly: tiny"), "{head}");
+    // One section per metric, and uPlot drew a plot in each of them.
+    let sections = dom.matches("<section class=\"plot\"").count();
+    assert_eq!(sections, metrics, "{head}");
+    assert_eq!(
+        dom.matches("<div class=\"uplot").count(),
+        sections,
+        "{head}"
     );
+    for kind in ["time_ratio", "counter"] {
+        assert!(
+            dom.contains(&format!("data-kind=\"{kind}\"")),
+            "no {kind} plot"
+        );
+    }
+    // The regression mark on the planted counter's plot.
+    let name = "grid tetra1@1/counter.primitive_tests";
+    let at = dom
+        .find(&format!("data-name=\"{name}\""))
+        .unwrap_or_else(|| panic!("no plot of {name}"));
+    let plot = &dom[at..at + dom[at..].find("</section>").unwrap()];
+    assert!(plot.contains("data-flag=\"regression\""), "{plot}");
+    assert!(
+        plot.contains(&format!("<span class=\"mark regression\"")),
+        "{plot}"
+    );
+    assert!(
+        plot.contains(&format!("regression night {night}")),
+        "{plot}"
+    );
+    // Commit links: in the nights table and in the held hover line, with the night's value.
+    let link = format!("href=\"https://git.example.org/rtbench/commit/{commit}\"");
+    assert!(dom.matches(&link).count() > sections, "{head}");
+    let hover = &plot[plot.find("<p class=\"hover\">").expect("a hover line")..];
+    assert!(hover.contains(&format!("night {night} (")), "{hover}");
+    assert!(hover.contains(&link), "{hover}");
+    assert!(hover.contains("regression: "), "{hover}");
 }

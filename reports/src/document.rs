@@ -14,6 +14,7 @@
 //! assert!(doc.to_html().contains("<td class=\"n\">263169</td>"));
 //! ```
 
+use maud::{html, Markup, PreEscaped, Render, DOCTYPE};
 use std::fmt::Write;
 
 /// A table with a caption (a heading above it, empty for none), ready for Markdown or HTML.
@@ -75,29 +76,32 @@ impl Table {
     }
 
     pub fn to_html(&self) -> String {
-        let mut s = String::new();
-        if !self.caption.is_empty() {
-            let _ = writeln!(s, "<h2>{}</h2>", escape(&self.caption));
-        }
-        s.push_str("<table>\n<thead><tr>");
-        for h in &self.header {
-            let _ = write!(s, "<th>{}</th>", inline_html(h));
-        }
-        s.push_str("</tr></thead>\n<tbody>\n");
-        for row in &self.rows {
-            s.push_str("<tr>");
-            for (i, cell) in row.iter().enumerate() {
-                let class = if self.numeric.get(i) == Some(&true) {
-                    " class=\"n\""
-                } else {
-                    ""
-                };
-                let _ = write!(s, "<td{class}>{}</td>", inline_html(cell));
+        self.markup().into_string()
+    }
+
+    /// The table as markup, its caption a heading above it.
+    pub fn markup(&self) -> Markup {
+        html! {
+            @if !self.caption.is_empty() {
+                h2 { (self.caption) }
             }
-            s.push_str("</tr>\n");
+            table {
+                thead { tr { @for h in &self.header { th { (Inline(h)) } } } }
+                tbody {
+                    @for row in &self.rows {
+                        tr {
+                            @for (i, cell) in row.iter().enumerate() {
+                                @if self.numeric.get(i) == Some(&true) {
+                                    td.n { (Inline(cell)) }
+                                } @else {
+                                    td { (Inline(cell)) }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
         }
-        s.push_str("</tbody>\n</table>\n");
-        s
     }
 }
 
@@ -183,39 +187,37 @@ impl Document {
 
     /// One self-contained page (no script, no external resource).
     pub fn to_html(&self) -> String {
-        let mut s = format!(
-            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{t}</title>\n\
-             <style>{STYLE}</style>\n</head>\n<body>\n<h1>{t}</h1>\n",
-            t = escape(&self.title)
-        );
-        for b in &self.blocks {
-            match b {
-                Block::Heading(h) => {
-                    let _ = writeln!(s, "<h2>{}</h2>", inline_html(h));
-                }
-                Block::Paragraph(p) => {
-                    let _ = writeln!(s, "<p>{}</p>", inline_html(p));
-                }
-                Block::List(items) => {
-                    s.push_str("<ul>\n");
-                    for i in items {
-                        let _ = writeln!(s, "<li>{}</li>", inline_html(i));
-                    }
-                    s.push_str("</ul>\n");
-                }
-                Block::Table(t) => s.push_str(&t.to_html()),
-                Block::Figure { path, caption } => {
-                    let _ = writeln!(
-                        s,
-                        "<figure><img src=\"{}\" alt=\"{c}\"><figcaption>{c}</figcaption></figure>",
-                        escape(path),
-                        c = escape(caption)
-                    );
+        let body = html! {
+            h1 { (self.title) }
+            @for b in &self.blocks {
+                @match b {
+                    Block::Heading(h) => h2 { (Inline(h)) },
+                    Block::Paragraph(p) => p { (Inline(p)) },
+                    Block::List(items) => ul { @for i in items { li { (Inline(i)) } } },
+                    Block::Table(t) => (t.markup()),
+                    Block::Figure { path, caption } => figure {
+                        img src=(path) alt=(caption);
+                        figcaption { (caption) }
+                    },
                 }
             }
+        };
+        page(&self.title, body).into_string()
+    }
+}
+
+/// A self-contained page: the shared style, this title and body.
+pub(crate) fn page(title: &str, body: Markup) -> Markup {
+    html! {
+        (DOCTYPE)
+        html lang="en" {
+            head {
+                meta charset="utf-8";
+                title { (title) }
+                style { (PreEscaped(STYLE)) }
+            }
+            body { (body) }
         }
-        s.push_str("</body>\n</html>\n");
-        s
     }
 }
 
@@ -230,31 +232,24 @@ pub(crate) fn md_cell(text: &str) -> String {
     text.replace('|', "\\|").replace('\n', " ")
 }
 
-pub fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
+/// Text with the inline Markdown the documents use (`code` and **bold**) rendered as markup; the
+/// text itself is escaped by maud.
+pub struct Inline<'a>(pub &'a str);
 
-/// Escapes text, then renders the inline Markdown the documents use: `code` and **bold**.
-pub fn inline_html(text: &str) -> String {
-    let escaped = escape(text);
-    let mut out = String::with_capacity(escaped.len());
-    for (i, part) in escaped.split('`').enumerate() {
-        if i % 2 == 1 {
-            let _ = write!(out, "<code>{part}</code>");
-        } else {
-            for (j, p) in part.split("**").enumerate() {
-                if j % 2 == 1 {
-                    let _ = write!(out, "<b>{p}</b>");
-                } else {
-                    out.push_str(p);
+impl Render for Inline<'_> {
+    fn render(&self) -> Markup {
+        html! {
+            @for (i, part) in self.0.split('`').enumerate() {
+                @if i % 2 == 1 {
+                    code { (part) }
+                } @else {
+                    @for (j, p) in part.split("**").enumerate() {
+                        @if j % 2 == 1 { b { (p) } } @else { (p) }
+                    }
                 }
             }
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! | `wide` | `collapse` (binary tree collapsed to N-wide), `direct` (001's own N-ary builders) | `collapse` |
 //! | `leaf` | most primitives per leaf, 1–16 (001 uses 1) | 1 for bvh2, 4 for bvh4/bvh8 |
 //! | `simd` | `on`, `off` (bvh4: SSE, with FMA when the CPU has AVX2 + FMA; bvh8: AVX2 + FMA) | `on` (bvh2: `off`) |
+//! | `isa` | `auto`: the widest instruction set the CPU has; `avx2`: AVX2 + FMA even where AVX-512 is there; `avx512`: the same traversal compiled with AVX-512 (F, VL, BW, DQ: 32 vector registers, comparisons into mask registers), where the CPU has it (else AVX2; `build_stats.avx512` says which ran). The same operations in the same order either way, so the same hits, counters and images | `auto` |
 //! | `triangle` | `watertight`, `moller` | `watertight` |
 //! | `bins` | bins per axis of the binned SAH, 2–256 | 32 |
 //! | `packets` | `on`: leaves of triangles only store them in packets of 4 tested with one SIMD test (`leaf.rs`), and only triangles share leaves (spheres and cones get one leaf each, `collapse.rs`); `off`: every primitive tested on its own | `on` (bvh2: `off`) |
@@ -33,6 +34,29 @@ use super::tree::MAX_WIDTH;
 use crate::engine::{EngineError, Settings};
 use crate::geometry::TriangleTest;
 use std::str::FromStr;
+
+/// Which instruction set the SIMD traversal is compiled for (`isa`; `simd=on` only).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// AVX-512 where the CPU has it, else AVX2 + FMA.
+    Auto,
+    /// AVX2 + FMA.
+    Avx2,
+    /// AVX-512 F, VL, BW and DQ where the CPU has them, else AVX2 + FMA.
+    Avx512,
+}
+
+impl FromStr for Isa {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Isa::Auto),
+            "avx2" => Ok(Isa::Avx2),
+            "avx512" => Ok(Isa::Avx512),
+            _ => Err("expected auto, avx2 or avx512".into()),
+        }
+    }
+}
 
 /// How the binary tree (or, with `wide=direct`, the N-ary tree) is split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,6 +145,8 @@ pub struct Config {
     pub wide: WideMethod,
     pub leaf: usize,
     pub simd: bool,
+    /// The instruction set of the SIMD traversal.
+    pub isa: Isa,
     pub triangle: TriangleTest,
     pub bins: usize,
     pub packets: bool,
@@ -161,6 +187,7 @@ impl Config {
             4
         };
         let simd = settings.get("simd", OnOff(width > 2))?.0;
+        let isa = settings.get("isa", Isa::Auto)?;
         let triangle = settings.get("triangle", TriangleTest::default())?;
         let bins = settings.get("bins", 32usize)?;
         let packets = settings.get("packets", OnOff(width > 2))?.0;
@@ -244,6 +271,7 @@ impl Config {
             wide,
             leaf,
             simd,
+            isa,
             triangle,
             bins,
             packets,
@@ -300,6 +328,15 @@ mod tests {
         assert!(parse(8, &[("leaf", "17")]).is_err());
         assert!(parse(8, &[("builder", "kd")]).is_err());
         assert!(parse(2, &[("simd", "on")]).is_err());
+        assert_eq!(parse(8, &[]).unwrap().isa, Isa::Auto);
+        for (v, isa) in [
+            ("auto", Isa::Auto),
+            ("avx2", Isa::Avx2),
+            ("avx512", Isa::Avx512),
+        ] {
+            assert_eq!(parse(4, &[("isa", v)]).unwrap().isa, isa);
+        }
+        assert!(parse(8, &[("isa", "sse9")]).is_err());
         assert_eq!((c.packets, c.split_leaves), (true, false));
         let c = parse(4, &[("packets", "off")]).unwrap();
         assert_eq!((c.packets, c.split_leaves), (false, true));

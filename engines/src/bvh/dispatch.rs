@@ -2,6 +2,13 @@
 //! which triangle packet kernel a tree of width N is traversed with, chosen at run time with
 //! `is_x86_feature_detected!`. The whole traversal loop is compiled inside a
 //! `#[target_feature]` function for AVX2 so the box test's intrinsics inline.
+//!
+//! On CPUs with AVX-512 (F, VL, BW, DQ) the same AVX2 traversal is also compiled with those
+//! enabled (`isa=auto|avx512`): the source and its operations are the same, so hits, counters
+//! and images are the same bits, but the compiler then has 32 vector registers instead of 16
+//! and compares into mask registers. The AVX2 loops spill: the bvh8 any-hit kernel read or
+//! wrote a vector on the stack in 867 of its ~7,000 instructions (objdump), mostly the
+//! watertight triangle test's 20-odd live lanes.
 
 use super::box_test::ScalarPerBox;
 use super::traverse::{self, Bvh};
@@ -91,6 +98,57 @@ pub fn avx8() -> Option<Kernels<8>> {
     }
 }
 
+/// Whether the CPU has the AVX-512 subsets the `avx512` kernels are compiled with (and AVX2
+/// and FMA, which the same code also uses).
+pub fn avx512_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        Avx8::available()
+            && is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx512dq")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// [`sse4`]'s AVX2 + FMA kernels compiled with AVX-512 too, when the CPU has it.
+pub fn sse4_avx512() -> Option<Kernels<4>> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx512_available().then_some(Kernels {
+            closest: x86::fma4_512_closest,
+            any: x86::fma4_512_any,
+            lanes: 4,
+            name: "sse+fma, avx512",
+        })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        None
+    }
+}
+
+/// [`avx8`]'s kernels compiled with AVX-512 too, when the CPU has it.
+pub fn avx8_avx512() -> Option<Kernels<8>> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx512_available().then_some(Kernels {
+            closest: x86::avx8_512_closest,
+            any: x86::avx8_512_any,
+            lanes: 8,
+            name: "avx2, avx512",
+        })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        None
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::traverse::{self, Bvh};
@@ -103,6 +161,50 @@ mod x86 {
     /// box test's intrinsics (and the leaf kernels) inline into it.
     macro_rules! avx2_entry {
         ($closest:ident, $closest_impl:ident, $any:ident, $any_impl:ident, $n:literal, $test:ty) => {
+            simd_entry!(
+                $closest,
+                $closest_impl,
+                $any,
+                $any_impl,
+                $n,
+                $test,
+                "avx2,fma",
+                Avx8::available(),
+                "this kernel needs AVX2 and FMA"
+            );
+        };
+    }
+
+    /// [`avx2_entry`]'s kernels compiled with AVX-512 F, VL, BW and DQ as well (the same
+    /// source: only the registers and encodings the compiler may use differ).
+    macro_rules! avx512_entry {
+        ($closest:ident, $closest_impl:ident, $any:ident, $any_impl:ident, $n:literal, $test:ty) => {
+            simd_entry!(
+                $closest,
+                $closest_impl,
+                $any,
+                $any_impl,
+                $n,
+                $test,
+                "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq",
+                super::avx512_available(),
+                "this kernel needs AVX2, FMA and AVX-512 F, VL, BW, DQ"
+            );
+        };
+    }
+
+    macro_rules! simd_entry {
+        (
+            $closest:ident,
+            $closest_impl:ident,
+            $any:ident,
+            $any_impl:ident,
+            $n:literal,
+            $test:ty,
+            $features:literal,
+            $available:expr,
+            $needs:literal
+        ) => {
             pub fn $closest(
                 bvh: &Bvh<$n>,
                 rays: &[Ray],
@@ -110,8 +212,8 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                assert!(Avx8::available(), "this kernel needs AVX2 and FMA");
-                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
+                assert!($available, $needs);
+                // SAFETY: the CPU has the features (asserted above), all the callee requires.
                 unsafe { $closest_impl(bvh, rays, hits, t, c) }
             }
 
@@ -122,12 +224,12 @@ mod x86 {
                 t: TriangleTest,
                 c: &mut Counters,
             ) {
-                assert!(Avx8::available(), "this kernel needs AVX2 and FMA");
-                // SAFETY: the CPU has AVX2 and FMA (asserted above), all the callee requires.
+                assert!($available, $needs);
+                // SAFETY: the CPU has the features (asserted above), all the callee requires.
                 unsafe { $any_impl(bvh, rays, out, t, c) }
             }
 
-            #[target_feature(enable = "avx2,fma")]
+            #[target_feature(enable = $features)]
             unsafe fn $closest_impl(
                 bvh: &Bvh<$n>,
                 rays: &[Ray],
@@ -138,7 +240,7 @@ mod x86 {
                 traverse::closest_batch::<$n, $test, Avx8>(bvh, rays, hits, t, c)
             }
 
-            #[target_feature(enable = "avx2,fma")]
+            #[target_feature(enable = $features)]
             unsafe fn $any_impl(
                 bvh: &Bvh<$n>,
                 rays: &[Ray],
@@ -164,6 +266,22 @@ mod x86 {
         fma4_closest_impl,
         fma4_any,
         fma4_any_impl,
+        4,
+        Sse4<true>
+    );
+    avx512_entry!(
+        avx8_512_closest,
+        avx8_512_closest_impl,
+        avx8_512_any,
+        avx8_512_any_impl,
+        8,
+        Avx8
+    );
+    avx512_entry!(
+        fma4_512_closest,
+        fma4_512_closest_impl,
+        fma4_512_any,
+        fma4_512_any_impl,
         4,
         Sse4<true>
     );
@@ -249,9 +367,12 @@ mod tests {
         for k in &fours {
             assert_eq!(run(&bvh4, k, &rays), want4, "{}", k.name);
         }
+        if let Some(k) = sse4_avx512() {
+            assert_eq!(run(&bvh4, &k, &rays), want4, "{}", k.name);
+        }
         let (bvh8, _) = build_bvh::<8>(&g, &config(8)).unwrap();
         let want8 = run(&bvh8, &scalar::<8>(), &rays);
-        if let Some(k) = avx8() {
+        for k in avx8().into_iter().chain(avx8_avx512()) {
             assert_eq!(run(&bvh8, &k, &rays), want8, "{}", k.name);
         }
     }

@@ -47,7 +47,7 @@ pub fn info2() -> EngineInfo {
         description:
             "binary BVH (seed 001): object median, full-sweep or binned SAH; scalar traversal",
         available: || Ok(()),
-        build: |input, settings| build_engine::<2>(input, settings, || None),
+        build: |input, settings| build_engine::<2>(input, settings, || None, || None),
     }
 }
 
@@ -56,7 +56,9 @@ pub fn info4() -> EngineInfo {
         name: "bvh4",
         description: "4-wide BVH (seed 001), children's boxes side by side, SSE ray-4-box test",
         available: || Ok(()),
-        build: |input, settings| build_engine::<4>(input, settings, dispatch::sse4),
+        build: |input, settings| {
+            build_engine::<4>(input, settings, dispatch::sse4, dispatch::sse4_avx512)
+        },
     }
 }
 
@@ -65,7 +67,9 @@ pub fn info8() -> EngineInfo {
         name: "bvh8",
         description: "8-wide BVH, children's boxes side by side, AVX2 ray-8-box test",
         available: || Ok(()),
-        build: |input, settings| build_engine::<8>(input, settings, dispatch::avx8),
+        build: |input, settings| {
+            build_engine::<8>(input, settings, dispatch::avx8, dispatch::avx8_avx512)
+        },
     }
 }
 
@@ -324,6 +328,7 @@ fn build_engine<const N: usize>(
     input: &BuildInput,
     settings: Settings,
     simd_kernels: fn() -> Option<Kernels<N>>,
+    avx512_kernels: fn() -> Option<Kernels<N>>,
 ) -> Result<Box<dyn Engine>, EngineError> {
     const { assert!(N <= traverse::MAX_TRAVERSAL_WIDTH) };
     let config = Config::parse(N, settings)?;
@@ -332,7 +337,13 @@ fn build_engine<const N: usize>(
     let build_s = start.elapsed().as_secs_f64();
     // `simd=on` falls back to scalar on CPUs without the instructions (reported in stats).
     let kernels = if config.simd {
-        let single = simd_kernels().unwrap_or_else(dispatch::scalar::<N>);
+        let wide = match config.isa {
+            config::Isa::Avx2 => None,
+            config::Isa::Auto | config::Isa::Avx512 => avx512_kernels(),
+        };
+        let single = wide
+            .or_else(simd_kernels)
+            .unwrap_or_else(dispatch::scalar::<N>);
         packet::kernels::<N>(config.packet, config.packet_cull).unwrap_or(single)
     } else if !config.precompute {
         dispatch::scalar_per_box::<N>()
@@ -344,6 +355,10 @@ fn build_engine<const N: usize>(
     stats.insert("build_s".into(), build_s);
     stats.insert("leaf_size".into(), config.leaf as f64);
     stats.insert("simd_lanes".into(), kernels.lanes as f64);
+    stats.insert(
+        "avx512".into(),
+        kernels.name.contains("avx512") as u8 as f64,
+    );
     stats.insert(
         "packet_rays".into(),
         if kernels.name.contains("packets") {

@@ -111,9 +111,16 @@ pub fn run(c: &crate::cli::HistoryCommand) -> Result<()> {
                 problems[0]
             )))
         }
-        H::Dashboard { db, out } => {
+        H::Dashboard {
+            db,
+            out,
+            commit_url,
+        } => {
+            if let Some(t) = commit_url {
+                crate::history::dashboard::check_commit_url(t)?;
+            }
             let h = History::open_read(db)?;
-            crate::history::dashboard::write(&h, out)?;
+            crate::history::dashboard::write(&h, out, commit_url.as_deref())?;
             eprintln!("dashboard: {}", out.join("index.html").display());
             Ok(())
         }

@@ -113,7 +113,7 @@ pub fn run(a: &NightlyArgs) -> Result<()> {
         crate::output::write_atomic(&d.join("nightly.md"), |w| {
             std::io::Write::write_all(w, md.as_bytes())
         })?;
-        dashboard::write(&history, &d.join("dashboard"))?;
+        dashboard::write(&history, &d.join("dashboard"), suite.commit_url.as_deref())?;
         eprintln!(
             "nightly: summary {}, dashboard {}",
             d.join("nightly.md").display(),

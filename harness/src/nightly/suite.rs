@@ -57,6 +57,7 @@ struct RawSuite {
     baseline_nights: Option<usize>,
     confirm_nights: Option<u32>,
     max_seconds: Option<f64>,
+    commit_url: Option<String>,
     instructions: Option<RawInstructions>,
     criterion: Option<RawCriterion>,
 }
@@ -132,6 +133,8 @@ pub struct Suite {
     /// (reported, not failing) and the regression is reported when the next night confirms it.
     pub confirm_nights: u32,
     pub max_seconds: Option<f64>,
+    /// The dashboard's link of a commit: an http(s) URL holding `{commit}`.
+    pub commit_url: Option<String>,
     pub instructions: Option<Instructions>,
     pub criterion: Option<Criterion>,
 }
@@ -370,6 +373,10 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
     if let Some(s) = raw.max_seconds {
         positive(file, "max_seconds", s)?;
     }
+    if let Some(t) = &raw.commit_url {
+        crate::history::dashboard::check_commit_url(t)
+            .map_err(|e| input(format!("{file}: {e}")))?;
+    }
     let instructions = match raw.instructions {
         None => None,
         Some(i) => {
@@ -436,6 +443,7 @@ pub fn parse(file: &str, text: &str) -> Result<Suite> {
         baseline_nights,
         confirm_nights,
         max_seconds: raw.max_seconds,
+        commit_url: raw.commit_url,
         instructions,
         criterion,
     })
