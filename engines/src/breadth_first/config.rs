@@ -114,6 +114,25 @@ pub struct BreadthFirstConfig {
     pub max_passes: Option<u64>,
     /// One line on stderr after every pass (`progress=on`): a 10^9-object run takes hours.
     pub progress: bool,
+    /// What one call of an in-memory run holds (`batch=band|generation`).
+    pub batch: Batch,
+}
+
+/// What one call of the in-memory workload hands the engine ([`crate::Engine::batch_hint`]).
+///
+/// A whole generation is the thesis's procedure (Algorithm 3.6: every ray of a depth in one
+/// breadth-first trace); in core it makes the caller hold the whole generation too (its rays,
+/// paths and shadow rays: about 100 MB at 512² on balls4), and the engine as many rays as the
+/// generation has. A band of pixel rows, as the in-memory engines get, holds a few thousand
+/// rays at once; each call still sweeps the scene once per pass for all of its rays. The out-of-core
+/// workload ([`super::BreadthFirst::trace_stream`]) is not split either way: it fills the
+/// budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Batch {
+    /// The caller's bands of pixel rows, one call per band and query (the default).
+    Band,
+    /// Whole generations, one call per generation and query (seed 000's procedure in core).
+    Generation,
 }
 
 /// Hierarchy constants set by the user (`None`: the thesis's for the scene).
@@ -288,6 +307,11 @@ impl BreadthFirstConfig {
             "cold" => true,
             v => return Err(bad("cache", v, "warm or cold")),
         };
+        let batch = match s.get("batch", "band".to_string())?.as_str() {
+            "band" => Batch::Band,
+            "generation" => Batch::Generation,
+            v => return Err(bad("batch", v, "band or generation")),
+        };
         let grid = super::hires::config::GridKind::from_settings(&mut s)?;
         s.finish()?;
         if let super::hires::config::GridKind::TwoLevel(tl) = &grid {
@@ -351,6 +375,7 @@ impl BreadthFirstConfig {
             bh,
             cold,
             grid,
+            batch,
         })
     }
 }

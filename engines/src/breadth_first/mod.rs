@@ -12,7 +12,8 @@
 //!
 //! Built from a `BuildInput` (an in-memory scene) it first writes the scene as a store
 //! ([`crate::store`]) in its spill directory; [`BreadthFirst::open`] builds it from a store on
-//! disk. It answers a whole generation per call ([`Engine::batch_hint`] is `None`).
+//! disk. In memory it answers one band of pixel rows per call (`batch=band`, the in-memory
+//! engines' bands), or a whole generation (`batch=generation`, [`config::Batch`]).
 //!
 //! Settings (`key=value`):
 //!
@@ -47,6 +48,7 @@
 //! | `subspace` | voxels per side | what 1/4 of `memory` holds | a cubic preprocessing subspace (`two-level`) |
 //! | `hrgrid` | `build`, `reuse`, `resume` | `build` | make the on-disk grid `hrgrid.bin` in the store at preprocessing, or open the one there; `resume`: make it keeping `hrgrid.progress.json` after each subspace, and take up an interrupted or finished build of the same grid (its subspaces and seconds from the record: `hr_build_resumed_subspaces`, `hr_build_prior_s`, both counted in `hr_build_s` and `preprocess_s`) |
 //! | `hrgrid_subspaces` | a count | none | build only the first K subspaces of the on-disk grid, the rest left empty: a timing model of a build longer than one sitting, whose answers are not the scene's; needs `hrgrid=build` and `max_passes`, and the partial grid is removed from the store once opened (`hr_subspaces` built of `hr_subspaces_total`, `hr_build_partial`) |
+//! | `batch` | `band`, `generation` | `band` | what one call of an in-memory run holds: the caller's band of pixel rows (a few thousand rays; the caller holds no more), or a whole generation (seed 000's procedure, Algorithm 3.6; caller and engine hold every ray of the generation). The out-of-core workload fills the budget either way ([`config::Batch`]) |
 //! | `floor` | `out`, `in` | `out` | floor and backdrop polygons (the `grid` engine's test, on bounding boxes) in a group of their own, tested for every ray as it enters memory, and the grid fitted to the rest (§1.2: the thesis did so for balls and tree) |
 //!
 //! Counters: `rays`, `primitive_tests`, `primitive_hits`, `box_tests` (ray–bounding-box tests
@@ -599,7 +601,11 @@ impl Engine for BreadthFirst {
     }
 
     fn batch_hint(&self) -> Option<usize> {
-        None
+        match self.config.batch {
+            // One call per band and query: the band's rays are swept together.
+            config::Batch::Band => Some(usize::MAX),
+            config::Batch::Generation => None,
+        }
     }
 
     fn failure(&self) -> Option<String> {

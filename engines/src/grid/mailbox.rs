@@ -13,8 +13,8 @@ use std::sync::Mutex;
 
 /// Stamps of one batch: `stamps[p] == ray` when primitive p was tested against the current ray.
 pub struct Mailbox {
-    stamps: Vec<u32>,
-    ray: u32,
+    pub(super) stamps: Vec<u32>,
+    pub(super) ray: u32,
 }
 
 impl Mailbox {

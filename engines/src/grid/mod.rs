@@ -47,7 +47,7 @@ use crate::ray::{Hit, Ray};
 use build::Cells;
 use config::GridConfig;
 use glam::Vec3;
-use mailbox::MailboxPool;
+use mailbox::{Mailbox, MailboxPool};
 use shadow_cache::ShadowCache;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -170,31 +170,68 @@ impl Local {
     }
 }
 
-impl Engine for Grid {
-    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], c: &mut Counters) {
-        let mut mb = self.config.mailbox.then(|| self.mailboxes.take());
-        let mut l = Local::default();
+impl Grid {
+    /// Answers a batch of closest-hit queries with the walk's switches made constants.
+    fn intersect_with<const MB: bool, const CULL: bool>(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Hit],
+        mb: &mut Mailbox,
+        c: &mut Counters,
+        l: &mut Local,
+    ) {
         for (r, h) in rays.iter().zip(hits.iter_mut()) {
-            *h = self.closest(r, &mut mb, c, &mut l);
-        }
-        l.flush(c, self.config.voxel_cull, false);
-        if let Some(m) = mb {
-            self.mailboxes.give(m);
+            *h = self.closest::<MB, CULL>(r, mb, c, l);
         }
     }
 
-    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], c: &mut Counters) {
-        let mut mb = self.config.mailbox.then(|| self.mailboxes.take());
+    /// Answers a batch of any-hit queries with the walk's switches made constants.
+    fn occluded_with<const MB: bool, const CULL: bool>(
+        &self,
+        rays: &[Ray],
+        occluded: &mut [bool],
+        mb: &mut Mailbox,
+        c: &mut Counters,
+        l: &mut Local,
+    ) {
         let mut cache = ShadowCache::default();
-        let mut l = Local::default();
         for (r, o) in rays.iter().zip(occluded.iter_mut()) {
             let cache = self.config.shadow_cache.then_some(&mut cache);
-            *o = self.any(r, &mut mb, cache, c, &mut l);
+            *o = self.any::<MB, CULL>(r, mb, cache, c, l);
+        }
+    }
+}
+
+impl Engine for Grid {
+    fn intersect(&self, rays: &[Ray], hits: &mut [Hit], c: &mut Counters) {
+        // With mailboxes off the pool's mailboxes hold no stamps, and none is read.
+        let mut mb = self.mailboxes.take();
+        let mut l = Local::default();
+        let cull = !self.prim_bounds.is_empty();
+        match (self.config.mailbox, cull) {
+            (true, true) => self.intersect_with::<true, true>(rays, hits, &mut mb, c, &mut l),
+            (true, false) => self.intersect_with::<true, false>(rays, hits, &mut mb, c, &mut l),
+            (false, true) => self.intersect_with::<false, true>(rays, hits, &mut mb, c, &mut l),
+            (false, false) => self.intersect_with::<false, false>(rays, hits, &mut mb, c, &mut l),
+        }
+        l.flush(c, self.config.voxel_cull, false);
+        self.mailboxes.give(mb);
+    }
+
+    fn occluded(&self, rays: &[Ray], occluded: &mut [bool], c: &mut Counters) {
+        let mut mb = self.mailboxes.take();
+        let mut l = Local::default();
+        let cull = !self.prim_bounds.is_empty();
+        match (self.config.mailbox, cull) {
+            (true, true) => self.occluded_with::<true, true>(rays, occluded, &mut mb, c, &mut l),
+            (true, false) => self.occluded_with::<true, false>(rays, occluded, &mut mb, c, &mut l),
+            (false, true) => self.occluded_with::<false, true>(rays, occluded, &mut mb, c, &mut l),
+            (false, false) => {
+                self.occluded_with::<false, false>(rays, occluded, &mut mb, c, &mut l)
+            }
         }
         l.flush(c, self.config.voxel_cull, self.config.shadow_cache);
-        if let Some(m) = mb {
-            self.mailboxes.give(m);
-        }
+        self.mailboxes.give(mb);
     }
 
     fn structure_bytes(&self) -> u64 {

@@ -46,6 +46,45 @@ impl RaySetup {
     }
 }
 
+/// Counts of one ray's walk, kept in locals (registers) while it runs and added to `Counters`
+/// once at its end: an increment through `&mut Counters` in the inner loop was a load and a
+/// store per reference.
+#[derive(Default)]
+struct WalkCounts {
+    cells: u64,
+    empty: u64,
+    box_tests: u64,
+    culled: u64,
+    mailbox_skips: u64,
+    tests: u64,
+}
+
+impl WalkCounts {
+    #[inline(always)]
+    fn flush(&self, c: &mut Counters, l: &mut Local) {
+        c.cells_visited += self.cells;
+        c.empty_cells_visited += self.empty;
+        c.box_tests += self.box_tests;
+        c.mailbox_skips += self.mailbox_skips;
+        c.primitive_tests += self.tests;
+        l.culled += self.culled;
+    }
+}
+
+/// Whether the box `b` lies apart from `piece` along some axis (`Vec3::cmpgt(..).any()` of
+/// either side, the same answer: a NaN compares false either way), without the six
+/// short-circuit branches `any() || any()` compiled to.
+#[inline(always)]
+fn apart(b: &[Vec3; 2], piece: &(Vec3, Vec3)) -> bool {
+    let ([lo, hi], (plo, phi)) = (b, piece);
+    (lo.x > phi.x)
+        | (lo.y > phi.y)
+        | (lo.z > phi.z)
+        | (hi.x < plo.x)
+        | (hi.y < plo.y)
+        | (hi.z < plo.z)
+}
+
 impl Grid {
     /// Walks the cells `ray` crosses within `[ray.tmin, ray.tmax]`, near to far, calling
     /// `visit(cell, t_enter, t_exit)` for each until it returns true or the ray leaves the grid
@@ -58,12 +97,28 @@ impl Grid {
         })
     }
 
-    /// The nearest hit of one ray.
+    /// The mailbox's stamps and current stamp, and the culling boxes, each as long as the
+    /// primitives (`n`) where its switch is on (else empty, and never read).
+    #[inline(always)]
+    fn per_prim<'a, const MB: bool, const CULL: bool>(
+        &'a self,
+        mb: &'a mut Mailbox,
+        n: usize,
+    ) -> (&'a mut [u32], u32, &'a [[Vec3; 2]]) {
+        let stamp = mb.ray;
+        let stamps: &mut [u32] = if MB { &mut mb.stamps[..n] } else { &mut [] };
+        let bounds: &[[Vec3; 2]] = if CULL { &self.prim_bounds[..n] } else { &[] };
+        (stamps, stamp, bounds)
+    }
+
+    /// The nearest hit of one ray. `MB`: mailboxes on (`mb` then holds one); `CULL`: voxel
+    /// culling on. Each switch is a constant of the instance, so the loop over a cell's
+    /// references tests neither.
     #[inline]
-    pub(super) fn closest(
+    pub(super) fn closest<const MB: bool, const CULL: bool>(
         &self,
         ray: &Ray,
-        mb: &mut Option<Mailbox>,
+        mb: &mut Mailbox,
         c: &mut Counters,
         l: &mut Local,
     ) -> Hit {
@@ -83,52 +138,56 @@ impl Grid {
             }
         }
         if !self.cells.refs.is_empty() {
-            if let Some(m) = mb.as_mut() {
-                m.next_ray();
+            if MB {
+                mb.next_ray();
             }
-            let cull = !self.prim_bounds.is_empty();
             let g = &self.cells;
+            let (stamps, stamp, bounds) = self.per_prim::<MB, CULL>(mb, prims.len());
+            let mut n = WalkCounts::default();
+            let mut hits = 0;
             // The walk covers the segment left after the floor.
             let segment = r;
             self.walk(&segment, |cell, t_enter, t_exit| {
-                c.cells_visited += 1;
+                n.cells += 1;
                 let list = g.prims_in(cell);
                 if list.is_empty() {
-                    c.empty_cells_visited += 1;
+                    n.empty += 1;
                     return r.tmax <= t_exit;
                 }
-                let piece = if cull {
+                let piece = if CULL {
                     segment_box(&r, t_enter, t_exit.min(r.tmax), g.pad)
                 } else {
                     (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
-                    if let Some(m) = mb.as_ref() {
-                        if m.tested(p) {
-                            c.mailbox_skips += 1;
+                    // Indexed once here: `stamps` and `bounds` have this length, so their own
+                    // checks fold into this one.
+                    let prim = &prims[p as usize];
+                    if MB && stamps[p as usize] == stamp {
+                        n.mailbox_skips += 1;
+                        continue;
+                    }
+                    if CULL {
+                        n.box_tests += 1;
+                        if apart(&bounds[p as usize], &piece) {
+                            n.culled += 1;
                             continue;
                         }
                     }
-                    if cull {
-                        c.box_tests += 1;
-                        let [blo, bhi] = self.prim_bounds[p as usize];
-                        if blo.cmpgt(piece.1).any() || bhi.cmplt(piece.0).any() {
-                            l.culled += 1;
-                            continue;
-                        }
+                    if MB {
+                        stamps[p as usize] = stamp;
                     }
-                    if let Some(m) = mb.as_mut() {
-                        m.mark(p);
-                    }
-                    c.primitive_tests += 1;
-                    if let Some((t, u, v)) = prims[p as usize].intersect(&r, test, &s.wt) {
-                        c.primitive_hits += 1;
+                    n.tests += 1;
+                    if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
+                        hits += 1;
                         (r.tmax, best, bu, bv) = (t, p, u, v);
                     }
                 }
                 // Seed 002 §1.6: stop once the nearest hit lies within the cells walked.
                 r.tmax <= t_exit
             });
+            n.flush(c, l);
+            c.primitive_hits += hits;
         }
         if best == u32::MAX {
             Hit::MISS
@@ -142,12 +201,12 @@ impl Grid {
         }
     }
 
-    /// Whether anything blocks one ray's segment.
+    /// Whether anything blocks one ray's segment (`MB`, `CULL`: as [`Grid::closest`]).
     #[inline]
-    pub(super) fn any(
+    pub(super) fn any<const MB: bool, const CULL: bool>(
         &self,
         ray: &Ray,
-        mb: &mut Option<Mailbox>,
+        mb: &mut Mailbox,
         cache: Option<&mut ShadowCache>,
         c: &mut Counters,
         l: &mut Local,
@@ -156,8 +215,8 @@ impl Grid {
         let s = RaySetup::new(ray);
         let prims = &self.geometry.prims;
         let test = self.config.triangle;
-        if let Some(m) = mb.as_mut() {
-            m.next_ray();
+        if MB {
+            mb.next_ray();
         }
         // The shadow cache: try the light's last blocker first.
         let key = cache.as_ref().and_then(|_| Key::of(ray));
@@ -171,8 +230,8 @@ impl Grid {
                 }
                 l.cache_misses += 1;
                 // Tested and missed: the walk need not test it again.
-                if let Some(m) = mb.as_mut() {
-                    m.mark(p);
+                if MB {
+                    mb.mark(p);
                 }
             }
         }
@@ -186,47 +245,51 @@ impl Grid {
             }
         }
         if blocker == u32::MAX && !self.cells.refs.is_empty() {
-            let cull = !self.prim_bounds.is_empty();
             let g = &self.cells;
+            let (stamps, stamp, bounds) = self.per_prim::<MB, CULL>(mb, prims.len());
+            let mut n = WalkCounts::default();
             self.walk(ray, |cell, t_enter, t_exit| {
-                c.cells_visited += 1;
+                n.cells += 1;
                 let list = g.prims_in(cell);
                 if list.is_empty() {
-                    c.empty_cells_visited += 1;
+                    n.empty += 1;
                     return false;
                 }
-                let piece = if cull {
+                let piece = if CULL {
                     segment_box(ray, t_enter, t_exit, g.pad)
                 } else {
                     (Vec3::ZERO, Vec3::ZERO)
                 };
                 for &p in list {
-                    if let Some(m) = mb.as_ref() {
-                        if m.tested(p) {
-                            c.mailbox_skips += 1;
+                    // Indexed once here: `stamps` and `bounds` have this length, so their own
+                    // checks fold into this one.
+                    let prim = &prims[p as usize];
+                    if MB && stamps[p as usize] == stamp {
+                        n.mailbox_skips += 1;
+                        continue;
+                    }
+                    if CULL {
+                        n.box_tests += 1;
+                        if apart(&bounds[p as usize], &piece) {
+                            n.culled += 1;
                             continue;
                         }
                     }
-                    if cull {
-                        c.box_tests += 1;
-                        let [blo, bhi] = self.prim_bounds[p as usize];
-                        if blo.cmpgt(piece.1).any() || bhi.cmplt(piece.0).any() {
-                            l.culled += 1;
-                            continue;
-                        }
+                    if MB {
+                        stamps[p as usize] = stamp;
                     }
-                    if let Some(m) = mb.as_mut() {
-                        m.mark(p);
-                    }
-                    c.primitive_tests += 1;
-                    if prims[p as usize].intersect(ray, test, &s.wt).is_some() {
-                        c.primitive_hits += 1;
+                    n.tests += 1;
+                    if prim.intersect(ray, test, &s.wt).is_some() {
                         blocker = p;
                         return true;
                     }
                 }
                 false
             });
+            n.flush(c, l);
+            if blocker != u32::MAX {
+                c.primitive_hits += 1;
+            }
         }
         if blocker == u32::MAX {
             return false;

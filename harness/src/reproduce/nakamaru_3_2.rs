@@ -378,6 +378,8 @@ fn breadth_first_point(prepared: &workload::Prepared, floor: &str, p: &mut Point
             ("memory".into(), "32MiB".into()),
             ("registration".into(), "thesis".into()),
             ("floor".into(), floor.into()),
+            // The thesis's procedure: every ray of a generation in one breadth-first trace.
+            ("batch".into(), "generation".into()),
         ],
     ))?;
     let e = BreadthFirst::from_scene(&prepared.input, config)?;

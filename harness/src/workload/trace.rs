@@ -407,7 +407,8 @@ struct Setup<'a> {
 /// procedure reads). A band's ray trees are traced generation by generation to the end, so only
 /// one band's generations are held per thread, and its rows of pixels are made as it finishes;
 /// bands run on the pool's threads. Engines that answer whole generations at once
-/// ([`Engine::batch_hint`] `None`, the breadth-first engine) always get whole generations. The
+/// ([`Engine::batch_hint`] `None`, the breadth-first engine with `batch=generation`) always get
+/// whole generations. The
 /// corner colours are kept (3.2 MB at 512²) only with `keep_corners`.
 ///
 /// Chunking changes no answer and no colour: a corner's colour is the sum of its own ray tree's
