@@ -47,6 +47,8 @@ pub enum FindingKind {
     OnlyInB,
     /// Times not compared: no Embree run beside this one in A or B.
     NoYardstick,
+    /// Not compared: A and B traced other workloads under one key (another image size).
+    DifferentWorkload,
     /// The speed-up over one thread (`run --paired-threads N`, in both sets) moved past the
     /// tolerance: a fall is a regression, a rise an improvement.
     ThreadSpeedup,
@@ -400,6 +402,22 @@ fn compare_records(runs_a: &[RunRecord], runs_b: &[RunRecord], c: &mut Compariso
                 continue;
             }
             (true, true) => {}
+        }
+        if ra.size != rb.size {
+            // Another image size traces other rays: its counters and times are another
+            // workload's, and the run key does not hold the size.
+            c.notes.push(finding(
+                ra,
+                FindingKind::DifferentWorkload,
+                "size",
+                Value::from(ra.size),
+                Value::from(rb.size),
+                &format!(
+                    "not compared: traced at {}² in A and {}² in B",
+                    ra.size, rb.size
+                ),
+            ));
+            continue;
         }
         compare_counters(ra, rb, c);
         if ra.engine != EMBREE {

@@ -405,3 +405,20 @@ fn different_machines_are_named() {
     // A note, not a verdict: the same runs still compare.
     assert!(!c.is_regression() && c.matched == 6);
 }
+
+#[test]
+fn runs_of_another_image_size_are_not_compared() {
+    let mut b = base();
+    for r in b.iter_mut() {
+        r.size = 128;
+        r.counters.insert("primitive_tests".into(), 1);
+    }
+    let c = compare_sets(&base(), &b, 5.0);
+    assert!(!c.is_regression(), "{}", c.to_markdown());
+    assert_eq!(c.counters_compared + c.times_compared, 0);
+    assert_eq!(c.notes.len(), 6);
+    assert!(c
+        .notes
+        .iter()
+        .all(|f| f.kind == FindingKind::DifferentWorkload && f.message.contains("128²")));
+}

@@ -417,6 +417,23 @@ pub fn compare(a: &CompareArgs) -> Result<()> {
             changed_files(&a.a, &a.b)
         )));
     }
+    let other_workload = c
+        .notes
+        .iter()
+        .filter(|f| f.kind == rtbench_reports::FindingKind::DifferentWorkload)
+        .count();
+    if other_workload == c.matched {
+        let f = &c
+            .notes
+            .iter()
+            .find(|f| f.kind == rtbench_reports::FindingKind::DifferentWorkload);
+        return Err(input(format!(
+            "{} and {}: nothing compared, every matched run traced another workload ({})",
+            a.a.display(),
+            a.b.display(),
+            f.map(|f| f.message.clone()).unwrap_or_default()
+        )));
+    }
     if a.json {
         print_json(&serde_json::to_value(&c).expect("comparison serialises"));
     } else {

@@ -75,6 +75,8 @@ pub fn run(engine: &str, program: &str, sf: u32, trace: f64) -> RunRecord {
             tessellate: None,
             objects: 10u64.pow(sf),
             primitives: 10u64.pow(sf),
+            file: None,
+            sha256: None,
         },
         threads: 1,
         repeats: 3,
