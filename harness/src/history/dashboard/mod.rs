@@ -15,22 +15,11 @@
 mod board;
 mod page;
 
-pub use board::check_commit_url;
+pub use board::{check_commit_url, fmt_value};
 
 use super::History;
 use crate::error::{input, Result};
 use std::path::Path;
-
-/// A value as the tables print it: counts whole, small values with four significant digits.
-pub fn fmt_value(v: f64) -> String {
-    if v.abs() >= 1e4 && v.fract() == 0.0 {
-        format!("{v:.0}")
-    } else if v.abs() >= 100.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.4}")
-    }
-}
 
 /// Writes `dir/index.html`. `commit_url`: a template holding `{commit}` that links each commit id.
 pub fn write(h: &History, dir: &Path, commit_url: Option<&str>) -> Result<()> {

@@ -3,8 +3,7 @@
 //! script and uPlot (vendored from the npm registry, MIT licence in `uplot/LICENSE`) are inlined:
 //! one file, no network.
 
-use super::board::{Board, NightInfo, Plot};
-use super::fmt_value;
+use super::board::{fmt_value, Board, NightInfo, Plot};
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const UPLOT_JS: &str = include_str!("uplot/uPlot.iife.min.js");
