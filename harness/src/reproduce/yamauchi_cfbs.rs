@@ -536,16 +536,31 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             "4-ary 5-stage, P_M = 0.5",
             p.claim("sim-vs-theory").claim.clone(),
             format!(
-                "latency doubles at λ ≈ {} (model) and {} (simulation); model saturation {:.3e}",
+                "latency doubles at λ ≈ {} (model) and {} (simulation){}; model saturation {:.3e}",
                 k.model.map_or("-".into(), |v| format!("{v:.2e}")),
                 k.simulated
                     .map_or("beyond the grid".into(), |v| format!("{v:.2e}")),
+                match (k.model, k.simulated) {
+                    (Some(m), Some(s)) => format!(": simulation / model = {:.2}", s / m),
+                    _ => String::new(),
+                },
                 k.model_saturation
             ),
-            Kind::Shape,
-            Verdict::Shown,
-        ), r.packets_per_point),
+            Kind::Ratio,
+            order_later(k.model, k.simulated),
+        )
+        .with_note("holds when the simulation's knee (latency twice the light-load latency) is 10^0.5 to 10^1.5 times the model's, on a grid of λ in steps of 10^0.25"), r.packets_per_point),
     ]
+}
+
+/// 003 §4.3.1: the random simulation saturates "about one order of magnitude" later than the
+/// model. Judged on the knees' ratio, simulation / model, within half an order of 10; shown when
+/// either knee lies beyond the grid.
+fn order_later(model: Option<f64>, simulated: Option<f64>) -> Verdict {
+    match (model, simulated) {
+        (Some(m), Some(s)) => Verdict::of((10f64.powf(0.5)..=10f64.powf(1.5)).contains(&(s / m))),
+        _ => Verdict::Shown,
+    }
 }
 
 /// The random simulation's row is 003's own method (§4.3.1: Poisson emissions, Table 3's times)
@@ -931,6 +946,17 @@ mod tests {
         assert!(quick.note.contains("50000 packets"), "{}", quick.note);
         let claim = TABLE.claims.iter().find(|c| c.key == "sim-vs-theory").unwrap();
         assert_eq!(claim.fidelity, Fidelity::Faithful);
+    }
+
+    /// "About one order of magnitude later", fed through its check: ten times holds, the same knee
+    /// or a hundred times does not, a knee beyond the grid is only shown.
+    #[test]
+    fn the_simulation_saturating_an_order_later_is_judged_on_the_knees_ratio() {
+        assert_eq!(order_later(Some(1e-4), Some(1e-3)), Verdict::Holds);
+        assert_eq!(order_later(Some(1e-4), Some(5.62e-4)), Verdict::Holds);
+        assert_eq!(order_later(Some(5.62e-4), Some(5.62e-4)), Verdict::Fails);
+        assert_eq!(order_later(Some(1e-4), Some(1e-2)), Verdict::Fails);
+        assert_eq!(order_later(Some(1e-4), None), Verdict::Shown);
     }
 
     #[test]
