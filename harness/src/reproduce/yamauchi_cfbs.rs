@@ -549,7 +549,7 @@ fn model_claim_rows(p: &Published, r: &Result_) -> Vec<Row> {
             Kind::Ratio,
             order_later(k.model, k.simulated),
         )
-        .with_note("holds when the simulation's knee (latency twice the light-load latency) is 10^0.5 to 10^1.5 times the model's, on a grid of λ in steps of 10^0.25"), r.packets_per_point),
+        .with_note("holds when the simulation's knee (latency twice the light-load latency) is 10^0.5 to 10^1.5 times the model's, on a grid of λ in steps of 10^0.25; a simulation with Table 3's service times saturates where a unit's utilisation reaches 1, the load at which the model saturates too, so an order of magnitude between them needs other times than Table 3's (003 does not say which its simulator used)"), r.packets_per_point),
     ]
 }
 
