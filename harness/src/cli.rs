@@ -244,14 +244,16 @@ pub struct PlanArgs {
     /// Skip the cross-check against Embree.
     #[arg(long)]
     pub no_check: bool,
-    /// In every run of an engine other than Embree, also time N back-to-back pairs of the engine
-    /// and Embree in one process (alternating which goes first); `report` shows their ratio and
+    /// In every run of an engine other than Embree, also time at least N back-to-back pairs of the
+    /// engine and Embree in one process (alternating which goes first; fast traces get more, until
+    /// the pairs span two seconds, at most 8 N); `report` shows their median ratio and
     /// `compare` judges on it: load on the machine and the state of one process move it far less
     /// than the ratio of two separate runs. 0 turns pairs off (and with --no-check, Embree is not
     /// built at all).
     #[arg(long, default_value_t = 5)]
     pub paired: u32,
-    /// In every run at more than one thread, also time N back-to-back pairs of the same trace at
+    /// In every run at more than one thread, also time at least N back-to-back pairs (more for
+    /// fast traces, as --paired takes them) of the same trace at
     /// one thread and at the run's threads in one process (alternating which goes first), and
     /// record the speed-up over one thread per pair (`thread_scaling`: median and range);
     /// `report` shows it. Runs at one thread ignore it.
@@ -346,11 +348,12 @@ pub struct RunOneArgs {
     /// Skip the cross-check against Embree.
     #[arg(long)]
     pub no_check: bool,
-    /// Also time N back-to-back pairs of this engine and Embree in this process (alternating
-    /// which goes first) and record their trace-CPU-time ratios: the low-noise yardstick.
+    /// Also time at least N back-to-back pairs of this engine and Embree in this process
+    /// (alternating which goes first; more, until they span two seconds, for fast traces) and
+    /// record their trace-CPU-time ratios: the low-noise yardstick.
     #[arg(long, default_value_t = 0)]
     pub paired: u32,
-    /// With `--threads` above 1, also time N back-to-back pairs of the trace at one thread and
+    /// With `--threads` above 1, also time at least N back-to-back pairs of the trace at one thread and
     /// at `--threads` (alternating which goes first) and record the speed-up of each pair.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub paired_threads: u32,

@@ -5,8 +5,9 @@
 //! - times are compared as each engine's trace time over Embree's *within its own set*, so whatever slowed
 //!   or sped up the whole machine between A and B cancels. The change of that ratio from A to B is judged
 //!   on its 95 % interval ([`crate::interval`]): on the log scale, B's ratio minus A's, each the mean log
-//!   of the engine's repeats minus the mean log of Embree's (or the mean log of the paired ratios where
-//!   both sets timed pairs, `run --paired N`), with Welch–Satterthwaite degrees of freedom. A regression
+//!   of the engine's repeats minus the mean log of Embree's (or the median log of the paired ratios,
+//!   [`crate::interval::LogMean::median_of`], where both sets timed pairs, `run --paired N`), with
+//!   Welch–Satterthwaite degrees of freedom. A regression
 //!   needs the whole interval above +threshold, an improvement the whole interval below −threshold; a
 //!   change whose estimate passes the threshold while its interval reaches back inside is reported as
 //!   "too few samples to decide", and so is a run with fewer than two samples on a side. Embree's own
@@ -507,13 +508,13 @@ fn compare_times(
     c: &mut Comparison,
 ) {
     // Both runs timed in pairs with Embree in their own processes (`run --paired N`): those
-    // ratios, each set's mean log of its pairs.
+    // ratios, each set's median log of its pairs.
     if let (Some(pa), Some(pb)) = (paired(ra), paired(rb)) {
         c.times_compared += 1;
-        let change = LogMean::of(&pb.samples)
-            .zip(LogMean::of(&pa.samples))
+        let change = LogMean::median_of(&pb.samples)
+            .zip(LogMean::median_of(&pa.samples))
             .map(|(b, a)| b.minus(&a));
-        let (qa, qb) = (geo(&pa.samples), geo(&pb.samples));
+        let (qa, qb) = (median_ratio(&pa.samples), median_ratio(&pb.samples));
         judge(
             ra,
             Judged {
@@ -591,16 +592,16 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
         return;
     };
     let (pa, pb) = (&sa.speedup, &sb.speedup);
-    let change = LogMean::of(&pb.samples)
-        .zip(LogMean::of(&pa.samples))
+    let change = LogMean::median_of(&pb.samples)
+        .zip(LogMean::median_of(&pa.samples))
         .map(|(b, a)| b.minus(&a));
     judge(
         ra,
         Judged {
             kind: FindingKind::ThreadSpeedup,
             what: "speed-up over 1 thread",
-            old: geo(&pa.samples),
-            new: geo(&pb.samples),
+            old: median_ratio(&pa.samples),
+            new: median_ratio(&pb.samples),
             change,
             samples: [pa.samples.len(), pb.samples.len()],
             higher_is_worse: false,
@@ -617,6 +618,11 @@ fn geo(x: &[f64]) -> f64 {
     (x.iter().map(|v| v.max(1e-300).ln()).sum::<f64>() / x.len() as f64).exp()
 }
 
+/// The figure of ratios measured in pairs: the exponential of their median log (0 for none).
+fn median_ratio(x: &[f64]) -> f64 {
+    LogMean::median_of(x).map_or_else(|| geo(x), |m| m.mean.exp())
+}
+
 /// A run's paired ratios to Embree, when it has some.
 fn paired(r: &RunRecord) -> Option<&crate::results::Spread> {
     r.paired_ratio
@@ -630,7 +636,7 @@ struct Judged<'a> {
     what: &'a str,
     old: f64,
     new: f64,
-    /// B's mean log minus A's; `None` when a side has fewer than two samples.
+    /// B's log figure minus A's; `None` when a side has fewer than two samples.
     change: Option<LogMean>,
     samples: [usize; 2],
     /// A rise is a regression (a time ratio), else a fall is (a speed-up).

@@ -35,8 +35,8 @@ pub struct Spread {
     pub median: f64,
     pub max: f64,
     pub samples: Vec<f64>,
-    /// For ratios measured in pairs (a paired ratio to Embree, a speed-up): their geometric mean
-    /// with its 95 % interval and the number of pairs ([`crate::interval::of_ratios`]). Absent
+    /// For ratios measured in pairs (a paired ratio to Embree, a speed-up): their median with its
+    /// 95 % interval and the number of pairs ([`crate::interval::of_ratios`]). Absent
     /// for times, and with fewer than two pairs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interval: Option<crate::interval::Interval>,
@@ -83,7 +83,7 @@ impl Spread {
         }
     }
 
-    /// [`Spread::of`] ratios measured in pairs, with the interval of their geometric mean.
+    /// [`Spread::of`] ratios measured in pairs, with the interval of their median.
     pub fn of_ratios(samples: &[f64]) -> Spread {
         Spread {
             interval: crate::interval::of_ratios(samples),

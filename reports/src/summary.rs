@@ -50,7 +50,7 @@ pub struct Row {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ratio_interval: Option<Interval>,
     /// Trace CPU time over Embree's timed in pairs in the run's process (`run --paired N`), with
-    /// the interval of the pairs' geometric mean.
+    /// the interval of the pairs' median ([`crate::interval::of_ratios`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub paired_ratio: Option<Spread>,
     pub structure_bytes: u64,

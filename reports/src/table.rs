@@ -178,8 +178,8 @@ pub fn scaling_table(summary: &Summary) -> Option<Table> {
 /// What the scaling table's columns mean.
 pub const SCALING_NOTES: &str = "Each pair traces the same built structure at one thread and at N threads back to \
 back in one process, alternating which goes first (`rtbench run --paired-threads`); the speed-up is each pair's \
-one-thread wall time over its N-thread wall time: the pairs' geometric mean with its 95 % interval (Student's t on \
-the logs), and their range; both traces must give the same image. 1 thread s and N threads s are the pairs' median wall times; CPU s × 1 thread is the CPU time of the \
+one-thread wall time over its N-thread wall time: the pairs' median with its 95 % interval (on \
+the logs, from their median absolute deviation), and their range; both traces must give the same image. 1 thread s and N threads s are the pairs' median wall times; CPU s × 1 thread is the CPU time of the \
 pool's threads at N threads over that at one (1.00: splitting cost no extra CPU time). Speed-up, separate runs: \
 this set's one-thread run's median trace time over this run's, for comparison.";
 
@@ -228,6 +228,6 @@ pub const NOTES: &str = "Times are medians over the repeats, with min–max. × 
 pool's threads where recorded) over Embree's on the same scene and threads in this results set: the quotient of the two \
 runs' geometric means over their repeats, with its 95 % interval (Welch, on the logs) and the repeats behind it (– \
 without an Embree run). Paired × Embree: the ratios timed back to back in the run's own process (`run --paired N`), \
-their geometric mean with its 95 % interval and the number of pairs. MB are 10^6 bytes; B/prim is the \
+their median with its 95 % interval and the number of pairs. MB are 10^6 bytes; B/prim is the \
 structure's bytes per primitive (Embree: what its memory monitor reports, BVH and its copies of the geometry). Hit agreement and PSNR \
 compare each engine's hits and image with Embree's (`rtbench check`); ∞ dB means identical images.";

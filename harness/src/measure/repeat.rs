@@ -1,8 +1,39 @@
 //! The one repeat and warm-up policy of `run`, `reproduce` and `nightly`: [`WARMUP`] untimed
 //! passes first (a fresh process's first pass runs measurably slower: cold caches, page faults on
 //! first touch, which would widen every spread), then the timed repeats, each measured by one span ([`span`]).
+//! Pairs (an engine and Embree, or one thread and many, traced back to back) follow [`pairs`].
 
-use super::span::{span, Sample, Workers};
+use super::span::{span, Sample, Span, Workers};
+
+/// The wall time the pairs of one paired measurement span at least. On this kind of shared machine
+/// the speed of one kind of code against another shifts for a fraction of a second at a time (a
+/// burst on the other core slows a memory-bound trace more than a compute-bound one): traces of a
+/// few tens of milliseconds once put five pairs in a row inside one such episode, and the run's
+/// ratio moved by 30 %. Spread over two seconds, an episode touches a few of the pairs, and the
+/// median of the pairs ([`rtbench_reports::interval::LogMean::median_of`]) passes over them.
+pub const PAIR_SPAN_S: f64 = 2.0;
+
+/// Pairs stop at this many times the number asked for, however short each pair is.
+pub const PAIR_CAP_FACTOR: u32 = 8;
+
+/// Runs `pair(i)` for i = 0, 1, … at least `min` times, and on until the pairs have spanned
+/// [`PAIR_SPAN_S`] of wall time, but at most `min` × [`PAIR_CAP_FACTOR`] and `max` times; returns the
+/// pairs' values. With `min` 0 it runs none.
+pub fn pairs<T, E>(
+    min: u32,
+    max: u32,
+    mut pair: impl FnMut(u32) -> Result<T, E>,
+) -> Result<Vec<T>, E> {
+    let cap = min.saturating_mul(PAIR_CAP_FACTOR).min(max.max(min));
+    let clock = Span::start(Workers::Caller);
+    let mut out = Vec::with_capacity(min as usize);
+    let mut i = 0;
+    while i < min || (i < cap && clock.elapsed_s() < PAIR_SPAN_S) {
+        out.push(pair(i)?);
+        i += 1;
+    }
+    Ok(out)
+}
 
 /// Untimed passes before the timed ones.
 pub const WARMUP: u32 = 1;
@@ -88,5 +119,24 @@ mod tests {
         assert_eq!(calls, 4);
         assert_eq!(out.iter().map(|(c, _)| *c).collect::<Vec<_>>(), [2, 3, 4]);
         assert_eq!(Repeats::new(0).timed, 1);
+    }
+
+    #[test]
+    fn fast_pairs_go_on_until_they_span_the_window_and_stop_at_the_cap() {
+        // Instant pairs: the window never fills, so the cap ends them.
+        let n = pairs(5, 1000, |_| Ok::<_, ()>(())).unwrap().len();
+        assert_eq!(n, (5 * PAIR_CAP_FACTOR) as usize);
+        assert_eq!(pairs(5, 7, |_| Ok::<_, ()>(())).unwrap().len(), 7);
+        assert_eq!(pairs(0, 1000, |_| Ok::<_, ()>(())).unwrap().len(), 0);
+        // Pairs longer than the window: exactly the minimum.
+        let slow = pairs(2, 1000, |_| {
+            std::thread::sleep(std::time::Duration::from_secs_f64(PAIR_SPAN_S / 2.0 + 0.01));
+            Ok::<_, ()>(())
+        });
+        assert_eq!(slow.unwrap().len(), 2);
+        assert_eq!(
+            pairs(3, 1000, |i| if i == 1 { Err(i) } else { Ok(i) }),
+            Err(1)
+        );
     }
 }

@@ -39,7 +39,8 @@ fn embree_available() -> bool {
         .any(|e| e.name == "embree" && (e.available)().is_ok())
 }
 
-/// Trace CPU time of `engine` over Embree's, `pairs` times, back to back in this process. Pair i
+/// Trace CPU time of `engine` over Embree's, back to back in this process: at least `pairs` pairs,
+/// more for fast traces until they span [`PAIR_SPAN_S`](crate::measure::repeat::PAIR_SPAN_S). Pair i
 /// traces the engine first when i is even and Embree first when it is odd, so a drift in the
 /// machine's speed within a pair cancels over two pairs.
 fn paired_ratios(
@@ -57,21 +58,24 @@ fn paired_ratios(
     // Embree's first render in a process is slow (cold caches, first-touch page faults), as the
     // engine's was before its untimed render above.
     time(yardstick);
-    (0..pairs)
-        .map(|i| {
-            let (a, b) = if i % 2 == 0 {
-                let a = time(engine);
-                (a, time(yardstick))
-            } else {
-                let b = time(yardstick);
-                (time(engine), b)
-            };
-            a / b.max(1e-12)
-        })
-        .collect()
+    let ratios = crate::measure::repeat::pairs(pairs, MAX_PAIRS, |i| {
+        let (a, b) = if i % 2 == 0 {
+            let a = time(engine);
+            (a, time(yardstick))
+        } else {
+            let b = time(yardstick);
+            (time(engine), b)
+        };
+        Ok::<_, std::convert::Infallible>(a / b.max(1e-12))
+    });
+    match ratios {
+        Ok(r) => r,
+        Err(never) => match never {},
+    }
 }
 
-/// The same trace at one thread and on `pool`, `pairs` times, back to back in this process:
+/// The same trace at one thread and on `pool`, back to back in this process, in pairs as
+/// [`paired_ratios`] takes them:
 /// (one-thread wall s, wall s on `pool`, one-thread pool CPU s, pool CPU s) per pair. Pair i
 /// traces one thread first when i is even and `pool` first when it is odd, as
 /// [`paired_ratios`] alternates. Every trace must give the image of the first: a speed-up of a
@@ -102,18 +106,16 @@ fn paired_thread_times(
     // The one-thread pool's first render is slow (its thread's buffers, first touch), as the
     // run's own pool was before its untimed render.
     time(&one)?;
-    (0..pairs)
-        .map(|i| {
-            let ((w1, c1), (wn, cn)) = if i % 2 == 0 {
-                let a = time(&one)?;
-                (a, time(pool)?)
-            } else {
-                let b = time(pool)?;
-                (time(&one)?, b)
-            };
-            Ok((w1, wn, c1, cn))
-        })
-        .collect()
+    crate::measure::repeat::pairs(pairs, MAX_PAIRS, |i| {
+        let ((w1, c1), (wn, cn)) = if i % 2 == 0 {
+            let a = time(&one)?;
+            (a, time(pool)?)
+        } else {
+            let b = time(pool)?;
+            (time(&one)?, b)
+        };
+        Ok((w1, wn, c1, cn))
+    })
 }
 
 /// Counters as a flat name → value map (common fields and the engine's own).
