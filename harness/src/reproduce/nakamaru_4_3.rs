@@ -150,7 +150,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "per-ray-growth-thesis",
             fidelity: Fidelity::Substituted,
-            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; another machine (2 cores, 2026) against a Pentium II 450 MHz with 256 MB",
+            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; substituted as sgb-ratio is (zstd stores, our reading of Klimaszewski's method); each growth is a ratio within one machine (ours a 2-core Xeon, the thesis's a Pentium II 450 MHz with 256 MB)",
         },
         Claim {
             key: "view",
