@@ -400,15 +400,7 @@ impl Hierarchy {
             "store_crc": header_crc(&h.dir)?,
         }))
         .map_err(io::Error::other)?;
-        let tmp_json = tmp(HIERARCHY_FILE);
-        made.push(tmp_json.clone());
-        {
-            use std::io::Write;
-            let mut f = std::fs::File::create(&tmp_json)?;
-            f.write_all(text.as_bytes())?;
-            f.sync_all()?;
-        }
-        std::fs::rename(&tmp_json, h.dir.join(HIERARCHY_FILE))?;
+        super::write_atomic(&h.dir.join(HIERARCHY_FILE), text.as_bytes())?;
         stats.io.bytes_written += text.len() as u64;
         stats.io.write_calls += 1;
         Ok(())

@@ -77,6 +77,21 @@ pub use segments::{Outcome, SegmentLog, SegmentedWriter, SEGMENTS_FILE};
 pub use surface::Surface;
 pub use write::{FileState, StoreWriter, WriteState};
 
+/// Writes `bytes` to `path` whole or not at all: into a temporary file beside it (`tempfile`),
+/// synced, then renamed over it, so a reader or a resumed run never sees half a record.
+pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_data()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
 /// Format version written in every file; readers refuse any other (2: checksums; 3: the material
 /// table moved out of header.json into `materials.bin`, so that the header stays small at 10^9
 /// objects).

@@ -88,12 +88,8 @@ impl SegmentLog {
     }
 
     fn write(&self, dir: &Path) -> io::Result<()> {
-        let tmp = dir.join(format!(".{SEGMENTS_FILE}.tmp"));
         let text = serde_json::to_vec_pretty(self).map_err(io::Error::other)?;
-        let f = std::fs::File::create(&tmp)?;
-        io::Write::write_all(&mut &f, &text)?;
-        f.sync_data()?;
-        std::fs::rename(&tmp, dir.join(SEGMENTS_FILE))
+        super::write_atomic(&dir.join(SEGMENTS_FILE), &text)
     }
 }
 

@@ -128,8 +128,8 @@ pub const VARS: &[Var] = &[
     },
     Var {
         name: "RTBENCH_TEST_SLOWDOWN",
-        forms: "a number of seconds ≥ 0",
-        about: "the extra time per call of the test-slow engine (engines)",
+        forms: "a fraction ≥ 0 (0.2: 20 % more)",
+        about: "the fraction of each batch's time the test-slow engine adds (engines)",
         check: non_negative,
     },
 ];

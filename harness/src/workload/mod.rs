@@ -92,7 +92,8 @@ pub fn build(
 }
 
 /// Bytes the workload holds per pixel corner, at least: measured 80 (in-memory engines) to 210
-/// (breadth-first) at --size 2048 (corners, rays, hits, paths, shading records), rounded up.
+/// (breadth-first with `batch=generation`; its default, `batch=band`, holds far less) at
+/// --size 2048 (corners, rays, hits, paths, shading records), rounded up.
 pub const BYTES_PER_CORNER: u64 = 256;
 
 fn gib(b: u64) -> String {

@@ -76,11 +76,9 @@ impl Progress {
         serde_json::from_slice(&std::fs::read(path).ok()?).ok()
     }
 
-    /// Written whole or not at all (a temporary renamed), after the grid's bytes are synced.
+    /// Written whole or not at all, after the grid's bytes are synced.
     fn write(&self, path: &Path) -> io::Result<()> {
-        let tmp = path.with_extension("json.tmp");
-        std::fs::write(&tmp, serde_json::to_vec(self).map_err(io::Error::other)?)?;
-        std::fs::rename(&tmp, path)
+        crate::store::write_atomic(path, &serde_json::to_vec(self).map_err(io::Error::other)?)
     }
 
     fn restore(&self, st: &mut BuildStats) {
