@@ -20,7 +20,7 @@ pub const TABLE: Table = lb::table(
     "yamauchi-static-lb",
     "§4.2.2, Figs. 31–34",
     "003 (Yamauchi 1997) §4.2.2: (Mπ)² speed-up/efficiency vs PEs, 3 allocations, 1D/2D/3D",
-    "about 5 CPU minutes (7 with the y-up room as extra rows), 25 minutes on a shared 2-core machine",
+    "about 3 CPU minutes without the y-up room's extra rows, 8 minutes on a shared 2-core machine",
     "about 1.5 CPU hours (66 room8 radiosity machines); resumable",
     &[
         Claim {
