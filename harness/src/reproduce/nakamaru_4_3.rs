@@ -6,8 +6,9 @@
 //! and B differ.
 //!
 //! A row is a chain of steps, each saved as it finishes (`--resume`), so a row of days is done
-//! in sittings: the basic store (gzip-compressed: the basic method reads it strictly forward,
-//! §3.4) and the split store are written in segments (`rtbench_engines::store::segments`), each
+//! in sittings: the basic store (compressed with the split store's codec, so that no method
+//! pays a decoder the others do not; the basic method reads it strictly forward, §3.4) and the
+//! split store are written in segments (`rtbench_engines::store::segments`), each
 //! segment a checkpoint; `max-seconds=S` stops the run at the first checkpoint past S seconds
 //! (the report then says which steps are still to do). A scene's rows share its stores and run
 //! in the order the disk allows: every row's basic steps first, the basic store removed after
@@ -134,7 +135,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "sgb-ratio",
             fidelity: Fidelity::Substituted,
-            why: "another machine (2 cores, virtual disk, page cache dropped by posix_fadvise in place of a 256 MB machine), our record format; codecs differ: the basic store is gzip level 1 (the codec of the thesis's Table 3.3, where gzip cost the basic method 2.5-3.4x), the split store zstd, so the basic time carries a decoding cost the others do not (not measured apart here); a row whose basic time is extrapolated is a model",
+            why: "both stores are zstd-compressed (level 3; the thesis's Table 4.3 stores were not compressed, ours must be to fit this disk: uncompressed, mount14's and rings368's split stores take ~55 and ~102 GB), one codec for all three methods; the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); the machine (a 2-core Xeon reading its disk cold, page cache dropped by posix_fadvise, 256 MiB engine budget) is stated, not the reason; a row whose basic time is extrapolated is a model",
         },
         Claim {
             key: "sg-ratio",
@@ -149,7 +150,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "per-ray-growth-thesis",
             fidelity: Fidelity::Substituted,
-            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; another machine (2 cores, 2026) against a Pentium II 450 MHz with 256 MB",
+            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; substituted as sgb-ratio is (zstd stores, our reading of Klimaszewski's method); each growth is a ratio within one machine (ours a 2-core Xeon, the thesis's a Pentium II 450 MHz with 256 MB)",
         },
         Claim {
             key: "view",
@@ -600,12 +601,35 @@ fn past(s: &Setup) -> bool {
     s.deadline.is_some_and(|d| Instant::now() >= d)
 }
 
+/// The codec of both stores: the basic store is written with the split store's, so that the
+/// three methods read alike and the ratios compare S, G and B, not codecs.
+fn codec_tag(c: Codec) -> String {
+    match c {
+        Codec::None => "none".into(),
+        Codec::Gzip(l) => format!("gzip{l}"),
+        Codec::Zstd(l) => format!("zstd{l}"),
+    }
+}
+
 fn row_key(m: &Measured, s: &Setup) -> String {
-    format!("{}-{}-{}-{}", m.row, s.size, s.memory, s.cache)
+    format!(
+        "{}-{}-{}-{}-{}",
+        m.row,
+        s.size,
+        s.memory,
+        s.cache,
+        codec_tag(s.split_codec)
+    )
 }
 
 fn store_dir(m: &Measured, s: &Setup, kind: &str) -> PathBuf {
-    s.stores.join(format!("{}{}-{kind}", m.scene, m.sf))
+    // The basic store's folder names its codec: one written with another codec is not resumed.
+    let tag = if kind == "basic" {
+        format!("-{}", codec_tag(s.split_codec))
+    } else {
+        String::new()
+    };
+    s.stores.join(format!("{}{}-{kind}{tag}", m.scene, m.sf))
 }
 
 /// Where a row's S+G+B image is kept between invocations (`.partial/nakamaru-4.3/images/`).
@@ -631,8 +655,12 @@ fn measure_basic(ctx: &Ctx, m: &mut Measured, s: &Setup, keep_basic: bool) -> Re
     let dir = store_dir(m, s, "basic");
     forget_lost_store(&mut m.basic_store, &dir, &m.row);
     if m.basic_store.is_none() {
-        eprintln!("nakamaru-4.3: {}: basic store (gzip, in segments) …", m.row);
-        match write_store(&src, &dir, Layout::Basic, Codec::Gzip(1), s)? {
+        eprintln!(
+            "nakamaru-4.3: {}: basic store ({}, in segments) …",
+            m.row,
+            codec_tag(s.split_codec)
+        );
+        match write_store(&src, &dir, Layout::Basic, s.split_codec, s)? {
             Some(st) => m.basic_store = Some(st),
             None => return Ok(false),
         }
@@ -1219,6 +1247,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
         } else {
             format!("{}: a smaller stand-in, not a row of the table", m.row)
         };
+        let first = rows.len();
         let shown = |f: fn(&PublishedRow) -> f64| pubrow.map_or("-".into(), |r| format!("{:.2}", f(r)));
         // Each claim as soon as the runs it compares are saved: a 10^9-object row is measured
         // one method an invocation (`methods`).
@@ -1390,6 +1419,13 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                 Verdict::NotMeasured,
             ));
         }
+        if pubrow.is_none() {
+            // A stand-in scene's rows are substituted whatever their claim's label (a model's
+            // row stays a model: the writer keeps the lower label).
+            for r in &mut rows[first..] {
+                r.fidelity.get_or_insert(Fidelity::Substituted);
+            }
+        }
     }
     rows
 }
@@ -1397,18 +1433,19 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
 fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finished: bool) -> Document {
     let mut doc = Document::new("nakamaru-4.3: massive data, basic method vs S+G and S+G+B");
     doc.paragraph(format!(
-        "Published: {}. Measured: `rtbench reproduce nakamaru-4.3{}`, {}×{}, engine memory {}, cache {}, high-resolution grid for every method (as the thesis), basic store gzip level 1 in segments of {} objects, split store {}.{}",
+        "Published: {}. Measured: `rtbench reproduce nakamaru-4.3{}`, {}×{}, engine memory {}, cache {}, high-resolution grid for every method (as the thesis), both stores {} (the basic store in segments of {} objects, the split store in blocks).{}",
         p.source.cite(),
         if quick { " --quick" } else { "" },
         s.size,
         s.size,
         s.memory,
         s.cache,
-        s.segment,
         match s.split_codec {
-            Codec::Zstd(l) => format!("zstd level {l} in blocks"),
-            _ => "uncompressed".into(),
+            Codec::Zstd(l) => format!("zstd level {l}"),
+            Codec::Gzip(l) => format!("gzip level {l}"),
+            Codec::None => "uncompressed".into(),
         },
+        s.segment,
         if finished { "" } else { " **Partial: stopped at a checkpoint; run again with --resume.**" }
     ));
     let mut t = DocTable::new(

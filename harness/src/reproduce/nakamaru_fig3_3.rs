@@ -30,8 +30,8 @@ pub const TABLE: Table = Table {
         },
         Claim {
             key: "example-ratio",
-            fidelity: Fidelity::Substituted,
-            why: "the figure's ratios belong to its drawn example; ours to a whole scene",
+            fidelity: Fidelity::NotReproducible,
+            why: "the 1/3 and 2/5 belong to the figure's drawn example, whose geometry is lost with the figure; a whole scene's ratio is a different quantity, shown and not judged",
         },
     ],
     run,

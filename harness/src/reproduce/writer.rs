@@ -42,10 +42,39 @@ fn claims_table(table: &Table, rows: &[Row]) -> DocTable {
         if n == 0 {
             continue;
         }
+        // Rows labelled below their claim (a stand-in scene, one scene's setting) are counted
+        // here, so the claim's label never speaks for rows that do not carry it.
+        let lower: Vec<(Fidelity, usize)> = Fidelity::ALL
+            .iter()
+            .filter(|f| **f != c.fidelity)
+            .map(|f| {
+                let k = rows
+                    .iter()
+                    .filter(|r| r.claim == c.key && r.fidelity == Some(*f))
+                    .count();
+                (*f, k)
+            })
+            .filter(|(_, k)| *k > 0)
+            .collect();
+        let label = if lower.is_empty() {
+            c.fidelity.name().to_string()
+        } else {
+            let own = n - lower.iter().map(|(_, k)| k).sum::<usize>();
+            let rest: Vec<String> = lower
+                .iter()
+                .map(|(f, k)| format!("{k} {}", f.name()))
+                .collect();
+            format!(
+                "{} (rows: {own} {}, {}; see their notes)",
+                c.fidelity.name(),
+                c.fidelity.name(),
+                rest.join(", ")
+            )
+        };
         t.push(vec![
             c.key.to_string(),
             n.to_string(),
-            c.fidelity.name().to_string(),
+            label,
             c.why.to_string(),
         ]);
     }
@@ -216,5 +245,41 @@ mod tests {
             d.to_markdown()
         };
         assert_eq!(md.matches(c.why).count(), 1, "{md}");
+    }
+
+    #[test]
+    fn a_claims_label_counts_the_rows_that_carry_a_lower_one() {
+        let table = find("nakamaru-4.2").unwrap();
+        let c = table
+            .claims
+            .iter()
+            .find(|c| c.fidelity == Fidelity::Faithful)
+            .unwrap();
+        let row = |i: usize| {
+            Row::new(
+                c.key,
+                format!("s{i}"),
+                "p",
+                "m",
+                Kind::Count,
+                Verdict::Holds,
+            )
+        };
+        let mut rows = vec![
+            row(0),
+            row(1).with_fidelity(Fidelity::Substituted, "a stand-in scene"),
+            row(2).with_fidelity(Fidelity::Substituted, "a stand-in scene"),
+        ];
+        label(table, &mut rows);
+        let t = claims_table(table, &rows);
+        let md = {
+            let mut d = Document::new("t");
+            d.table(t);
+            d.to_markdown()
+        };
+        assert!(
+            md.contains("faithful (rows: 1 faithful, 2 substituted; see their notes)"),
+            "{md}"
+        );
     }
 }
