@@ -398,8 +398,10 @@ fn paired_threads_record_each_pairs_speedup() {
         nums(&s["threads_s"]),
         nums(&s["speedup"]),
     );
-    assert_eq!((t1.len(), tn.len(), up.len()), (3, 3, 3));
-    for i in 0..3 {
+    // At least the 3 pairs asked for; fast traces get more (measure::repeat::pairs).
+    assert!(up.len() >= 3, "{s}");
+    assert_eq!((t1.len(), tn.len()), (up.len(), up.len()));
+    for i in 0..up.len() {
         assert!(t1[i] > 0.0 && tn[i] > 0.0);
         assert!(
             (up[i] - t1[i] / tn[i]).abs() <= 1e-9 * up[i],
@@ -558,8 +560,9 @@ fn embree_leaves_no_thread_spinning_beside_the_trace() {
         .lines()
         .filter(|l| l.starts_with("sched process"))
         .collect();
-    // The untimed render, two repeats, the one-thread pool's untimed render and one pair.
-    assert_eq!(lines.len(), 6, "{err}");
+    // The untimed render, two repeats, the one-thread pool's untimed render and the pairs (at least
+    // the one asked for; a fast trace gets more), two renders each.
+    assert!(lines.len() >= 6 && (lines.len() - 4) % 2 == 0, "{err}");
     for l in &lines {
         let w: Vec<&str> = l.split_whitespace().collect();
         let threads: usize = w[3].parse().unwrap();
