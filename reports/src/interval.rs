@@ -46,15 +46,8 @@ pub struct LogMean {
 impl LogMean {
     /// Of positive finite samples; `None` with fewer than two usable samples.
     pub fn of(samples: &[f64]) -> Option<LogMean> {
-        let logs: Vec<f64> = samples
-            .iter()
-            .filter(|x| x.is_finite() && **x > 0.0)
-            .map(|x| x.ln())
-            .collect();
+        let logs = logs(samples)?;
         let n = logs.len();
-        if n < 2 || n < samples.len() {
-            return None;
-        }
         let mean = logs.iter().sum::<f64>() / n as f64;
         let s2 = logs.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
         Some(LogMean {
@@ -70,15 +63,8 @@ impl LogMean {
     /// absolute deviation of the logs; n − 1 degrees of freedom. `None` with fewer than two usable
     /// samples.
     pub fn median_of(samples: &[f64]) -> Option<LogMean> {
-        let mut logs: Vec<f64> = samples
-            .iter()
-            .filter(|x| x.is_finite() && **x > 0.0)
-            .map(|x| x.ln())
-            .collect();
+        let mut logs = logs(samples)?;
         let n = logs.len();
-        if n < 2 || n < samples.len() {
-            return None;
-        }
         let median = median(&mut logs);
         let mut dev: Vec<f64> = logs.iter().map(|l| (l - median).abs()).collect();
         let sigma = 1.4826 * self::median(&mut dev);
@@ -134,6 +120,16 @@ pub fn t_975(df: f64) -> f64 {
     StudentsT::new(0.0, 1.0, df.max(1.0))
         .map(|t| t.inverse_cdf(0.5 + LEVEL / 2.0))
         .unwrap_or(f64::INFINITY)
+}
+
+/// The logs of the samples when there are at least two and every one is positive and finite.
+fn logs(samples: &[f64]) -> Option<Vec<f64>> {
+    let logs: Vec<f64> = samples
+        .iter()
+        .filter(|x| x.is_finite() && **x > 0.0)
+        .map(|x| x.ln())
+        .collect();
+    (logs.len() >= 2 && logs.len() == samples.len()).then_some(logs)
 }
 
 /// The median of some values (NaN for none); sorts them.
