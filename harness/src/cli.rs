@@ -357,6 +357,10 @@ pub struct RunOneArgs {
     /// at `--threads` (alternating which goes first) and record the speed-up of each pair.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub paired_threads: u32,
+    /// Exactly N pairs, however fast the trace: the nightly's rounds are its spread in time, and it
+    /// takes each round's median over a fixed number of pairs.
+    #[arg(long, hide = true)]
+    pub pairs_exact: bool,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -112,8 +112,8 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
     let list = rtbench(&["history", "list", "--db", db.to_str().unwrap(), "--json"]);
     let runs: Value = serde_json::from_slice(&list.stdout).unwrap();
     assert_eq!(runs.as_array().unwrap().len(), 4);
-    // Every pair of every round is stored: 3 rounds × at least 2 pairs of ratios per engine but
-    // Embree (fast traces get more pairs, until they span the pairs' window).
+    // Every pair of every round is stored: 3 rounds × 2 pairs of ratios per engine but Embree
+    // (exactly the suite's pairs a round, however fast the trace).
     let show = rtbench(&["history", "show", "--db", db.to_str().unwrap(), "--json"]);
     let v: Value = serde_json::from_slice(&show.stdout).unwrap();
     let ratio = v["metrics"]
@@ -122,7 +122,7 @@ fn nights_accumulate_and_a_planted_counter_change_is_named() {
         .iter()
         .find(|m| m["name"] == "grid tetra1@1/time_ratio")
         .expect("a ratio");
-    assert!(ratio["samples"].as_array().unwrap().len() >= 6, "{ratio}");
+    assert_eq!(ratio["samples"].as_array().unwrap().len(), 6, "{ratio}");
     assert!(v["environment"]["cpu_model"].is_string());
 
     // A planted counter change: exit 1, the counter named; --no-record leaves the history as it was.

@@ -144,6 +144,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         check: !p.no_check,
         paired: p.paired,
         paired_threads: p.paired_threads,
+        pairs_exact: false,
         max_seconds: p.max_seconds,
         max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
     })
@@ -364,6 +365,7 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
         check: !a.no_check,
         paired: a.paired,
         paired_threads: a.paired_threads,
+        pairs_exact: a.pairs_exact,
     };
     let rec = run_one(&spec)?;
     println!(

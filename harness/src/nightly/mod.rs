@@ -729,6 +729,8 @@ pub fn measure(
         check: false,
         paired: suite.paired,
         paired_threads: 0,
+        // A fixed number of pairs a round: each round's median is taken over `paired` samples.
+        pairs_exact: true,
         max_seconds: suite.max_seconds,
         max_memory: None,
     };

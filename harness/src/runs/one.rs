@@ -28,6 +28,8 @@ pub struct OneSpec {
     /// Pairs of this engine's traces at one thread and at `threads` to time back to back, for
     /// the speed-up over one thread (0: none; ignored at one thread).
     pub paired_threads: u32,
+    /// Exactly `paired` (and `paired_threads`) pairs, not more for fast traces.
+    pub pairs_exact: bool,
 }
 
 /// The most pairs `--paired` takes: each pair traces the whole workload twice.
@@ -39,8 +41,9 @@ fn embree_available() -> bool {
         .any(|e| e.name == "embree" && (e.available)().is_ok())
 }
 
-/// Trace CPU time of `engine` over Embree's, back to back in this process: at least `pairs` pairs,
-/// more for fast traces until they span [`PAIR_SPAN_S`](crate::measure::repeat::PAIR_SPAN_S). Pair i
+/// Trace CPU time of `engine` over Embree's, back to back in this process: `pairs` = (least, most)
+/// pairs, more than the least for fast traces until they span
+/// [`PAIR_SPAN_S`](crate::measure::repeat::PAIR_SPAN_S). Pair i
 /// traces the engine first when i is even and Embree first when it is odd, so a drift in the
 /// machine's speed within a pair cancels over two pairs.
 fn paired_ratios(
@@ -49,7 +52,7 @@ fn paired_ratios(
     engine: &dyn rtbench_engines::Engine,
     yardstick: &dyn rtbench_engines::Engine,
     size: u32,
-    pairs: u32,
+    (pairs, most): (u32, u32),
 ) -> Vec<f64> {
     let time = |e: &dyn rtbench_engines::Engine| {
         pool.install(|| trace::render(scene, e, size, None))
@@ -58,7 +61,7 @@ fn paired_ratios(
     // Embree's first render in a process is slow (cold caches, first-touch page faults), as the
     // engine's was before its untimed render above.
     time(yardstick);
-    let ratios = crate::measure::repeat::pairs(pairs, MAX_PAIRS, |i| {
+    let ratios = crate::measure::repeat::pairs(pairs, most, |i| {
         let (a, b) = if i % 2 == 0 {
             let a = time(engine);
             (a, time(yardstick))
@@ -85,7 +88,7 @@ fn paired_thread_times(
     scene: &rtbench_scenes::Scene,
     engine: &dyn rtbench_engines::Engine,
     size: u32,
-    pairs: u32,
+    (pairs, most): (u32, u32),
 ) -> Result<Vec<(f64, f64, f64, f64)>> {
     let one = crate::measure::threads::pool(Some(1))?;
     let mut image: Option<Vec<u8>> = None;
@@ -106,7 +109,7 @@ fn paired_thread_times(
     // The one-thread pool's first render is slow (its thread's buffers, first touch), as the
     // run's own pool was before its untimed render.
     time(&one)?;
-    crate::measure::repeat::pairs(pairs, MAX_PAIRS, |i| {
+    crate::measure::repeat::pairs(pairs, most, |i| {
         let ((w1, c1), (wn, cn)) = if i % 2 == 0 {
             let a = time(&one)?;
             (a, time(pool)?)
@@ -202,6 +205,8 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
     } else {
         None
     };
+    // The most pairs a run takes: the least asked for when they must be exact.
+    let most = |n: u32| if spec.pairs_exact { n } else { MAX_PAIRS };
     let paired_ratio = match (&yardstick, spec.paired) {
         (Some(y), n) if n > 0 => Some(Spread::of_ratios(&paired_ratios(
             &pool,
@@ -209,7 +214,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             engine.as_ref(),
             y.as_ref(),
             spec.size,
-            n,
+            (n, most(n)),
         ))),
         _ => None,
     };
@@ -219,7 +224,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             scene,
             engine.as_ref(),
             spec.size,
-            spec.paired_threads,
+            (spec.paired_threads, most(spec.paired_threads)),
         )?;
         Some(ThreadScaling::of(pool.current_num_threads(), &pairs))
     } else {

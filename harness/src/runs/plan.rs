@@ -172,6 +172,8 @@ pub struct Common {
     pub paired: u32,
     /// Pairs of one-thread and N-thread traces timed back to back in the child (0: none).
     pub paired_threads: u32,
+    /// Exactly the pairs asked for, not more for fast traces (`run-one --pairs-exact`).
+    pub pairs_exact: bool,
     pub max_seconds: Option<f64>,
     pub max_memory: Option<u64>,
 }
@@ -314,6 +316,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     }
     if common.paired_threads > 0 {
         cmd.args(["--paired-threads", &common.paired_threads.to_string()]);
+    }
+    if common.pairs_exact {
+        cmd.arg("--pairs-exact");
     }
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
