@@ -252,9 +252,10 @@ fn harness_readers_never_panic() {
     }
 }
 
-// Minutes at 10^6 inputs per reader, so not in every `cargo test` (the small run above is); run it
-// by hand with `RTBENCH_FUZZ_N=1000000 cargo test --release -p rtbench --bin rtbench -- --ignored
-// fuzz_at_scale` (RTBENCH_FUZZ_ONLY=history|suite|shard for one reader).
+// Minutes at 10^6 inputs per reader, so not in every `cargo test` (the small run above is); it runs
+// with `RTBENCH_FUZZ_N=1000000 bash scripts/test.sh`, or alone with `RTBENCH_FUZZ_N=1000000 cargo
+// test --release -p rtbench --bin rtbench -- --ignored fuzz_at_scale`
+// (RTBENCH_FUZZ_ONLY=history|suite|shard for one reader).
 #[test]
 #[ignore = "the large run: RTBENCH_FUZZ_N inputs per reader (see the comment above)"]
 fn fuzz_at_scale() {

@@ -60,6 +60,36 @@ struct WalkCounts {
 }
 
 impl WalkCounts {
+    /// Whether the walk tests primitive `p` in this cell, counted: not when this ray tested it
+    /// already (`MB`: its mailbox stamp), nor when its box is apart from the ray's piece of the
+    /// cell (`CULL`); a primitive admitted is stamped. Both walks, closest and any hit, filter so.
+    #[inline(always)]
+    fn admit<const MB: bool, const CULL: bool>(
+        &mut self,
+        p: usize,
+        stamps: &mut [u32],
+        stamp: u32,
+        bounds: &[[Vec3; 2]],
+        piece: &(Vec3, Vec3),
+    ) -> bool {
+        if MB && stamps[p] == stamp {
+            self.mailbox_skips += 1;
+            return false;
+        }
+        if CULL {
+            self.box_tests += 1;
+            if apart(&bounds[p], piece) {
+                self.culled += 1;
+                return false;
+            }
+        }
+        if MB {
+            stamps[p] = stamp;
+        }
+        self.tests += 1;
+        true
+    }
+
     #[inline(always)]
     fn flush(&self, c: &mut Counters, l: &mut Local) {
         c.cells_visited += self.cells;
@@ -163,21 +193,9 @@ impl Grid {
                     // Indexed once here: `stamps` and `bounds` have this length, so their own
                     // checks fold into this one.
                     let prim = &prims[p as usize];
-                    if MB && stamps[p as usize] == stamp {
-                        n.mailbox_skips += 1;
+                    if !n.admit::<MB, CULL>(p as usize, stamps, stamp, bounds, &piece) {
                         continue;
                     }
-                    if CULL {
-                        n.box_tests += 1;
-                        if apart(&bounds[p as usize], &piece) {
-                            n.culled += 1;
-                            continue;
-                        }
-                    }
-                    if MB {
-                        stamps[p as usize] = stamp;
-                    }
-                    n.tests += 1;
                     if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
                         hits += 1;
                         (r.tmax, best, bu, bv) = (t, p, u, v);
@@ -264,21 +282,9 @@ impl Grid {
                     // Indexed once here: `stamps` and `bounds` have this length, so their own
                     // checks fold into this one.
                     let prim = &prims[p as usize];
-                    if MB && stamps[p as usize] == stamp {
-                        n.mailbox_skips += 1;
+                    if !n.admit::<MB, CULL>(p as usize, stamps, stamp, bounds, &piece) {
                         continue;
                     }
-                    if CULL {
-                        n.box_tests += 1;
-                        if apart(&bounds[p as usize], &piece) {
-                            n.culled += 1;
-                            continue;
-                        }
-                    }
-                    if MB {
-                        stamps[p as usize] = stamp;
-                    }
-                    n.tests += 1;
                     if prim.intersect(ray, test, &s.wt).is_some() {
                         blocker = p;
                         return true;
