@@ -60,34 +60,56 @@ struct WalkCounts {
 }
 
 impl WalkCounts {
-    /// Whether the walk tests primitive `p` in this cell, counted: not when this ray tested it
-    /// already (`MB`: its mailbox stamp), nor when its box is apart from the ray's piece of the
-    /// cell (`CULL`); a primitive admitted is stamped. Both walks, closest and any hit, filter so.
+    /// The next primitive of a cell's list, from `list[*at]` on, that the walk tests, counted:
+    /// not one this ray tested already (`MB`: its mailbox stamp), nor one whose box is apart
+    /// from the ray's piece of the cell (`CULL`); a primitive admitted is stamped. Both walks,
+    /// closest and any hit, filter so. `*at` moves past the primitive returned (or to the
+    /// list's end).
+    ///
+    /// The scan keeps its counts in locals and adds them once: the big cells of balls and tree
+    /// have hundreds of references that the culling test rejects, and counting each through
+    /// the walk's captured counts was a load and a store per reference, one after the other.
     #[inline(always)]
-    fn admit<const MB: bool, const CULL: bool>(
+    #[allow(clippy::too_many_arguments)]
+    fn next_admitted<const MB: bool, const CULL: bool>(
         &mut self,
-        p: usize,
+        list: &[u32],
+        at: &mut usize,
         stamps: &mut [u32],
         stamp: u32,
         bounds: &[[Vec3; 2]],
-        piece: &(Vec3, Vec3),
-    ) -> bool {
-        if MB && stamps[p] == stamp {
-            self.mailbox_skips += 1;
-            return false;
-        }
-        if CULL {
-            self.box_tests += 1;
-            if apart(&bounds[p], piece) {
-                self.culled += 1;
-                return false;
+        piece: &CullPiece,
+    ) -> Option<u32> {
+        let (mut skips, mut boxes, mut culled) = (0u64, 0u64, 0u64);
+        let mut k = *at;
+        let found = loop {
+            let Some(&p) = list.get(k) else {
+                break None;
+            };
+            k += 1;
+            let i = p as usize;
+            if MB && stamps[i] == stamp {
+                skips += 1;
+                continue;
             }
-        }
-        if MB {
-            stamps[p] = stamp;
-        }
-        self.tests += 1;
-        true
+            if CULL {
+                boxes += 1;
+                if piece.apart(&bounds[i]) {
+                    culled += 1;
+                    continue;
+                }
+            }
+            if MB {
+                stamps[i] = stamp;
+            }
+            break Some(p);
+        };
+        *at = k;
+        self.mailbox_skips += skips;
+        self.box_tests += boxes;
+        self.culled += culled;
+        self.tests += found.is_some() as u64;
+        found
     }
 
     #[inline(always)]
@@ -101,18 +123,73 @@ impl WalkCounts {
     }
 }
 
-/// Whether the box `b` lies apart from `piece` along some axis (`Vec3::cmpgt(..).any()` of
-/// either side, the same answer: a NaN compares false either way), without the six
-/// short-circuit branches `any() || any()` compiled to.
-#[inline(always)]
-fn apart(b: &[Vec3; 2], piece: &(Vec3, Vec3)) -> bool {
-    let ([lo, hi], (plo, phi)) = (b, piece);
-    (lo.x > phi.x)
-        | (lo.y > phi.y)
-        | (lo.z > phi.z)
-        | (hi.x < plo.x)
-        | (hi.y < plo.y)
-        | (hi.z < plo.z)
+/// The ray's piece of a cell as the culling test reads it.
+#[derive(Clone, Copy)]
+struct CullPiece {
+    #[cfg(target_arch = "x86_64")]
+    lanes: (std::arch::x86_64::__m128, std::arch::x86_64::__m128),
+    #[cfg(not(target_arch = "x86_64"))]
+    lohi: (Vec3, Vec3),
+}
+
+impl CullPiece {
+    /// The piece's box `(lo, hi)`. On x86-64 as the lanes `apart` compares with: (hi.x, hi.y,
+    /// hi.z, +inf) and (-inf, lo.x, lo.y, lo.z).
+    #[inline(always)]
+    fn new(piece: (Vec3, Vec3)) -> CullPiece {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            let (lo, hi) = piece;
+            // SAFETY: SSE2 is part of the x86-64 baseline; `setr` only places values.
+            unsafe {
+                CullPiece {
+                    lanes: (
+                        _mm_setr_ps(hi.x, hi.y, hi.z, f32::INFINITY),
+                        _mm_setr_ps(f32::NEG_INFINITY, lo.x, lo.y, lo.z),
+                    ),
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            CullPiece { lohi: piece }
+        }
+    }
+
+    /// Whether the box `b` lies apart from the piece along some axis: `lo > piece.hi` or
+    /// `hi < piece.lo` on an axis (`Vec3::cmpgt(..).any()` of either side, the same answer: a
+    /// NaN compares false either way). On x86-64 in two SSE comparisons: the box's six floats
+    /// as the lanes (lo.x, lo.y, lo.z, hi.x) and (lo.z, hi.x, hi.y, hi.z) against the piece's
+    /// lanes, whose padding lanes (+inf, -inf) never compare true.
+    #[inline(always)]
+    fn apart(&self, b: &[Vec3; 2]) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            // `[Vec3; 2]` is six contiguous floats (`Vec3` is `repr(C)`, 12 bytes).
+            let f = b.as_ptr() as *const f32;
+            // SAFETY: SSE2 is part of the x86-64 baseline. Each unaligned load reads 4 of the
+            // box's 6 floats (from the first and from the third).
+            unsafe {
+                let lo = _mm_loadu_ps(f);
+                let hi = _mm_loadu_ps(f.add(2));
+                let (phi, plo) = self.lanes;
+                let m = _mm_or_ps(_mm_cmpgt_ps(lo, phi), _mm_cmplt_ps(hi, plo));
+                _mm_movemask_ps(m) != 0
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let ([lo, hi], (plo, phi)) = (b, &self.lohi);
+            (lo.x > phi.x)
+                | (lo.y > phi.y)
+                | (lo.z > phi.z)
+                | (hi.x < plo.x)
+                | (hi.y < plo.y)
+                | (hi.z < plo.z)
+        }
+    }
 }
 
 impl Grid {
@@ -184,18 +261,16 @@ impl Grid {
                     n.empty += 1;
                     return r.tmax <= t_exit;
                 }
-                let piece = if CULL {
+                let piece = CullPiece::new(if CULL {
                     segment_box(&r, t_enter, t_exit.min(r.tmax), g.pad)
                 } else {
                     (Vec3::ZERO, Vec3::ZERO)
-                };
-                for &p in list {
-                    // Indexed once here: `stamps` and `bounds` have this length, so their own
-                    // checks fold into this one.
+                });
+                let mut at = 0;
+                while let Some(p) =
+                    n.next_admitted::<MB, CULL>(list, &mut at, stamps, stamp, bounds, &piece)
+                {
                     let prim = &prims[p as usize];
-                    if !n.admit::<MB, CULL>(p as usize, stamps, stamp, bounds, &piece) {
-                        continue;
-                    }
                     if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
                         hits += 1;
                         (r.tmax, best, bu, bv) = (t, p, u, v);
@@ -273,18 +348,16 @@ impl Grid {
                     n.empty += 1;
                     return false;
                 }
-                let piece = if CULL {
+                let piece = CullPiece::new(if CULL {
                     segment_box(ray, t_enter, t_exit, g.pad)
                 } else {
                     (Vec3::ZERO, Vec3::ZERO)
-                };
-                for &p in list {
-                    // Indexed once here: `stamps` and `bounds` have this length, so their own
-                    // checks fold into this one.
+                });
+                let mut at = 0;
+                while let Some(p) =
+                    n.next_admitted::<MB, CULL>(list, &mut at, stamps, stamp, bounds, &piece)
+                {
                     let prim = &prims[p as usize];
-                    if !n.admit::<MB, CULL>(p as usize, stamps, stamp, bounds, &piece) {
-                        continue;
-                    }
                     if prim.intersect(ray, test, &s.wt).is_some() {
                         blocker = p;
                         return true;
