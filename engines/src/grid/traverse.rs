@@ -80,8 +80,12 @@ impl WalkCounts {
         bounds: &[[Vec3; 2]],
         piece: &CullPiece,
     ) -> Option<u32> {
-        let (mut skips, mut boxes, mut culled) = (0u64, 0u64, 0u64);
-        let mut k = *at;
+        // Only the rare mailbox skips are counted in the loop: every other reference scanned
+        // is box-tested (`CULL`) and then culled, except the one admitted, so the loop carries
+        // no count through memory when the compiler runs out of registers.
+        let start = *at;
+        let mut skips = 0u64;
+        let mut k = start;
         let found = loop {
             let Some(&p) = list.get(k) else {
                 break None;
@@ -92,12 +96,8 @@ impl WalkCounts {
                 skips += 1;
                 continue;
             }
-            if CULL {
-                boxes += 1;
-                if piece.apart(&bounds[i]) {
-                    culled += 1;
-                    continue;
-                }
+            if CULL && piece.apart(&bounds[i]) {
+                continue;
             }
             if MB {
                 stamps[i] = stamp;
@@ -105,10 +105,14 @@ impl WalkCounts {
             break Some(p);
         };
         *at = k;
+        let admitted = found.is_some() as u64;
         self.mailbox_skips += skips;
-        self.box_tests += boxes;
-        self.culled += culled;
-        self.tests += found.is_some() as u64;
+        if CULL {
+            let boxes = (k - start) as u64 - skips;
+            self.box_tests += boxes;
+            self.culled += boxes - admitted;
+        }
+        self.tests += admitted;
         found
     }
 
