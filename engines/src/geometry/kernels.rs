@@ -212,7 +212,10 @@ macro_rules! kernels {
 
         /// Woop, Benthin and Wald 2013, "Watertight Ray/Triangle Intersection": edges shared by
         /// two triangles are never missed and never hit twice. Returns (t, u, v) as Möller's.
-        #[inline]
+        ///
+        /// Always inlined: left to itself the compiler kept it out of line in the grid's walks,
+        /// a call per test with the triangle copied to the stack for it.
+        #[inline(always)]
         pub fn triangle_watertight(
             o: V,
             w: &WatertightRay,
