@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The tables of docs/benchmarks.md from the runs of scripts/benchmarks.sh: python3 scripts/benchmarks.py OUT.
 
-Intervals are distribution-free 95 % intervals of a median from the order statistics of its samples (the
-binomial ranks; with 7 samples, the smallest and largest: 98 % coverage; with 9, the 2nd and 8th: 96 %). Fewer than 6 samples give no
+A ratio measured in pairs over rounds (`run --repeat 3 --paired 9`: three processes, each round's median of its
+pairs) is shown with the 95 % interval `rtbench run` gives it, Student's t over the rounds. Other intervals are
+distribution-free 95 % intervals of a median from the order statistics of its samples (the binomial ranks; with 7
+samples, the smallest and largest: 98 % coverage; with 9, the 2nd and 8th: 96 %). Fewer than 6 samples give no
 interval at 95 % and are shown as their range, marked "range"."""
 import json
 import math
@@ -46,6 +48,15 @@ def median_ci(xs):
     if best is None:
         return med, xs[0], xs[-1], False
     return med, best[0], best[1], True
+
+
+def pairs_ci(r, spread):
+    """A paired figure's (estimate, lo, hi, exact): over the run's rounds when it ran in two or more (the
+    interval its record carries), else from the order statistics of its pairs."""
+    i = spread.get("interval")
+    if len((r or {}).get("rounds") or []) >= 2 and i:
+        return i["estimate"], i["lo"], i["hi"], True
+    return median_ci(spread["samples"])
 
 
 def fmt_ci(c, digits=2):
@@ -105,7 +116,7 @@ def speed(d):
         for e in engines:
             r = t[s].get(e)
             p = (r or {}).get("paired_ratio")
-            c = median_ci(p["samples"]) if p else None
+            c = pairs_ci(r, p) if p else None
             if c:
                 logs[e].append(math.log(c[0]))
             agree = (r or {}).get("check") or {}
@@ -154,7 +165,7 @@ def threads(d):
         row = [s]
         for e in engines:
             ts = (t[s].get(e) or {}).get("thread_scaling")
-            row.append(fmt_ci(median_ci(ts["speedup"]["samples"])) if ts else "–")
+            row.append(fmt_ci(pairs_ci(t[s].get(e), ts["speedup"])) if ts else "–")
         rows.append(row)
     return md(["scene"] + [f"{e} speed-up at 2 threads" for e in engines], rows) + failures(recs)
 

@@ -234,6 +234,13 @@ pub struct PlanArgs {
     /// Repeats of each run (min, median, max are reported).
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
+    /// Rounds each run's repeats and pairs are spread over (default 3, never more than
+    /// --repeat): every round runs each job once, in a process of its own, so a run's samples
+    /// come from several processes minutes apart, and its intervals (and `compare`) take the
+    /// round as the unit. Two processes of one binary differ by several percent in speed against
+    /// Embree, which one process's samples cannot show. `sweep` runs each job in one process.
+    #[arg(long, value_name = "R")]
+    pub rounds: Option<u32>,
     /// Threads: a list of counts and/or `all`, e.g. `1,all` (a count above the available
     /// parallelism is refused).
     #[arg(long, default_value = "1")]
@@ -245,15 +252,15 @@ pub struct PlanArgs {
     #[arg(long)]
     pub no_check: bool,
     /// In every run of an engine other than Embree, also time at least N back-to-back pairs of the
-    /// engine and Embree in one process (alternating which goes first; fast traces get more, until
-    /// the pairs span two seconds, at most 8 N); `report` shows their median ratio and
-    /// `compare` judges on it: load on the machine and the state of one process move it far less
-    /// than the ratio of two separate runs. 0 turns pairs off (and with --no-check, Embree is not
+    /// engine and Embree, shared out over the rounds (alternating which goes first; fast traces
+    /// get more, until each round's pairs span two seconds, at most 8 times its share); `report`
+    /// shows their ratio and `compare` judges on it: load on the machine moves it far less than
+    /// the ratio of two separate runs. 0 turns pairs off (and with --no-check, Embree is not
     /// built at all).
     #[arg(long, default_value_t = 5)]
     pub paired: u32,
-    /// In every run at more than one thread, also time at least N back-to-back pairs (more for
-    /// fast traces, as --paired takes them) of the same trace at
+    /// In every run at more than one thread, also time at least N back-to-back pairs (shared out
+    /// over the rounds; more for fast traces, as --paired takes them) of the same trace at
     /// one thread and at the run's threads in one process (alternating which goes first), and
     /// record the speed-up over one thread per pair (`thread_scaling`: median and range);
     /// `report` shows it. Runs at one thread ignore it.

@@ -96,12 +96,17 @@ fn killed_run_leaves_valid_results_and_resume_completes_it() {
     assert!(ok(&out));
     let after = records(&dir);
     assert_eq!(after.len(), 6);
-    // The runs done before the kill were kept, not redone.
+    // Each run in two rounds (--repeat 2: one repeat a round, in two processes).
+    assert!(after
+        .iter()
+        .all(|a| a["rounds"].as_array().map(Vec::len) == Some(2)));
+    // The rounds done before the kill were kept, not redone: their samples come first.
     for r in &before {
+        let kept = &r["time_s"]["trace"]["samples"][0];
         assert!(
             after
                 .iter()
-                .any(|a| a["key"] == r["key"] && a["finished_at"] == r["finished_at"]),
+                .any(|a| a["key"] == r["key"] && &a["time_s"]["trace"]["samples"][0] == kept),
             "{} redone",
             r["key"]
         );

@@ -52,7 +52,8 @@ impl<'a> Anchors<'a> {
 }
 
 /// Sets every ok run's [`RunRecord::ratio_to_embree`] from its Embree run in `records` (trace CPU
-/// time when recorded, else wall time; the quotient of geometric means with its Welch interval);
+/// time when recorded, else wall time; the quotient of geometric means with its Welch interval,
+/// or over rounds where both ran in the same number of rounds, [`crate::rounds::quotient`]);
 /// clears it where there is no Embree run or too few repeats.
 pub fn attach_ratios(records: &mut [RunRecord]) {
     let ratios: Vec<Option<crate::interval::Interval>> = {
@@ -61,6 +62,9 @@ pub fn attach_ratios(records: &mut [RunRecord]) {
             .iter()
             .map(|r| {
                 let a = anchors.anchor(r).filter(|_| r.ok() && r.engine != EMBREE)?;
+                if let Some(q) = crate::rounds::quotient(r, a) {
+                    return Some(q.interval());
+                }
                 crate::interval::of_quotient(
                     &r.time_s.trace_for_compare().samples,
                     &a.time_s.trace_for_compare().samples,

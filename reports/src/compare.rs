@@ -7,7 +7,10 @@
 //!   on its 95 % interval ([`crate::interval`]): on the log scale, B's ratio minus A's, each the mean log
 //!   of the engine's repeats minus the mean log of Embree's (or the median log of the paired ratios,
 //!   [`crate::interval::LogMean::median_of`], where both sets timed pairs, `run --paired N`), with
-//!   Welch–Satterthwaite degrees of freedom. A regression
+//!   Welch–Satterthwaite degrees of freedom. Where both sets ran in rounds (`run --rounds R`), each
+//!   side's figure is instead the mean of its rounds' figures, and its interval Student's t over
+//!   the rounds ([`crate::rounds`]): a process's state and the minute it ran in then count as the
+//!   noise they are. A regression
 //!   needs the whole interval above +threshold, an improvement the whole interval below −threshold; a
 //!   change whose estimate passes the threshold while its interval reaches back inside is reported as
 //!   "too few samples to decide", and so is a run with fewer than two samples on a side. Embree's own
@@ -20,6 +23,7 @@ use crate::anchor::{Anchors, EMBREE};
 use crate::interval::{self, LogMean};
 use crate::number;
 use crate::results::{read_environment, read_results, Environment, RunRecord};
+use crate::rounds;
 use crate::summary::latest_per_key;
 use crate::ReportError;
 use serde::Serialize;
@@ -511,6 +515,24 @@ fn compare_times(
     // ratios, each set's median log of its pairs.
     if let (Some(pa), Some(pb)) = (paired(ra), paired(rb)) {
         c.times_compared += 1;
+        // Where both sides ran in rounds, the round is the unit ([`crate::rounds`]).
+        if let (Some(a), Some(b)) = (rounds::paired(ra), rounds::paired(rb)) {
+            judge(
+                ra,
+                Judged {
+                    kind: FindingKind::TimeRatio,
+                    what: "trace time / Embree (paired)",
+                    old: a.mean.exp(),
+                    new: b.mean.exp(),
+                    change: Some(b.minus(&a)),
+                    samples: [a.n, b.n],
+                    unit: "rounds",
+                    higher_is_worse: true,
+                },
+                c,
+            );
+            return;
+        }
         let change = LogMean::median_of(&pb.samples)
             .zip(LogMean::median_of(&pa.samples))
             .map(|(b, a)| b.minus(&a));
@@ -524,6 +546,7 @@ fn compare_times(
                 new: qb,
                 change,
                 samples: [pa.samples.len(), pb.samples.len()],
+                unit: "samples",
                 higher_is_worse: true,
             },
             c,
@@ -553,6 +576,23 @@ fn compare_times(
         return;
     };
     c.times_compared += 1;
+    if let (Some(a), Some(b)) = (rounds::quotient(ra, ya), rounds::quotient(rb, yb)) {
+        judge(
+            ra,
+            Judged {
+                kind: FindingKind::TimeRatio,
+                what: "trace time / Embree",
+                old: a.mean.exp(),
+                new: b.mean.exp(),
+                change: Some(b.minus(&a)),
+                samples: [a.n, b.n],
+                unit: "rounds",
+                higher_is_worse: true,
+            },
+            c,
+        );
+        return;
+    }
     let t = |r: &RunRecord| r.time_s.trace_for_compare().samples.clone();
     let (ea, eb, sa, sb) = (t(ra), t(rb), t(ya), t(yb));
     let change = match (
@@ -578,6 +618,7 @@ fn compare_times(
             new: geo(&eb) / geo(&sb),
             change,
             samples: [ea.len() + sa.len(), eb.len() + sb.len()],
+            unit: "samples",
             higher_is_worse: true,
         },
         c,
@@ -591,6 +632,23 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
     let (Some(sa), Some(sb)) = (&ra.thread_scaling, &rb.thread_scaling) else {
         return;
     };
+    if let (Some(a), Some(b)) = (rounds::speedup(ra), rounds::speedup(rb)) {
+        judge(
+            ra,
+            Judged {
+                kind: FindingKind::ThreadSpeedup,
+                what: "speed-up over 1 thread",
+                old: a.mean.exp(),
+                new: b.mean.exp(),
+                change: Some(b.minus(&a)),
+                samples: [a.n, b.n],
+                unit: "rounds",
+                higher_is_worse: false,
+            },
+            c,
+        );
+        return;
+    }
     let (pa, pb) = (&sa.speedup, &sb.speedup);
     let change = LogMean::median_of(&pb.samples)
         .zip(LogMean::median_of(&pa.samples))
@@ -604,6 +662,7 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
             new: median_ratio(&pb.samples),
             change,
             samples: [pa.samples.len(), pb.samples.len()],
+            unit: "samples",
             higher_is_worse: false,
         },
         c,
@@ -639,6 +698,8 @@ struct Judged<'a> {
     /// B's log figure minus A's; `None` when a side has fewer than two samples.
     change: Option<LogMean>,
     samples: [usize; 2],
+    /// What `samples` counts: "samples", or "rounds" where each side's figure is over rounds.
+    unit: &'a str,
     /// A rise is a regression (a time ratio), else a fall is (a speed-up).
     higher_is_worse: bool,
 }
@@ -662,11 +723,12 @@ fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
             interval_pct: None,
             samples: Some(j.samples),
             message: format!(
-                "{}: {} {} → {}: too few samples to decide ({na} in A, {nb} in B; at least 2 a side)",
+                "{}: {} {} → {}: too few samples to decide ({na} {} in A, {nb} in B; at least 2 a side)",
                 ra.key,
                 j.what,
                 number::ratio(j.old),
-                number::ratio(j.new)
+                number::ratio(j.new),
+                j.unit
             ),
         });
         return;
@@ -688,7 +750,7 @@ fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
         None
     };
     let interval_text = format!("95 % CI [{}%, {}%]", signed(lo), signed(hi));
-    let n_text = format!("{na} samples in A, {nb} in B");
+    let n_text = format!("{na} {} in A, {nb} in B", j.unit);
     let mut f = Finding {
         key: ra.key.clone(),
         kind: j.kind,

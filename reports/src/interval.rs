@@ -46,7 +46,16 @@ pub struct LogMean {
 impl LogMean {
     /// Of positive finite samples; `None` with fewer than two usable samples.
     pub fn of(samples: &[f64]) -> Option<LogMean> {
-        let logs = logs(samples)?;
+        LogMean::of_logs(&logs(samples)?)
+    }
+
+    /// Of values already on the log scale (one log figure per round, say): their mean, with the
+    /// squared standard error s²/n and n − 1 degrees of freedom; `None` with fewer than two
+    /// values or any that is not finite.
+    pub fn of_logs(logs: &[f64]) -> Option<LogMean> {
+        if logs.len() < 2 || logs.iter().any(|l| !l.is_finite()) {
+            return None;
+        }
         let n = logs.len();
         let mean = logs.iter().sum::<f64>() / n as f64;
         let s2 = logs.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
@@ -130,6 +139,16 @@ fn logs(samples: &[f64]) -> Option<Vec<f64>> {
         .map(|x| x.ln())
         .collect();
     (logs.len() >= 2 && logs.len() == samples.len()).then_some(logs)
+}
+
+/// The median log of one or more positive finite samples (`None` otherwise): one round's figure
+/// of its pairs ([`crate::rounds`]).
+pub fn median_log(samples: &[f64]) -> Option<f64> {
+    if samples.is_empty() || samples.iter().any(|x| !x.is_finite() || *x <= 0.0) {
+        return None;
+    }
+    let mut logs: Vec<f64> = samples.iter().map(|x| x.ln()).collect();
+    Some(median(&mut logs))
 }
 
 /// The median of some values (NaN for none); sorts them.

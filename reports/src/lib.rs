@@ -31,6 +31,7 @@ pub mod number;
 pub mod plot;
 mod report;
 pub mod results;
+pub mod rounds;
 mod scaling;
 mod summary;
 mod table;
@@ -42,7 +43,7 @@ pub use error::ReportError;
 pub use interval::Interval;
 pub use report::{write_report, Format};
 pub use results::{
-    read_environment, read_results, run_key, CheckResult, Environment, ReadError, RunRecord,
+    read_environment, read_results, run_key, CheckResult, Environment, ReadError, Round, RunRecord,
     Sample, SceneInfo, Spread, Timings,
 };
 pub use scaling::ThreadScaling;

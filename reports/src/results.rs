@@ -229,10 +229,29 @@ pub struct RunRecord {
     /// Wall seconds of the whole child process.
     pub wall_s: f64,
     pub finished_at: String,
+    /// How the samples split into rounds (`rtbench run --rounds R`, the nightly's rounds): round i
+    /// is one process at one time, and its repeats, pairs and thread pairs follow round i − 1's in
+    /// `samples`, `paired_ratio` and `thread_scaling`. Intervals and `compare` take the round as
+    /// the unit where there are two or more ([`crate::rounds`]). Empty for a run of one process.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rounds: Vec<Round>,
     /// The machine (host name) the run was measured on, set by `rtbench merge` when shards run on
     /// several machines: a run and its Embree anchor always share one. `None` in unsharded results.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+}
+
+/// What one round of a run (one process) measured: how many of the run's samples are its own.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+pub struct Round {
+    /// Timed repeats (in `samples` and every `time_s` spread).
+    pub repeats: usize,
+    /// Pairs with Embree (in `paired_ratio`).
+    #[serde(default)]
+    pub pairs: usize,
+    /// Pairs of one thread and the run's threads (in `thread_scaling`).
+    #[serde(default)]
+    pub thread_pairs: usize,
 }
 
 impl RunRecord {

@@ -62,6 +62,9 @@ pub struct Row {
     /// The machine the run (and so its ratio to Embree) was measured on, in merged shard results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+    /// Rounds the run was spread over (`run --rounds`; 1 for one process): with two or more,
+    /// its intervals are over the rounds, and `n` counts rounds.
+    pub rounds: usize,
 }
 
 /// A run that did not finish, and why.
@@ -209,6 +212,7 @@ impl Summary {
                 check: r.check.clone(),
                 thread_scaling: r.thread_scaling.clone(),
                 machine: r.machine.clone(),
+                rounds: r.rounds.len().max(1),
             })
             .collect();
         rows.sort_by(|a, b| {

@@ -20,6 +20,16 @@ const HEADER: [(&str, bool); 12] = [
     ("PSNR dB", true),
 ];
 
+/// What an interval's n counts: the run's rounds where it was spread over two or more (the
+/// interval is then over the rounds), else its samples.
+fn count(r: &Row, i: &crate::interval::Interval) -> String {
+    if r.rounds >= 2 && i.n == r.rounds {
+        format!("{} rounds", i.n)
+    } else {
+        i.n.to_string()
+    }
+}
+
 /// One table per thread count: scene × engine.
 /// In results merged from shards (`rtbench merge`), a last column names the machine each row (and
 /// its ratio to Embree, always measured on the same machine) comes from.
@@ -75,13 +85,13 @@ fn cells(r: &Row) -> Vec<String> {
         ),
         number::sig(r.mrays_per_s, 3),
         match (&r.ratio_interval, r.ratio_to_embree) {
-            (Some(i), _) => format!("{} ({})", i.text(), i.n),
+            (Some(i), _) => format!("{} ({})", i.text(), count(r, i)),
             (None, Some(q)) if r.engine == crate::anchor::EMBREE => number::ratio(q),
             (None, Some(q)) => format!("{} (too few repeats for an interval)", number::ratio(q)),
             _ => "–".to_string(),
         },
         match r.paired_ratio.as_ref().and_then(|p| p.interval.as_ref()) {
-            Some(i) => format!("{} ({})", i.text(), i.n),
+            Some(i) => format!("{} ({})", i.text(), count(r, i)),
             None => match &r.paired_ratio {
                 Some(p) => format!("{} ({})", number::ratio(p.median), p.samples.len()),
                 None => "–".to_string(),

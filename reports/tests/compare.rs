@@ -151,7 +151,7 @@ fn a_regression_needs_its_whole_interval_past_the_threshold() {
     assert!(!c.is_regression());
     assert!(c.notes.iter().any(|f| f.kind == FindingKind::Undecided
         && f.message
-            .contains("too few samples to decide (2 in A, 2 in B")));
+            .contains("too few samples to decide (2 samples in A, 2 in B")));
 }
 
 #[test]
@@ -331,6 +331,48 @@ fn paired_ratios_are_compared_when_both_runs_have_them() {
         .find(|f| f.key == "grid/balls3@1")
         .expect("the paired slowdown is found");
     assert!((f.change_pct.unwrap() - 20.0).abs() < 0.5, "{f:?}");
+}
+
+/// Paired ratios in three rounds (`run --rounds 3`), each round's four pairs within 0.2 % of its
+/// own figure: `q` scaled by `shifts[i]` in round i.
+fn rounds(r: &mut RunRecord, q: f64, shifts: [f64; 3]) {
+    let mut v = Vec::new();
+    for s in shifts {
+        v.extend([0.998, 1.0, 1.001, 1.002].map(|x| q * s * x));
+    }
+    r.paired_ratio = Some(rtbench_reports::Spread::of_ratios(&v));
+    r.rounds = vec![
+        rtbench_reports::Round {
+            repeats: 1,
+            pairs: 4,
+            thread_pairs: 0
+        };
+        3
+    ];
+}
+
+#[test]
+fn with_rounds_a_process_shifted_as_a_whole_is_noise_and_a_slowdown_is_not() {
+    // Same code: in B one process ran 7 % fast against Embree (all its pairs), as processes do.
+    // Pooled, the pairs' median moves less but its interval is narrower still; by rounds, the
+    // shift is the spread it is.
+    let (mut a, mut b) = (base(), base());
+    rounds(find(&mut a, "grid/balls3@1"), 7.7, [1.0, 1.0, 1.0]);
+    rounds(find(&mut b, "grid/balls3@1"), 7.7, [1.0, 1.07, 1.0]);
+    let c = compare_sets(&a, &b, 5.0);
+    assert!(!c.is_regression(), "{}", c.to_markdown());
+    // 10 % slower in every round: a regression, judged on 3 rounds a side.
+    rounds(find(&mut a, "grid/balls3@1"), 7.7, [1.0, 1.01, 0.99]);
+    rounds(find(&mut b, "grid/balls3@1"), 8.47, [1.0, 0.99, 1.01]);
+    let c = compare_sets(&a, &b, 5.0);
+    let f = c
+        .regressions
+        .iter()
+        .find(|f| f.key == "grid/balls3@1")
+        .expect("the slowdown is found");
+    assert_eq!(f.samples, Some([3, 3]));
+    assert!(f.message.contains("3 rounds in A, 3 in B"), "{}", f.message);
+    assert!((f.change_pct.unwrap() - 10.0).abs() < 0.5, "{f:?}");
 }
 
 /// A speed-up over one thread timed in pairs (`run --paired-threads`), 1% spread around `s`.

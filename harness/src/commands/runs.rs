@@ -128,6 +128,10 @@ fn plan_threads(p: &PlanArgs) -> Result<Vec<Option<usize>>> {
         .collect()
 }
 
+/// Rounds of `run` when --rounds is not given: with the default three repeats, one repeat a
+/// round, each job's samples from three processes.
+pub const DEFAULT_ROUNDS: u32 = 3;
+
 fn common(p: &PlanArgs) -> Result<Common> {
     workload::check_size(p.size)?;
     if p.repeat == 0 {
@@ -138,8 +142,13 @@ fn common(p: &PlanArgs) -> Result<Common> {
             return Err(input(format!("--max-seconds {s}: must be positive")));
         }
     }
+    let rounds = p.rounds.unwrap_or(DEFAULT_ROUNDS);
+    if rounds == 0 {
+        return Err(input("--rounds must be at least 1"));
+    }
     Ok(Common {
         repeats: p.repeat,
+        rounds,
         size: p.size,
         check: !p.no_check,
         paired: p.paired,
@@ -261,7 +270,15 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     if threads.len() != 1 {
         return Err(input("sweep: give one --threads value"));
     }
-    let common = common(&a.plan)?;
+    if a.plan.rounds.is_some_and(|r| r != 1) {
+        return Err(input(
+            "sweep: --rounds is for run (a sweep runs each size factor once, in one process)",
+        ));
+    }
+    let common = Common {
+        rounds: 1,
+        ..common(&a.plan)?
+    };
     if common.max_seconds.is_none() && common.max_memory.is_none() {
         return Err(input(
             "sweep: give --max-seconds or --max-memory (the limit that ends each scene's sweep)",

@@ -219,8 +219,8 @@ impl StoreBytes for StoreWriter {
 }
 
 /// `rtbench scene store`: streams the scene into a store directory (seed 000's "S"; format in
-/// `rtbench_engines::store`). Written as `.NAME.tmp-PID` beside `out` and renamed when complete,
-/// so a failure (bad input, full disk) leaves nothing behind.
+/// `rtbench_engines::store`). Written into a temporary directory `.NAME.tmp-…` beside `out` and
+/// renamed when complete, so a failure (bad input, full disk) leaves nothing behind.
 pub fn store(
     src: &Source,
     out: &Path,
@@ -270,11 +270,14 @@ pub fn store(
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let tmp = parent.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    std::fs::create_dir_all(parent)
+        .map_err(|e| input(format!("{}: cannot write: {e}", out.display())))?;
+    // Removed when this returns early (an error) or on a signal; kept and renamed when whole.
+    let tmp_dir = tempfile::Builder::new()
+        .prefix(&format!(".{}.tmp-", name.to_string_lossy()))
+        .tempdir_in(parent)
+        .map_err(|e| input(format!("{}: cannot write: {e}", out.display())))?;
+    let tmp = tmp_dir.path().to_path_buf();
     let cleanup = |e: String| {
         let _ = std::fs::remove_dir_all(&tmp);
         input(e)
@@ -320,6 +323,7 @@ pub fn store(
     if out.exists() {
         let _ = std::fs::remove_dir(out);
     }
+    let tmp = tmp_dir.keep();
     std::fs::rename(&tmp, out)
         .map_err(|e| cleanup(format!("{}: cannot rename into place: {e}", out.display())))?;
     let header = StoreHeader::read(out).map_err(|e| input(e.to_string()))?;

@@ -664,31 +664,6 @@ pub fn summary_markdown(
     s
 }
 
-/// One job's record over the rounds: the samples of every round, the counters of the first.
-fn merge(mut a: RunRecord, b: &RunRecord) -> RunRecord {
-    use rtbench_reports::Spread;
-    let cat = |x: &Spread, y: &Spread| {
-        let mut v = x.samples.clone();
-        v.extend(&y.samples);
-        Spread::of(&v)
-    };
-    let t = &mut a.time_s;
-    t.build = cat(&t.build, &b.time_s.build);
-    t.trace = cat(&t.trace, &b.time_s.trace);
-    t.intersect = cat(&t.intersect, &b.time_s.intersect);
-    t.shade = cat(&t.shade, &b.time_s.shade);
-    t.trace_cpu = cat(&t.trace_cpu, &b.time_s.trace_cpu);
-    a.paired_ratio = match (&a.paired_ratio, &b.paired_ratio) {
-        (Some(x), Some(y)) => Some(cat(x, y)),
-        (x, y) => x.clone().or_else(|| y.clone()),
-    };
-    a.repeats += b.repeats;
-    a.mrays_per_s = a.rays_total as f64 / a.time_s.trace.median.max(1e-12) / 1e6;
-    a.wall_s += b.wall_s;
-    a.peak_rss_bytes = a.peak_rss_bytes.max(b.peak_rss_bytes);
-    a
-}
-
 /// What a night (or a shard of one) measured, before it is compared and recorded.
 pub struct Measured {
     pub env: Environment,
@@ -725,6 +700,7 @@ pub fn measure(
     // touches one sample of many metrics rather than every sample of one.
     let common = Common {
         repeats: 1,
+        rounds: 1,
         size: suite.size,
         check: false,
         paired: suite.paired,
@@ -753,8 +729,8 @@ pub fn measure(
             let rec = plan::run_child(job, &common);
             progress.finish(job, &rec, false);
             *slot = Some(match slot.take() {
-                Some(prev) if rec.ok() => merge(prev, &rec),
-                _ => rec,
+                Some(prev) => crate::runs::rounds::absorb(prev, rec),
+                None => rec,
             });
         }
     }

@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 pub struct Checkpoint {
     dir: PathBuf,
     resume: bool,
+    /// Steps loaded instead of measured by this process: a run with `--resume` that found
+    /// nothing saved measured every row itself, and says so.
+    loaded: std::sync::atomic::AtomicUsize,
 }
 
 impl Checkpoint {
@@ -23,13 +26,22 @@ impl Checkpoint {
         if !resume && dir.exists() {
             std::fs::remove_dir_all(&dir).map_err(|e| input(format!("{}: {e}", dir.display())))?;
         }
-        Ok(Checkpoint { dir, resume })
+        Ok(Checkpoint {
+            dir,
+            resume,
+            loaded: std::sync::atomic::AtomicUsize::new(0),
+        })
     }
 
     /// `out/.partial/<id>`: where a table may also keep what its steps need between runs
     /// (scene stores), removed with the steps when a run starts without `--resume`.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// How many steps [`Checkpoint::load`] found saved.
+    pub fn loaded(&self) -> usize {
+        self.loaded.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     fn file(&self, key: &str) -> PathBuf {
@@ -44,12 +56,17 @@ impl Checkpoint {
         }
         let f = self.file(key);
         match std::fs::read(&f) {
-            Ok(bytes) => serde_json::from_slice(&bytes).map(Some).map_err(|e| {
-                input(format!(
-                    "{}: not a saved step ({e}); remove it to measure again",
-                    f.display()
-                ))
-            }),
+            Ok(bytes) => {
+                let step = serde_json::from_slice(&bytes).map_err(|e| {
+                    input(format!(
+                        "{}: not a saved step ({e}); remove it to measure again",
+                        f.display()
+                    ))
+                })?;
+                self.loaded
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                Ok(Some(step))
+            }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
             Err(e) => Err(input(format!("{}: {e}", f.display()))),
         }

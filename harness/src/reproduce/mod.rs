@@ -241,7 +241,8 @@ pub fn run(
     };
     let clock = invocation::Invocation::start();
     let mut output = (table.run)(&ctx)?;
-    clock.stamp(&mut output, resume);
+    // Rows loaded from saved steps were measured by earlier invocations; say so only then.
+    clock.stamp(&mut output, checkpoint.loaded() > 0);
     writer::write(table, out, output, as_json)?;
     Ok(())
 }

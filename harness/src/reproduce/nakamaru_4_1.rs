@@ -60,7 +60,7 @@ pub const TABLE: Table = Table {
     about: "000 (Nakamaru 2002) Table 4.1: basic breadth-first method vs S+G and S+G+B (bounding-box hierarchy), 27 rows up to 5e7 objects",
     runtime: Runtime {
         quick: "minutes",
-        full: "about an hour of tracing (27 rows × 3 methods out of core: 0.91 h measured) plus the stores' writing; resumable",
+        full: "about 80 minutes (27 rows × 3 methods out of core, and the stores' writing: 4620 s on a 2-core machine); resumable",
     },
     params: &[ROWS, SIZE, MEMORY, CACHE, SPILL],
     claims: &[

@@ -1517,7 +1517,7 @@ fn document(p: &Published, measured: &[Measured], s: &Setup, quick: bool, finish
                             r.subspaces_total,
                             r.pre_s()
                         )
-                    } else if r.earlier_s > 0.0 {
+                    } else if r.earlier_s >= 0.005 {
                         format!(
                             "{:.2} (of which {:.2} by earlier, stopped invocations)",
                             r.preprocess_s, r.earlier_s

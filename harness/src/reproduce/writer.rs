@@ -214,26 +214,32 @@ mod tests {
     use super::super::{find, Kind, Verdict};
     use super::*;
 
+    /// A table's first claim that `pick` accepts, and a row of it named `s{i}`.
+    fn claim_rows(
+        id: &str,
+        pick: fn(&super::super::Claim) -> bool,
+        kind: Kind,
+        verdict: Verdict,
+    ) -> (
+        &'static Table,
+        &'static super::super::Claim,
+        impl Fn(usize) -> Row,
+    ) {
+        let table = find(id).unwrap();
+        let c = table.claims.iter().find(|c| pick(c)).unwrap();
+        let row = move |i: usize| Row::new(c.key, format!("s{i}"), "p", "m", kind, verdict);
+        (table, c, row)
+    }
+
     #[test]
     fn a_claims_reason_is_stated_once_not_on_every_row() {
-        let table = find("yamauchi-cfbs").unwrap();
-        let c = table
-            .claims
-            .iter()
-            .find(|c| c.fidelity != Fidelity::Faithful)
-            .unwrap();
-        let mut rows: Vec<Row> = (0..3)
-            .map(|i| {
-                Row::new(
-                    c.key,
-                    format!("s{i}"),
-                    "p",
-                    "m",
-                    Kind::Ratio,
-                    Verdict::Shown,
-                )
-            })
-            .collect();
+        let (table, c, row) = claim_rows(
+            "yamauchi-cfbs",
+            |c| c.fidelity != Fidelity::Faithful,
+            Kind::Ratio,
+            Verdict::Shown,
+        );
+        let mut rows: Vec<Row> = (0..3).map(row).collect();
         label(table, &mut rows);
         assert!(rows
             .iter()
@@ -249,22 +255,12 @@ mod tests {
 
     #[test]
     fn a_claims_label_counts_the_rows_that_carry_a_lower_one() {
-        let table = find("nakamaru-4.2").unwrap();
-        let c = table
-            .claims
-            .iter()
-            .find(|c| c.fidelity == Fidelity::Faithful)
-            .unwrap();
-        let row = |i: usize| {
-            Row::new(
-                c.key,
-                format!("s{i}"),
-                "p",
-                "m",
-                Kind::Count,
-                Verdict::Holds,
-            )
-        };
+        let (table, _, row) = claim_rows(
+            "nakamaru-4.2",
+            |c| c.fidelity == Fidelity::Faithful,
+            Kind::Count,
+            Verdict::Holds,
+        );
         let mut rows = vec![
             row(0),
             row(1).with_fidelity(Fidelity::Substituted, "a stand-in scene"),

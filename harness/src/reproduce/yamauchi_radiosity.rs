@@ -39,7 +39,7 @@ pub const TABLE: Table = Table {
     about: "003 (Yamauchi 1997): the radiosity pass on the (Mπ)² machine vs a single-process solution, and both passes' image, on the room",
     runtime: Runtime {
         quick: "seconds",
-        full: "minutes",
+        full: "about a quarter of an hour",
     },
     params: &[THREADS, SIZE, ROOM, THRESHOLD, PES],
     claims: &[

@@ -152,8 +152,8 @@ pub fn check_out(out: &Path, dirs: &[PathBuf]) -> Result<()> {
 /// Files to write, by name: built whole before anything touches the disk.
 pub type Files = Vec<(String, Vec<u8>)>;
 
-/// Writes the files into a temp directory beside OUT, then renames it to OUT: an interrupted merge
-/// leaves no half-written results set.
+/// Writes the files into a temporary directory beside OUT (`tempfile`, removed however this
+/// returns), then renames it to OUT: an interrupted merge leaves no half-written results set.
 pub fn write_all(out: &Path, files: Files) -> Result<()> {
     let parent = out
         .parent()
@@ -164,26 +164,21 @@ pub fn write_all(out: &Path, files: Files) -> Result<()> {
     let name = out
         .file_name()
         .ok_or_else(|| input(format!("--out {}: not a directory name", out.display())))?;
-    let tmp = parent.join(format!(
-        ".{}.merge-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| -> Result<()> {
-        std::fs::create_dir_all(&tmp)
-            .map_err(|e| input(format!("{}: cannot create: {e}", tmp.display())))?;
-        for (f, bytes) in &files {
-            write_atomic(&tmp.join(f), |w| std::io::Write::write_all(w, bytes))?;
-        }
-        if out.exists() {
-            std::fs::remove_dir(out).map_err(|e| input(format!("--out {}: {e}", out.display())))?;
-        }
-        std::fs::rename(&tmp, out).map_err(|e| input(format!("--out {}: {e}", out.display())))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".{}.merge-", name.to_string_lossy()))
+        .tempdir_in(parent)
+        .map_err(|e| input(format!("{}: cannot create: {e}", parent.display())))?;
+    for (f, bytes) in &files {
+        write_atomic(&tmp.path().join(f), |w| std::io::Write::write_all(w, bytes))?;
     }
-    result
+    if out.exists() {
+        std::fs::remove_dir(out).map_err(|e| input(format!("--out {}: {e}", out.display())))?;
+    }
+    let tmp = tmp.keep();
+    std::fs::rename(&tmp, out).map_err(|e| {
+        let _ = std::fs::remove_dir_all(&tmp);
+        input(format!("--out {}: {e}", out.display()))
+    })
 }
 
 pub fn jsonl(records: &[RunRecord]) -> Vec<u8> {

@@ -304,6 +304,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
         image_sha256: Some(crate::output::hex(&sha2::Sha256::digest(pixels))),
         samples,
         ratio_to_embree: None,
+        rounds: Vec::new(),
         wall_s: start.elapsed().as_secs_f64(),
         finished_at: crate::measure::environment::now_utc(),
         machine: None,

@@ -114,8 +114,12 @@ pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
         0 => String::new(),
         n => format!(" paired_threads={n}"),
     };
+    let rounds = match c.rounds {
+        1 => String::new(),
+        n => format!(" rounds={n}"),
+    };
     format!(
-        "{kind} repeats={} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
+        "{kind} repeats={}{rounds} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
         c.repeats,
         c.size,
         c.check,
@@ -165,7 +169,10 @@ impl Job {
 /// What every run of a plan shares.
 #[derive(Clone, Debug)]
 pub struct Common {
+    /// Timed repeats of each job, over all its rounds.
     pub repeats: u32,
+    /// Rounds each job is spread over (`run --rounds`; 1: one process does all the repeats).
+    pub rounds: u32,
     pub size: u32,
     pub check: bool,
     /// Pairs of engine and Embree traces timed back to back in the child (0: none).
@@ -505,30 +512,61 @@ impl Progress {
     }
 }
 
-/// `rtbench run`: every job, in order; returns how many failed.
+/// `rtbench run`: every job once per round ([`super::rounds`]), in plan order each round; the
+/// record of a job holds its rounds so far after each one, so an interrupted run keeps them and
+/// `--resume` runs only the rounds missing. Returns how many jobs failed.
 pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) -> Result<usize> {
-    let mut progress = Progress::new(jobs.len());
-    let mut failures = 0;
-    for job in jobs {
-        let key = job.key();
-        if resume && out.has(&key) {
-            let rec = out
-                .records
-                .iter()
-                .find(|r| r.key == key)
-                .cloned()
-                .expect("has");
-            progress.finish(job, &rec, true);
-            continue;
+    let split = super::rounds::Split::of(
+        common.rounds,
+        common.repeats,
+        common.paired,
+        common.paired_threads,
+    );
+    let mut progress = Progress::new(jobs.len() * split.rounds as usize);
+    // This invocation's record of each job (with --resume, what the directory holds).
+    let mut records: Vec<Option<RunRecord>> = jobs
+        .iter()
+        .map(|j| {
+            let key = j.key();
+            resume
+                .then(|| out.records.iter().find(|r| r.key == key).cloned())
+                .flatten()
+        })
+        .collect();
+    for round in 0..split.rounds as usize {
+        let (repeats, paired, paired_threads) = split.round(round as u32);
+        // The cross-check is the same in every round: the first one makes it.
+        let child = Common {
+            repeats,
+            rounds: 1,
+            paired,
+            paired_threads,
+            check: common.check && round == 0,
+            ..common.clone()
+        };
+        for (job, slot) in jobs.iter().zip(records.iter_mut()) {
+            let done = slot.as_ref().map_or(0, |r| {
+                if r.ok() {
+                    super::rounds::rounds_in(r)
+                } else {
+                    usize::MAX
+                }
+            });
+            if done > round {
+                progress.finish(job, slot.as_ref().expect("done"), true);
+                continue;
+            }
+            let rec = run_child(job, &child);
+            progress.finish(job, &rec, false);
+            let rec = match slot.take() {
+                Some(prev) => super::rounds::absorb(prev, rec),
+                None => rec,
+            };
+            out.put(rec.clone())?;
+            *slot = Some(rec);
         }
-        let rec = run_child(job, common);
-        if !rec.ok() {
-            failures += 1;
-        }
-        progress.finish(job, &rec, false);
-        out.put(rec)?;
     }
-    Ok(failures)
+    Ok(records.iter().flatten().filter(|r| !r.ok()).count())
 }
 
 /// `rtbench sweep`: for each scene and engine, raise the SF from `sf_start` until a run fails

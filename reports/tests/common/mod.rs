@@ -102,6 +102,7 @@ pub fn run(engine: &str, program: &str, sf: u32, trace: f64) -> RunRecord {
         image_sha256: Some("00ff".to_string()),
         samples: Vec::new(),
         ratio_to_embree: None,
+        rounds: Vec::new(),
         wall_s: 1.0,
         finished_at: "2026-11-21T10:00:00Z".to_string(),
         machine: None,

@@ -211,6 +211,9 @@ pub fn build(h: &History, commit_url: Option<&str>) -> Result<Board> {
             last_findings = findings;
         }
     }
+    // A counter that is 0 on every night is one the engine does not keep (a BVH visits no grid
+    // cells): no plot for it. It is still recorded and gated, so a night it moves is marked.
+    plots.retain(|_, p| !(p.kind == "counter" && p.y.iter().all(|v| *v == 0.0)));
     let gates: Vec<&Finding> = last_findings
         .iter()
         .filter(|f| f.verdict == "gate")
