@@ -70,7 +70,6 @@ impl WalkCounts {
     /// have hundreds of references that the culling test rejects, and counting each through
     /// the walk's captured counts was a load and a store per reference, one after the other.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn next_admitted<const MB: bool, const CULL: bool>(
         &mut self,
         list: &[u32],
