@@ -253,7 +253,8 @@ pub struct PlanArgs {
     pub no_check: bool,
     /// In every run of an engine other than Embree, also time at least N back-to-back pairs of the
     /// engine and Embree, shared out over the rounds (alternating which goes first; fast traces
-    /// get more, until each round's pairs span two seconds, at most 8 times its share); `report`
+    /// get more, until the run's pairs span two seconds over its rounds, at most 8 times each
+    /// round's share); `report`
     /// shows their ratio and `compare` judges on it: load on the machine moves it far less than
     /// the ratio of two separate runs. 0 turns pairs off (and with --no-check, Embree is not
     /// built at all).
@@ -368,6 +369,10 @@ pub struct RunOneArgs {
     /// takes each round's median over a fixed number of pairs.
     #[arg(long, hide = true)]
     pub pairs_exact: bool,
+    /// Fast traces' pairs go on until they span this many seconds: `run` gives each of its
+    /// rounds a share of two seconds.
+    #[arg(long, hide = true, default_value_t = crate::measure::repeat::PAIR_SPAN_S)]
+    pub pair_span: f64,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -517,20 +517,8 @@ fn compare_times(
         c.times_compared += 1;
         // Where both sides ran in rounds, the round is the unit ([`crate::rounds`]).
         if let (Some(a), Some(b)) = (rounds::paired(ra), rounds::paired(rb)) {
-            judge(
-                ra,
-                Judged {
-                    kind: FindingKind::TimeRatio,
-                    what: "trace time / Embree (paired)",
-                    old: a.mean.exp(),
-                    new: b.mean.exp(),
-                    change: Some(b.minus(&a)),
-                    samples: [a.n, b.n],
-                    unit: "rounds",
-                    higher_is_worse: true,
-                },
-                c,
-            );
+            let what = "trace time / Embree (paired)";
+            judge(ra, by_rounds(FindingKind::TimeRatio, what, a, b, true), c);
             return;
         }
         let change = LogMean::median_of(&pb.samples)
@@ -577,20 +565,8 @@ fn compare_times(
     };
     c.times_compared += 1;
     if let (Some(a), Some(b)) = (rounds::quotient(ra, ya), rounds::quotient(rb, yb)) {
-        judge(
-            ra,
-            Judged {
-                kind: FindingKind::TimeRatio,
-                what: "trace time / Embree",
-                old: a.mean.exp(),
-                new: b.mean.exp(),
-                change: Some(b.minus(&a)),
-                samples: [a.n, b.n],
-                unit: "rounds",
-                higher_is_worse: true,
-            },
-            c,
-        );
+        let what = "trace time / Embree";
+        judge(ra, by_rounds(FindingKind::TimeRatio, what, a, b, true), c);
         return;
     }
     let t = |r: &RunRecord| r.time_s.trace_for_compare().samples.clone();
@@ -633,18 +609,10 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
         return;
     };
     if let (Some(a), Some(b)) = (rounds::speedup(ra), rounds::speedup(rb)) {
+        let what = "speed-up over 1 thread";
         judge(
             ra,
-            Judged {
-                kind: FindingKind::ThreadSpeedup,
-                what: "speed-up over 1 thread",
-                old: a.mean.exp(),
-                new: b.mean.exp(),
-                change: Some(b.minus(&a)),
-                samples: [a.n, b.n],
-                unit: "rounds",
-                higher_is_worse: false,
-            },
+            by_rounds(FindingKind::ThreadSpeedup, what, a, b, false),
             c,
         );
         return;
@@ -667,6 +635,26 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
         },
         c,
     );
+}
+
+/// A figure both sides measured over rounds: A's and B's mean log over their rounds.
+fn by_rounds(
+    kind: FindingKind,
+    what: &str,
+    a: LogMean,
+    b: LogMean,
+    higher_is_worse: bool,
+) -> Judged<'_> {
+    Judged {
+        kind,
+        what,
+        old: a.mean.exp(),
+        new: b.mean.exp(),
+        change: Some(b.minus(&a)),
+        samples: [a.n, b.n],
+        unit: "rounds",
+        higher_is_worse,
+    }
 }
 
 /// Geometric mean (0 for no sample).

@@ -238,6 +238,8 @@ pub const NOTES: &str = "Times are medians over the repeats, with min–max. × 
 pool's threads where recorded) over Embree's on the same scene and threads in this results set: the quotient of the two \
 runs' geometric means over their repeats, with its 95 % interval (Welch, on the logs) and the repeats behind it (– \
 without an Embree run). Paired × Embree: the ratios timed back to back in the run's own process (`run --paired N`), \
-their median with its 95 % interval and the number of pairs. MB are 10^6 bytes; B/prim is the \
+their median with its 95 % interval and the number of pairs. A run spread over rounds (`run --rounds R`, one process \
+each) gives one figure per round (its pairs' median; its repeats over Embree's in the same round), and the cell is their \
+mean with Student's t interval over the rounds, n counting rounds. MB are 10^6 bytes; B/prim is the \
 structure's bytes per primitive (Embree: what its memory monitor reports, BVH and its copies of the geometry). Hit agreement and PSNR \
 compare each engine's hits and image with Embree's (`rtbench check`); ∞ dB means identical images.";

@@ -325,12 +325,16 @@ fn paired_ratios_are_compared_when_both_runs_have_them() {
     // A 20% slower engine in its pairs is a regression.
     pair(find(&mut b, "grid/balls3@1"), 0.6);
     let c = compare_sets(&a, &b, 5.0);
-    let f = c
-        .regressions
-        .iter()
-        .find(|f| f.key == "grid/balls3@1")
-        .expect("the paired slowdown is found");
+    let f = regression(&c, "grid/balls3@1");
     assert!((f.change_pct.unwrap() - 20.0).abs() < 0.5, "{f:?}");
+}
+
+/// The regression `compare` found on `key`.
+fn regression<'a>(c: &'a Comparison, key: &str) -> &'a rtbench_reports::Finding {
+    c.regressions
+        .iter()
+        .find(|f| f.key == key)
+        .unwrap_or_else(|| panic!("no regression on {key}: {}", c.to_markdown()))
 }
 
 /// Paired ratios in three rounds (`run --rounds 3`), each round's four pairs within 0.2 % of its
@@ -365,11 +369,7 @@ fn with_rounds_a_process_shifted_as_a_whole_is_noise_and_a_slowdown_is_not() {
     rounds(find(&mut a, "grid/balls3@1"), 7.7, [1.0, 1.01, 0.99]);
     rounds(find(&mut b, "grid/balls3@1"), 8.47, [1.0, 0.99, 1.01]);
     let c = compare_sets(&a, &b, 5.0);
-    let f = c
-        .regressions
-        .iter()
-        .find(|f| f.key == "grid/balls3@1")
-        .expect("the slowdown is found");
+    let f = regression(&c, "grid/balls3@1");
     assert_eq!(f.samples, Some([3, 3]));
     assert!(f.message.contains("3 rounds in A, 3 in B"), "{}", f.message);
     assert!((f.change_pct.unwrap() - 10.0).abs() < 0.5, "{f:?}");

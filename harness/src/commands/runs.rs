@@ -154,6 +154,7 @@ fn common(p: &PlanArgs) -> Result<Common> {
         paired: p.paired,
         paired_threads: p.paired_threads,
         pairs_exact: false,
+        pair_span_s: crate::measure::repeat::PAIR_SPAN_S,
         max_seconds: p.max_seconds,
         max_memory: p.max_memory.as_deref().map(parse_bytes).transpose()?,
     })
@@ -383,6 +384,14 @@ pub fn run_one_cmd(a: &RunOneArgs) -> Result<()> {
         paired: a.paired,
         paired_threads: a.paired_threads,
         pairs_exact: a.pairs_exact,
+        pair_span_s: if a.pair_span.is_finite() {
+            a.pair_span.max(0.0)
+        } else {
+            return Err(input(format!(
+                "--pair-span {}: not a number of seconds",
+                a.pair_span
+            )));
+        },
     };
     let rec = run_one(&spec)?;
     println!(

@@ -17,18 +17,20 @@ pub const PAIR_SPAN_S: f64 = 2.0;
 pub const PAIR_CAP_FACTOR: u32 = 8;
 
 /// Runs `pair(i)` for i = 0, 1, … at least `min` times, and on until the pairs have spanned
-/// [`PAIR_SPAN_S`] of wall time, but at most `min` × [`PAIR_CAP_FACTOR`] and `max` times; returns the
-/// pairs' values. With `min` 0 it runs none.
+/// `span_s` of wall time ([`PAIR_SPAN_S`], or its share of it in one round of several), but at
+/// most `min` × [`PAIR_CAP_FACTOR`] and `max` times; returns the pairs' values. With `min` 0 it
+/// runs none.
 pub fn pairs<T, E>(
     min: u32,
     max: u32,
+    span_s: f64,
     mut pair: impl FnMut(u32) -> Result<T, E>,
 ) -> Result<Vec<T>, E> {
     let cap = min.saturating_mul(PAIR_CAP_FACTOR).min(max.max(min));
     let clock = Span::start(Workers::Caller);
     let mut out = Vec::with_capacity(min as usize);
     let mut i = 0;
-    while i < min || (i < cap && clock.elapsed_s() < PAIR_SPAN_S) {
+    while i < min || (i < cap && clock.elapsed_s() < span_s) {
         out.push(pair(i)?);
         i += 1;
     }
@@ -124,18 +126,32 @@ mod tests {
     #[test]
     fn fast_pairs_go_on_until_they_span_the_window_and_stop_at_the_cap() {
         // Instant pairs: the window never fills, so the cap ends them.
-        let n = pairs(5, 1000, |_| Ok::<_, ()>(())).unwrap().len();
+        let n = pairs(5, 1000, PAIR_SPAN_S, |_| Ok::<_, ()>(()))
+            .unwrap()
+            .len();
         assert_eq!(n, (5 * PAIR_CAP_FACTOR) as usize);
-        assert_eq!(pairs(5, 7, |_| Ok::<_, ()>(())).unwrap().len(), 7);
-        assert_eq!(pairs(0, 1000, |_| Ok::<_, ()>(())).unwrap().len(), 0);
+        assert_eq!(
+            pairs(5, 7, PAIR_SPAN_S, |_| Ok::<_, ()>(())).unwrap().len(),
+            7
+        );
+        assert_eq!(
+            pairs(0, 1000, PAIR_SPAN_S, |_| Ok::<_, ()>(()))
+                .unwrap()
+                .len(),
+            0
+        );
         // Pairs longer than the window: exactly the minimum.
-        let slow = pairs(2, 1000, |_| {
+        let slow = pairs(2, 1000, PAIR_SPAN_S, |_| {
             std::thread::sleep(std::time::Duration::from_secs_f64(PAIR_SPAN_S / 2.0 + 0.01));
             Ok::<_, ()>(())
         });
         assert_eq!(slow.unwrap().len(), 2);
         assert_eq!(
-            pairs(3, 1000, |i| if i == 1 { Err(i) } else { Ok(i) }),
+            pairs(3, 1000, PAIR_SPAN_S, |i| if i == 1 {
+                Err(i)
+            } else {
+                Ok(i)
+            }),
             Err(1)
         );
     }

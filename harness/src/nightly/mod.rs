@@ -707,6 +707,7 @@ pub fn measure(
         paired_threads: 0,
         // A fixed number of pairs a round: each round's median is taken over `paired` samples.
         pairs_exact: true,
+        pair_span_s: crate::measure::repeat::PAIR_SPAN_S,
         max_seconds: suite.max_seconds,
         max_memory: None,
     };

@@ -30,6 +30,9 @@ pub struct OneSpec {
     pub paired_threads: u32,
     /// Exactly `paired` (and `paired_threads`) pairs, not more for fast traces.
     pub pairs_exact: bool,
+    /// The wall time fast traces' pairs span at least (a round's share of
+    /// [`PAIR_SPAN_S`](crate::measure::repeat::PAIR_SPAN_S)).
+    pub pair_span_s: f64,
 }
 
 /// The most pairs `--paired` takes: each pair traces the whole workload twice.
@@ -53,6 +56,7 @@ fn paired_ratios(
     yardstick: &dyn rtbench_engines::Engine,
     size: u32,
     (pairs, most): (u32, u32),
+    span_s: f64,
 ) -> Vec<f64> {
     let time = |e: &dyn rtbench_engines::Engine| {
         pool.install(|| trace::render(scene, e, size, None))
@@ -61,7 +65,7 @@ fn paired_ratios(
     // Embree's first render in a process is slow (cold caches, first-touch page faults), as the
     // engine's was before its untimed render above.
     time(yardstick);
-    let ratios = crate::measure::repeat::pairs(pairs, most, |i| {
+    let ratios = crate::measure::repeat::pairs(pairs, most, span_s, |i| {
         let (a, b) = if i % 2 == 0 {
             let a = time(engine);
             (a, time(yardstick))
@@ -89,6 +93,7 @@ fn paired_thread_times(
     engine: &dyn rtbench_engines::Engine,
     size: u32,
     (pairs, most): (u32, u32),
+    span_s: f64,
 ) -> Result<Vec<(f64, f64, f64, f64)>> {
     let one = crate::measure::threads::pool(Some(1))?;
     let mut image: Option<Vec<u8>> = None;
@@ -109,7 +114,7 @@ fn paired_thread_times(
     // The one-thread pool's first render is slow (its thread's buffers, first touch), as the
     // run's own pool was before its untimed render.
     time(&one)?;
-    crate::measure::repeat::pairs(pairs, most, |i| {
+    crate::measure::repeat::pairs(pairs, most, span_s, |i| {
         let ((w1, c1), (wn, cn)) = if i % 2 == 0 {
             let a = time(&one)?;
             (a, time(pool)?)
@@ -215,6 +220,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             y.as_ref(),
             spec.size,
             (n, most(n)),
+            spec.pair_span_s,
         ))),
         _ => None,
     };
@@ -225,6 +231,7 @@ pub fn run_one(spec: &OneSpec) -> Result<RunRecord> {
             engine.as_ref(),
             spec.size,
             (spec.paired_threads, most(spec.paired_threads)),
+            spec.pair_span_s,
         )?;
         Some(ThreadScaling::of(pool.current_num_threads(), &pairs))
     } else {

@@ -181,6 +181,8 @@ pub struct Common {
     pub paired_threads: u32,
     /// Exactly the pairs asked for, not more for fast traces (`run-one --pairs-exact`).
     pub pairs_exact: bool,
+    /// The wall time fast traces' pairs span at least in each child (`run-one --pair-span`).
+    pub pair_span_s: f64,
     pub max_seconds: Option<f64>,
     pub max_memory: Option<u64>,
 }
@@ -326,6 +328,9 @@ pub fn run_child(job: &Job, common: &Common) -> RunRecord {
     }
     if common.pairs_exact {
         cmd.arg("--pairs-exact");
+    }
+    if common.pair_span_s != crate::measure::repeat::PAIR_SPAN_S {
+        cmd.args(["--pair-span", &common.pair_span_s.to_string()]);
     }
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -542,6 +547,8 @@ pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) ->
             paired,
             paired_threads,
             check: common.check && round == 0,
+            // The rounds share the span fast traces' pairs take: more rounds, not more time.
+            pair_span_s: common.pair_span_s / f64::from(split.rounds),
             ..common.clone()
         };
         for (job, slot) in jobs.iter().zip(records.iter_mut()) {
