@@ -2,8 +2,8 @@
 //!
 //! Repeats and pairs timed in one process share that process's state and the minute it ran in. On
 //! this kind of machine both move an engine's speed against Embree's by several percent for tens
-//! of seconds at a time, and one process's pairs cannot see it: ten processes of grid against
-//! Embree on balls3, five pairs each, gave medians of 7.64–7.75 in eight and 7.21 in one, with
+//! of seconds at a time, and one process's pairs cannot see it: sixteen processes of grid against
+//! Embree on balls3, five pairs each, gave medians of 7.57–7.83 in fifteen and 7.21 in one, with
 //! every pair of that one between 7.10 and 7.25. An interval from one process's pairs is then a
 //! few tenths of a percent wide around a figure that is 6 % off, and two runs of one commit
 //! "differ".
