@@ -342,6 +342,24 @@ pub fn compare_all(
                         }
                     }
                 }
+                // The prediction interval tonight's value (or, confirming a suspect, the two
+                // nights' mean) had to leave: the centre times e^(±threshold · width).
+                let k = nights.len() as f64;
+                let width = v.spread
+                    * if previous.is_some() {
+                        (0.5 + 1.0 / k).sqrt()
+                    } else {
+                        (1.0 + 1.0 / k).sqrt()
+                    };
+                let (lo, hi) = (
+                    v.baseline * (-v.threshold * width).exp(),
+                    v.baseline * (v.threshold * width).exp(),
+                );
+                let against = format!(
+                    "{:.4} over {} nights, interval [{lo:.4}, {hi:.4}] at α = {used_alpha:.2e}",
+                    v.baseline,
+                    nights.len()
+                );
                 if v.direction != 0 {
                     let first_night = v.direction == 1 && two_night && !confirming;
                     out.push(Finding {
@@ -355,20 +373,18 @@ pub fn compare_all(
                         baseline: Some(v.baseline),
                         value: Some(m.value),
                         change_pct: Some(v.change_pct),
+                        // `table` reads the comparison back from between " against " and "; ".
                         message: format!(
-                            "{}: {:.4}{} against {:.4} over {} nights ({:+.2}%; {:.1} prediction widths, threshold {:.1} for α = {:.2e}; rank test p = {:.3}; every round {:+.2}% or more)",
+                            "{}: {:.4}{} against {against}; {:+.2}%, {:.1} prediction widths, threshold {:.1}; rank test p = {:.3}; every round {:+.2}% or more",
                             m.name,
                             m.value,
                             match previous {
                                 Some(p) => format!(" (and {p:.4} the night before)"),
                                 None => String::new(),
                             },
-                            v.baseline,
-                            nights.len(),
                             v.change_pct,
                             v.score,
                             v.threshold,
-                            used_alpha,
                             v.mw_p,
                             v.weakest_round_pct
                         ),
@@ -382,19 +398,6 @@ pub fn compare_all(
                             .push_str(" — confirmed: the night before was a suspect");
                     }
                 } else if m.gated {
-                    // The prediction interval tonight's value (or, confirming a suspect, the two
-                    // nights' mean) had to leave: the centre times e^(±threshold · width).
-                    let k = nights.len() as f64;
-                    let width = v.spread
-                        * if previous.is_some() {
-                            (0.5 + 1.0 / k).sqrt()
-                        } else {
-                            (1.0 + 1.0 / k).sqrt()
-                        };
-                    let (lo, hi) = (
-                        v.baseline * (-v.threshold * width).exp(),
-                        v.baseline * (v.threshold * width).exp(),
-                    );
                     out.push(Finding {
                         name: m.name.clone(),
                         verdict: "ok".into(),
@@ -402,9 +405,7 @@ pub fn compare_all(
                         value: Some(m.value),
                         change_pct: Some(v.change_pct),
                         message: format!(
-                            "{:.4} over {} nights, interval [{lo:.4}, {hi:.4}] at α = {used_alpha:.2e}{}",
-                            v.baseline,
-                            nights.len(),
+                            "{against}{}",
                             if previous.is_some() {
                                 " (the mean with the suspect night before)"
                             } else {
@@ -637,10 +638,18 @@ pub fn summary_markdown(
         let f = by_name.get(m.name.as_str());
         let against = match f {
             Some(f) if f.verdict == "ok" => f.message.clone(),
-            Some(f) => f
-                .baseline
-                .map(|b| format!("{} (above)", dashboard::fmt_value(b)))
-                .unwrap_or_default(),
+            // A flagged time metric's message names its comparison between " against " and "; ".
+            Some(f) => match f
+                .message
+                .split_once(" against ")
+                .and_then(|(_, rest)| rest.split_once("; "))
+            {
+                Some((against, _)) => against.to_string(),
+                None => f
+                    .baseline
+                    .map(|b| format!("{} (above)", dashboard::fmt_value(b)))
+                    .unwrap_or_default(),
+            },
             None => "not compared (see Gates)".to_string(),
         };
         s.push_str(&format!(
