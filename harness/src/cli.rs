@@ -241,6 +241,19 @@ pub struct PlanArgs {
     /// Embree, which one process's samples cannot show. `sweep` runs each job in one process.
     #[arg(long, value_name = "R")]
     pub rounds: Option<u32>,
+    /// Further rounds, one at a time, for the jobs whose ratio to Embree (or speed-up over one
+    /// thread) is not yet known to ±--target-ci: up to M rounds in all (default 9; M = --rounds
+    /// turns it off). A round beyond --rounds adds a repeat and a round's share of pairs to the
+    /// job, so a busy machine's run takes more repeats than --repeat where it needs them, and a
+    /// quiet one's stops at --rounds. Only jobs timed in pairs (--paired, --paired-threads) have
+    /// a figure to judge.
+    #[arg(long, value_name = "M")]
+    pub max_rounds: Option<u32>,
+    /// The half-width (percent) of the 95 % interval over rounds a job's figure must reach before
+    /// its rounds stop (default 2: a third of a change `compare` flags by default, 5 %, after the
+    /// two sides' intervals combine).
+    #[arg(long, value_name = "PCT")]
+    pub target_ci: Option<f64>,
     /// Threads: a list of counts and/or `all`, e.g. `1,all` (a count above the available
     /// parallelism is refused).
     #[arg(long, default_value = "1")]

@@ -58,6 +58,9 @@ fn killed_run_leaves_valid_results_and_resume_completes_it() {
         "3",
         "--repeat",
         "2",
+        // Two rounds exactly: none more for a figure still wide.
+        "--max-rounds",
+        "2",
         "--size",
         "128",
         "--out",
@@ -449,6 +452,47 @@ fn paired_threads_above_the_limit_is_refused() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--paired-threads 1001"), "{err}");
+}
+
+#[test]
+fn round_bounds_out_of_range_are_refused() {
+    for (flag, value, says) in [
+        (
+            "--max-rounds",
+            "2",
+            "--max-rounds 2: must be from the rounds every job runs (3)",
+        ),
+        ("--max-rounds", "101", "--max-rounds 101"),
+        (
+            "--target-ci",
+            "0",
+            "--target-ci 0: must be a percentage above 0",
+        ),
+        ("--target-ci", "NaN", "--target-ci NaN"),
+    ] {
+        let out = rtbench()
+            .args([
+                "run",
+                "--engines",
+                "bvh8",
+                "--scenes",
+                "tetra",
+                "--sf",
+                "1",
+                "--size",
+                "8",
+                flag,
+                value,
+                "--out",
+            ])
+            .arg(tmp("round-bounds"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(says), "{err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
 }
 
 /// `RTBENCH_SCHED=bands`: a two-thread render prints one `sched thread`

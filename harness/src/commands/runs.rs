@@ -146,9 +146,30 @@ fn common(p: &PlanArgs) -> Result<Common> {
     if rounds == 0 {
         return Err(input("--rounds must be at least 1"));
     }
+    // The rounds every job runs: never more than its repeats.
+    let base = rounds.min(p.repeat);
+    let max_rounds = p
+        .max_rounds
+        .unwrap_or(crate::runs::rounds::DEFAULT_MAX_ROUNDS.max(base));
+    if max_rounds < base || max_rounds > crate::runs::rounds::MAX_ROUNDS_LIMIT {
+        return Err(input(format!(
+            "--max-rounds {max_rounds}: must be from the rounds every job runs ({base}) to {}",
+            crate::runs::rounds::MAX_ROUNDS_LIMIT
+        )));
+    }
+    let target_ci_pct = p
+        .target_ci
+        .unwrap_or(crate::runs::rounds::DEFAULT_TARGET_CI_PCT);
+    if !(target_ci_pct > 0.0 && target_ci_pct < 100.0) {
+        return Err(input(format!(
+            "--target-ci {target_ci_pct}: must be a percentage above 0 and below 100"
+        )));
+    }
     Ok(Common {
         repeats: p.repeat,
         rounds,
+        max_rounds,
+        target_ci_pct,
         size: p.size,
         check: !p.no_check,
         paired: p.paired,
@@ -271,13 +292,14 @@ pub fn sweep(a: &SweepArgs) -> Result<()> {
     if threads.len() != 1 {
         return Err(input("sweep: give one --threads value"));
     }
-    if a.plan.rounds.is_some_and(|r| r != 1) {
+    if a.plan.rounds.is_some_and(|r| r != 1) || a.plan.max_rounds.is_some_and(|r| r != 1) {
         return Err(input(
-            "sweep: --rounds is for run (a sweep runs each size factor once, in one process)",
+            "sweep: --rounds and --max-rounds are for run (a sweep runs each size factor once, in one process)",
         ));
     }
     let common = Common {
         rounds: 1,
+        max_rounds: 1,
         ..common(&a.plan)?
     };
     if common.max_seconds.is_none() && common.max_memory.is_none() {

@@ -710,6 +710,8 @@ pub fn measure(
     let common = Common {
         repeats: 1,
         rounds: 1,
+        max_rounds: 1,
+        target_ci_pct: crate::runs::rounds::DEFAULT_TARGET_CI_PCT,
         size: suite.size,
         check: false,
         paired: suite.paired,

@@ -114,10 +114,16 @@ pub fn plan_text(kind: &str, c: &Common, keys: &[String]) -> String {
         0 => String::new(),
         n => format!(" paired_threads={n}"),
     };
-    let rounds = match c.rounds {
+    let mut rounds = match c.rounds {
         1 => String::new(),
         n => format!(" rounds={n}"),
     };
+    if c.max_rounds > c.rounds {
+        rounds.push_str(&format!(
+            " max_rounds={} target_ci={}",
+            c.max_rounds, c.target_ci_pct
+        ));
+    }
     format!(
         "{kind} repeats={}{rounds} size={} check={} paired={}{threads} max_seconds={:?} max_memory={:?}\n{}",
         c.repeats,
@@ -173,6 +179,10 @@ pub struct Common {
     pub repeats: u32,
     /// Rounds each job is spread over (`run --rounds`; 1: one process does all the repeats).
     pub rounds: u32,
+    /// Rounds a job may take in all: beyond `rounds`, one more at a time while its figure's
+    /// interval is wider than ±`target_ci_pct` (`run --max-rounds`; `rounds`: none more).
+    pub max_rounds: u32,
+    pub target_ci_pct: f64,
     pub size: u32,
     pub check: bool,
     /// Pairs of engine and Embree traces timed back to back in the child (0: none).
@@ -474,6 +484,16 @@ impl Progress {
         Progress { bar }
     }
 
+    /// `n` runs more than the plan counted, with a line saying why.
+    pub fn more(&mut self, n: usize, why: &str) {
+        self.bar.inc_length(n as u64);
+        if self.bar.is_hidden() {
+            eprintln!("{why}");
+        } else {
+            self.bar.println(why);
+        }
+    }
+
     pub fn finish(&mut self, job: &Job, rec: &RunRecord, skipped: bool) {
         self.bar.inc(1);
         let (done, total) = (self.bar.position(), self.bar.length().unwrap_or(0));
@@ -511,9 +531,13 @@ impl Progress {
         } else {
             self.bar.println(line);
         }
-        if done >= total {
-            self.bar.finish_and_clear();
-        }
+    }
+}
+
+/// The bar goes when the run does: `run` may add rounds after the planned count is reached.
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
     }
 }
 
@@ -571,6 +595,54 @@ pub fn run(jobs: &[Job], common: &Common, out: &mut ResultsDir, resume: bool) ->
             };
             out.put(rec.clone())?;
             *slot = Some(rec);
+        }
+    }
+    // Further rounds, one at a time, for the jobs whose figure is still wider than the target:
+    // each such round runs those jobs once more, with the first round's share of repeats and pairs.
+    let (repeats, paired, paired_threads) = split.round(0);
+    let more = Common {
+        repeats,
+        rounds: 1,
+        paired,
+        paired_threads,
+        check: false,
+        pair_span_s: common.pair_span_s / f64::from(split.rounds),
+        ..common.clone()
+    };
+    for round in split.rounds as usize..common.max_rounds as usize {
+        let wanted: Vec<(usize, f64)> = records
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| {
+                let r = r.as_ref()?;
+                if super::rounds::rounds_in(r) > round {
+                    return None;
+                }
+                Some((i, super::rounds::too_wide(r, common.target_ci_pct)?))
+            })
+            .collect();
+        if wanted.is_empty() {
+            break;
+        }
+        progress.more(
+            wanted.len(),
+            &format!(
+                "round {}: {} job(s) not yet within ±{}% (widest ±{:.1}%)",
+                round + 1,
+                wanted.len(),
+                common.target_ci_pct,
+                wanted.iter().map(|w| w.1).fold(0.0, f64::max)
+            ),
+        );
+        for (i, _) in wanted {
+            let rec = run_child(&jobs[i], &more);
+            progress.finish(&jobs[i], &rec, false);
+            let rec = match records[i].take() {
+                Some(prev) => super::rounds::absorb(prev, rec),
+                None => rec,
+            };
+            out.put(rec.clone())?;
+            records[i] = Some(rec);
         }
     }
     Ok(records.iter().flatten().filter(|r| !r.ok()).count())

@@ -6,6 +6,19 @@
 
 use rtbench_reports::{Round, RunRecord, Spread, ThreadScaling};
 
+/// Rounds a job of `run` may take in all when its figure stays wide. On a busy 2-core machine
+/// about one process in twelve ran 10–25 % off its job's usual ratio to Embree: with three rounds
+/// a side, one such round widened the interval of a change past the default 5 % threshold and a
+/// planted 10 % slowdown went undecided in 2 of 20 compares; nine rounds a side caught every one
+/// when those runs' round figures were regrouped.
+pub const DEFAULT_MAX_ROUNDS: u32 = 9;
+
+/// More rounds than this are refused: each is a process per job.
+pub const MAX_ROUNDS_LIMIT: u32 = 100;
+
+/// The half-width (percent) a job's 95 % interval over rounds must reach before its rounds stop.
+pub const DEFAULT_TARGET_CI_PCT: f64 = 2.0;
+
 /// How a job's `repeats` and pairs spread over its rounds: never more rounds than repeats, and
 /// each count shared out as evenly as it goes (7 repeats over 3 rounds: 3, 2, 2), so the totals
 /// are those asked for.
@@ -65,6 +78,37 @@ fn round_of(r: &RunRecord) -> Round {
 /// The rounds a record holds (a record of one process is one round).
 pub fn rounds_in(r: &RunRecord) -> usize {
     r.rounds.len().max(1)
+}
+
+/// How far (percent, the wider side of the 95 % interval over rounds from its estimate) the job's
+/// widest figure — its ratio to Embree from pairs, its speed-up over one thread from thread
+/// pairs — is from being known to ±`target_pct`: `Some(half-width)` while it is wider, `None`
+/// once every figure is within it, or when the record has no figure over rounds to judge (a
+/// failed job, Embree's own, a run without pairs, a single round).
+pub fn too_wide(r: &RunRecord, target_pct: f64) -> Option<f64> {
+    if !r.ok() {
+        return None;
+    }
+    let widths = [
+        rtbench_reports::rounds::paired(r),
+        rtbench_reports::rounds::speedup(r),
+    ];
+    let widest = widths
+        .into_iter()
+        .flatten()
+        .map(|m| {
+            let i = m.interval();
+            (i.hi / i.estimate).max(i.estimate / i.lo) * 100.0 - 100.0
+        })
+        .fold(None, |acc: Option<f64>, w| {
+            Some(acc.map_or(w, |a| a.max(w)))
+        })?;
+    // A NaN width (a degenerate round) is as wide as can be.
+    (widest.is_nan() || widest > target_pct).then_some(if widest.is_nan() {
+        f64::INFINITY
+    } else {
+        widest
+    })
 }
 
 /// Joins round `next` into the job's record `acc`: samples follow acc's, `rounds` says which are
@@ -213,6 +257,28 @@ mod tests {
             r.reason.as_deref(),
             Some("round 2: time limit: still running after 5 s")
         );
+    }
+
+    #[test]
+    fn rounds_go_on_while_the_figure_is_wide() {
+        // Three rounds at 1.00, 1.01 and 0.99: ±2.5 % (t with 2 degrees of freedom), wider than
+        // ±2 %, narrower than ±3 %.
+        let mut r = record(&[1.0], &[1.0], "a");
+        for x in [1.01, 0.99] {
+            r = absorb(r, record(&[1.0], &[x], "a"));
+        }
+        let w = too_wide(&r, 2.0).expect("wider than 2 %");
+        assert!(w > 2.0 && w < 3.0, "{w}");
+        assert_eq!(too_wide(&r, 3.0), None);
+        // A fourth round at 1.00 brings it within ±2 %.
+        let r = absorb(r, record(&[1.0], &[1.0], "a"));
+        assert_eq!(too_wide(&r, 2.0), None);
+        // Nothing to judge: one round, or no pairs.
+        assert_eq!(too_wide(&record(&[1.0], &[1.0, 1.5], "a"), 0.1), None);
+        let mut bare = record(&[1.0], &[], "a");
+        bare.paired_ratio = None;
+        let bare = absorb(bare.clone(), bare);
+        assert_eq!(too_wide(&bare, 0.1), None);
     }
 
     #[test]
