@@ -23,20 +23,20 @@ for t in $TABLES; do
     case "$t" in
         speed)
             # Speed against Embree and the peers, memory, build time: one thread, 256², 9 engine/Embree pairs
-            # over 3 rounds (3 processes minutes apart: the interval is over the rounds; 256² keeps the table
+            # over 3 rounds and more for a run still wider than ±2 % (processes minutes apart: the interval is over the rounds; 256² keeps the table
             # within an hour on a shared 2-core machine; 512² is the SPD standard).
             say "speed: $RT run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 256 --repeat 3 --paired 9 --out $OUT/speed"
             "$RT" run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 256 --repeat 3 --paired 9 \
                 --out "$OUT/speed" --resume
             ;;
         threads)
-            # Thread scaling: the same structure traced at one and at two threads, 9 pairs over 3 rounds.
+            # Thread scaling: the same structure traced at one and at two threads, 9 pairs over 3 rounds and more while wide.
             say "threads: $RT run --engines embree,bvh8 --scenes balls,gears,tree --size 256 --threads 2 --paired-threads 9 --repeat 3 --no-check --out $OUT/threads"
             "$RT" run --engines embree,bvh8 --scenes balls,gears,tree --size 256 --threads 2 --paired-threads 9 \
                 --repeat 3 --no-check --out "$OUT/threads" --resume
             ;;
         build)
-            # Build time: 7 builds of every structure over 3 rounds (3 processes), at an image of 16² so
+            # Build time: 7 builds of every structure over 3 rounds (3 processes), 3 more in each further round, at an image of 16² so
             # that tracing costs nothing.
             say "build: $RT run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 16 --repeat 7 --no-check --out $OUT/build"
             "$RT" run --engines embree,grid,bvh2,bvh4,bvh8,obvhs --scenes standard --size 16 --repeat 7 --no-check \
