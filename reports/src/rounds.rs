@@ -2,11 +2,11 @@
 //!
 //! Repeats and pairs timed in one process share that process's state and the minute it ran in. On
 //! this kind of machine both move an engine's speed against Embree's by several percent for tens
-//! of seconds at a time, and one process's pairs cannot see it: 63 processes of grid against
-//! Embree on tetra3 (two to eight pairs each, a busy 2-core machine) gave medians of 1.53–1.60 in 51
-//! and 1.38–1.48 or 1.64–1.92 in the other 12, with every pair of the one at 1.92 between 1.86 and
-//! 1.93. An interval from one process's pairs is then a few percent wide around a figure that is
-//! 20 % off, and two runs of one commit "differ".
+//! of seconds at a time, and one process's pairs cannot see it: 118 processes of grid against
+//! Embree on tetra3 (three to nine pairs each, a busy 2-core machine) gave medians of 1.56–1.60 in
+//! 101, 1.39–1.46 in 14 and 1.82–1.95 in 3, with every pair of one at 1.39 between 1.38 and 1.40.
+//! An interval from one process's pairs is then a few percent wide around a figure that is 10 % off,
+//! and two runs of one commit "differ".
 //!
 //! So `rtbench run` (and the nightly) spread a run over rounds: each round runs every job once, in
 //! a process of its own, and the record keeps how many of its samples each round took
