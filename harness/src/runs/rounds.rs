@@ -7,10 +7,10 @@
 use rtbench_reports::{Round, RunRecord, Spread, ThreadScaling};
 
 /// Rounds a job of `run` may take in all when its figure stays wide. On a busy 2-core machine a
-/// process now and then runs 10–25 % off its job's usual ratio to Embree: with three rounds a side,
-/// one such round widened the interval of a change past the default 5 % threshold and a planted
-/// 10 % slowdown went undecided in 2 of 20 compares; with up to nine, 20 of 20 were caught and no
-/// run of the same commit was taken for a change (docs/guides/compare-engines.md).
+/// process now and then runs 10–26 % off its job's usual ratio to Embree: with the runs cut to three
+/// rounds a side, one such round widened the interval of a change past the default 5 % threshold
+/// and a planted 10 % slowdown went undecided in 2 of 20 compares; with up to nine, 20 of 20 were
+/// caught and no run of the same commit was taken for a change (docs/guides/compare-engines.md).
 pub const DEFAULT_MAX_ROUNDS: u32 = 9;
 
 /// More rounds than this are refused: each is a process per job.
