@@ -28,8 +28,10 @@ pub(crate) const PREALLOCATE: usize = 1 << 16;
 /// block, for 166 MiB of slots).
 #[inline]
 pub(crate) fn push_within<T>(v: &mut Vec<T>, x: T, capacity: usize) {
-    if v.len() == v.capacity() {
-        v.reserve_exact(capacity.max(v.len() + 1) - v.len());
+    // Below the bound, one step to it; past it (a budget that holds fewer than one pass needs),
+    // Vec's own doubling, so that pushing stays amortised O(1).
+    if v.len() == v.capacity() && v.len() < capacity {
+        v.reserve_exact(capacity - v.len());
     }
     v.push(x);
 }
