@@ -525,12 +525,12 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if mask != 0 {
-                    // The others are pushed in slot order, all at once (`compress_children`).
-                    let out: &mut [u32; N] = (&mut stack[sp..sp + N]).try_into().unwrap();
-                    sp +=
-                        T::compress_children(node, mask, out, |c| T::prefetch(child_addr(bvh, c)));
-                }
+                // The others are pushed in slot order, all at once (`compress_children`), and
+                // without asking first whether there are any: that branch went either way
+                // (cachegrind's simulation: 36 % of it mispredicted on gears4), and with none
+                // the call stores entries past the top that are never read.
+                let out: &mut [u32; N] = (&mut stack[sp..sp + N]).try_into().unwrap();
+                sp += T::compress_children(node, mask, out, |c| T::prefetch(child_addr(bvh, c)));
                 cur = node.child[i];
                 continue;
             }
