@@ -542,3 +542,32 @@ mod x86 {
         }
     }
 }
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::super::node::{WideNode, PLANES};
+    use super::ChildTest;
+    use crate::geometry::lanes::{Avx8, Scalar};
+
+    /// For every mask, the AVX2 form's table moves the same children, in the same order, as
+    /// the default form's loop pushes.
+    #[test]
+    fn avx2_compression_matches_the_loop() {
+        if !Avx8::available() {
+            return;
+        }
+        let node = WideNode::<8> {
+            planes: [[0.0; 8]; PLANES],
+            child: [10, 11, 12, 13, 14, 15, 16, 17],
+            len: 8,
+        };
+        for mask in 0..256u32 {
+            let mut want = [u32::MAX; 8];
+            let n = <Scalar as ChildTest<8>>::compress_children(&node, mask, &mut want, |_| {});
+            assert_eq!(n, mask.count_ones() as usize);
+            let mut got = [u32::MAX; 8];
+            let m = <Avx8 as ChildTest<8>>::compress_children(&node, mask, &mut got, |_| {});
+            assert_eq!((m, &got[..m]), (n, &want[..n]), "mask {mask:#04x}");
+        }
+    }
+}
