@@ -53,7 +53,7 @@ impl<'a> Anchors<'a> {
 
 /// Sets every ok run's [`RunRecord::ratio_to_embree`] from its Embree run in `records` (trace CPU
 /// time when recorded, else wall time; the quotient of geometric means with its Welch interval,
-/// or over rounds where both ran in the same number of rounds, [`crate::rounds::quotient`]);
+/// or over the rounds both ran where they ran two or more, [`crate::rounds::quotient`]);
 /// clears it where there is no Embree run or too few repeats.
 pub fn attach_ratios(records: &mut [RunRecord]) {
     let ratios: Vec<Option<crate::interval::Interval>> = {

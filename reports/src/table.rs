@@ -20,10 +20,11 @@ const HEADER: [(&str, bool); 12] = [
     ("PSNR dB", true),
 ];
 
-/// What an interval's n counts: the run's rounds where it was spread over two or more (the
-/// interval is then over the rounds), else its samples.
+/// What an interval's n counts: rounds where the run was spread over two or more and the interval
+/// is over rounds (all of them, or those its Embree run ran too: at most the run's rounds, where
+/// pooled samples are at least one a round from each side), else its samples.
 fn count(r: &Row, i: &crate::interval::Interval) -> String {
-    if r.rounds >= 2 && i.n == r.rounds {
+    if r.rounds >= 2 && i.n >= 2 && i.n <= r.rounds {
         format!("{} rounds", i.n)
     } else {
         i.n.to_string()

@@ -22,7 +22,7 @@
 //!   ray id (the thesis's sort by ray id).
 
 use super::slot::{face_bit_of, BoxRay, Slot, Tally};
-use super::voxels::{Registrations, Voxels, MARKED};
+use super::voxels::{push_within, Registrations, Voxels, MARKED};
 use crate::engine::Counters;
 use crate::geometry::dda::{Dda, START};
 use crate::geometry::kernels::f32::WatertightRay;
@@ -189,7 +189,7 @@ impl Work {
                     Ok(mut slot) => {
                         let g = &self.voxels;
                         if first_candidate(g, &mut slot.dda, self.boundary, c) {
-                            self.slots.push(slot);
+                            push_within(&mut self.slots, slot, self.capacity);
                         } else {
                             out(id, slot.best);
                         }

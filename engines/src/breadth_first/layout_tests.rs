@@ -1,10 +1,10 @@
 //! The sweep's in-core layout changes no answer: the box ray's test answers as the shared slab
 //! test for every box and traceable ray (NaN-making overflows included), the registrations
-//! grouped by voxel come in the order of the linked lists they replaced, and a ray that is not
-//! traceable is a miss.
+//! grouped by voxel come in the order of the linked lists they replaced, a ray that is not
+//! traceable is a miss, and the slots grow once to the rays the budget holds.
 
-use super::slot::BoxRay;
-use super::voxels::Registrations;
+use super::slot::{BoxRay, Slot};
+use super::voxels::{push_within, Registrations};
 use crate::geometry::aabb::{Aabb, SlabRay};
 use crate::test_support::{kv, spd};
 use crate::{build_engine, Counters, Hit, Ray};
@@ -124,4 +124,35 @@ fn a_ray_that_is_not_traceable_is_a_miss() {
     e.occluded(&rays, &mut occ, &mut c);
     assert_eq!(occ, [true, false, false, false, false]);
     assert_eq!(c.rays, 10);
+}
+
+/// The slots' array holds no more than the rays the budget gives it: past its first reservation
+/// it grows once to that count (a doubling would copy the old block into one up to twice the
+/// budget's, both held at once), and never past it.
+#[test]
+fn the_slots_grow_once_to_the_capacity_and_no_further() {
+    let capacity = 1000;
+    let slot = || std::mem::MaybeUninit::<Slot>::zeroed();
+    let mut v: Vec<std::mem::MaybeUninit<Slot>> = Vec::with_capacity(64);
+    let mut grew = 0;
+    let mut cap = v.capacity();
+    for _ in 0..capacity {
+        push_within(&mut v, slot(), capacity);
+        if v.capacity() != cap {
+            grew += 1;
+            cap = v.capacity();
+        }
+    }
+    assert_eq!((grew, v.capacity()), (1, capacity));
+    // Past the bound (no caller goes there) it still pushes, doubling as Vec does: a thousand
+    // pushes more take a handful of reservations, not one each.
+    for _ in 0..capacity {
+        push_within(&mut v, slot(), capacity);
+        if v.capacity() != cap {
+            grew += 1;
+            cap = v.capacity();
+        }
+    }
+    assert_eq!(v.len(), 2 * capacity);
+    assert!(grew <= 3, "{grew} reservations");
 }

@@ -3,6 +3,7 @@
 
 use super::blocks::{Phase, Walk};
 use crate::breadth_first::intersect::Work;
+use crate::breadth_first::voxels::push_within;
 use crate::engine::Counters;
 use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
@@ -39,8 +40,9 @@ impl Work {
                 };
                 match self.admit(id, ray, any, test, c) {
                     Ok(slot) => {
-                        self.slots.push(slot);
-                        self.hires.as_mut().expect("hires").walks.push(Walk::new());
+                        push_within(&mut self.slots, slot, self.capacity);
+                        let walks = &mut self.hires.as_mut().expect("hires").walks;
+                        push_within(walks, Walk::new(), self.capacity);
                     }
                     Err(best) => out(id, best),
                 }
