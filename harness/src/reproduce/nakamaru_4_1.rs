@@ -86,8 +86,8 @@ pub const TABLE: Table = Table {
         },
         Claim {
             key: "memory",
-            fidelity: Fidelity::Faithful,
-            why: "",
+            fidelity: Fidelity::Substituted,
+            why: "the thesis's only limit was its machine's 256 MB of physical RAM, operating system included (no other cap is stated); here the engine alone is given a 256 MiB budget on a 23.5 GiB machine, and the whole process's peak RSS (engine, image, code) is checked against a bound of ours, 320 MiB, and shown beside the thesis's 256 MB",
         },
     ],
     run,
@@ -562,7 +562,11 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "memory",
                 m.label(),
                 format!("{} MB machine; bound 320 MiB", p.memory_mib),
-                format!("peak RSS {:.1} MiB", peak as f64 / 1048576.0),
+                format!(
+                    "peak RSS {:.1} MiB ({:.0} MB)",
+                    peak as f64 / 1048576.0,
+                    peak as f64 / 1e6
+                ),
                 Kind::Ordering,
                 Verdict::of(peak <= 320 << 20),
             )
