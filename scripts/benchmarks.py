@@ -214,6 +214,17 @@ def ooc(d):
                "image sha256"], rows)
 
 
+def goals(j):
+    """Our engines' goals (kimura-simd's tables beside 001's claim, not claims of 001): the goal rows, then what
+    each factor of the SIMD traversal is worth on the same trees."""
+    g = md(["scene", "ratio", "goal", "measured", "met"],
+           [[r["scene"], r["ratio"], r["goal"], f"{r['measured']:.2f}", "yes" if r["met"] else "**no**"]
+            for r in j["goals"]])
+    f = md(["scene", "factor", "ratio", "numerator ÷ denominator"],
+           [[r["scene"], r["factor"], f"{r['ratio']:.2f}", f"{r['over']} ÷ {r['under']}"] for r in j["factors"]])
+    return f"{g}\n\n{f}"
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/benchmarks"
     parts = [("speed", speed), ("speed", memory), ("build", build), ("threads", threads), ("grid", grid)]
@@ -223,6 +234,13 @@ def main():
             print(f"## {f.__name__} ({sub}: {env_line(d)})\n\n{f(d)}\n")
     if os.path.isdir(os.path.join(out, "ooc")):
         print(f"## ooc\n\n{ooc(os.path.join(out, 'ooc'))}\n")
+    p = os.path.join(out, "goals", "kimura-simd.json")
+    if os.path.exists(p):
+        j = json.load(open(p))
+        v = j["invocation"]
+        dirty = " (with uncommitted changes)" if v.get("dirty") else ""
+        print(f"## goals ({v['date'][:16].replace('T', ' ')} UTC, commit {v['commit'][:10]}{dirty}, {v['machine']})"
+              f"\n\n{goals(j)}\n")
 
 
 if __name__ == "__main__":
