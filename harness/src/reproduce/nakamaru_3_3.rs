@@ -64,8 +64,8 @@ pub const TABLE: Table = Table {
         },
         Claim {
             key: "traced-in-memory",
-            fidelity: Fidelity::Faithful,
-            why: "",
+            fidelity: Fidelity::Substituted,
+            why: "the thesis's only limit was its machine's 32 MB of physical RAM, operating system included (no other cap is stated); here the engine alone is given 28 MiB on a 23.5 GiB machine, and the whole process's peak RSS (engine, image, code) is checked against a bound of ours, 64 MiB, and shown beside the thesis's 32 MB",
         },
         Claim {
             key: "image-equal",
@@ -357,7 +357,11 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                         "traced-in-memory",
                         &subject,
                         format!("32 MB machine; bound {} MiB", p.memory_limit_mib),
-                        format!("peak RSS {:.1} MiB", peak as f64 / 1048576.0),
+                        format!(
+                            "peak RSS {:.1} MiB ({:.0} MB)",
+                            peak as f64 / 1048576.0,
+                            peak as f64 / 1e6
+                        ),
                         Kind::Ordering,
                         Verdict::of(peak <= limit),
                     )
