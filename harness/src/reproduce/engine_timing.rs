@@ -56,7 +56,8 @@ pub fn settings(kv: &[(&str, &str)]) -> Vec<(String, String)> {
         .collect()
 }
 
-fn available(engine: &str) -> bool {
+/// Whether the registry has `engine` and it can run here.
+pub(super) fn available(engine: &str) -> bool {
     rtbench_engines::registry()
         .into_iter()
         .find(|e| e.name == engine)

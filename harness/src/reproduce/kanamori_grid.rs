@@ -223,7 +223,7 @@ fn measure_builds(scene: &'static str, sf: u32, input: &BuildInput, out: &mut Ve
     const BUILDS: usize = 5;
     let engines: Vec<_> = BUILD_ENGINES
         .iter()
-        .filter(|&&(_, engine, _)| rtbench_engines::registry().into_iter().find(|e| e.name == engine).is_some_and(|e| (e.available)().is_ok()))
+        .filter(|&&(_, engine, _)| super::engine_timing::available(engine))
         .collect();
     let mut times = vec![Vec::with_capacity(BUILDS); engines.len()];
     for _ in 0..BUILDS {
