@@ -97,7 +97,7 @@ mod tests;
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
 use crate::grid::build::{FLOOR_FLAT, FLOOR_SPAN};
 use crate::ray::{Hit, Ray};
-use crate::store::{ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface};
+use crate::store::{IoCounters, ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface};
 use config::{BreadthFirstConfig, Count, Floor, Registration};
 use glam::Vec3;
 use hires::config::GridKind;
@@ -545,8 +545,34 @@ impl BreadthFirst {
         c: &mut Counters,
     ) -> std::io::Result<()> {
         let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
-        let before = w.io();
-        let r = w.trace(rays, any, self.config.triangle, out, c);
+        Self::trace_work(
+            &mut w,
+            self.config.triangle,
+            rays,
+            any,
+            out,
+            c,
+            IoCounters::default(),
+        )
+    }
+
+    /// [`Self::trace_stream`] on the engine's work, already locked; `opened` is what opening
+    /// its readers for this call read, counted with the call's own reads.
+    fn trace_work(
+        w: &mut Work,
+        triangle: crate::geometry::TriangleTest,
+        rays: &mut dyn Iterator<Item = (u32, Ray)>,
+        any: bool,
+        out: &mut dyn FnMut(u32, Hit),
+        c: &mut Counters,
+        opened: IoCounters,
+    ) -> std::io::Result<()> {
+        let mut before = w.io();
+        before.bytes_read = before.bytes_read.saturating_sub(opened.bytes_read);
+        before.read_calls = before.read_calls.saturating_sub(opened.read_calls);
+        before.seeks = before.seeks.saturating_sub(opened.seeks);
+        before.codec_bytes = before.codec_bytes.saturating_sub(opened.codec_bytes);
+        let r = w.trace(rays, any, triangle, out, c);
         let floor_tests = std::mem::take(&mut w.floor_tests);
         if floor_tests > 0 {
             *c.extra.entry("bf_floor_tests".into()).or_insert(0) += floor_tests;
@@ -568,6 +594,17 @@ impl BreadthFirst {
         r
     }
 
+    /// The scene's readers opened again, and what opening them read (the bounding-box
+    /// hierarchy's and the high-resolution grid's files keep their readers).
+    fn fresh_readers(
+        w: &mut Work,
+        header: &StoreHeader,
+        config: &BreadthFirstConfig,
+    ) -> std::io::Result<IoCounters> {
+        w.scene = SceneReader::open(header, config.buffer as usize, config.lazy)?;
+        Ok(w.scene.io())
+    }
+
     fn answer<T>(
         &self,
         rays: &[Ray],
@@ -577,7 +614,23 @@ impl BreadthFirst {
         put: impl Fn(&mut T, Hit),
     ) {
         let mut it = rays.iter().enumerate().map(|(i, r)| (i as u32, *r));
-        let r = self.trace_stream(&mut it, any, &mut |id, h| put(&mut out[id as usize], h), c);
+        let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
+        // The calls of an in-memory trace (one per band and query) may come in any order, from
+        // several threads. Each starts with the scene's readers as the engine opened them, so
+        // what it reads, and its I/O counters, do not depend on where the call before it left
+        // the file buffers (the lazy geometry reads end wherever that call's rays ended).
+        let r = Self::fresh_readers(&mut w, &self.header, &self.config).and_then(|opened| {
+            let mut put = |id: u32, h: Hit| put(&mut out[id as usize], h);
+            Self::trace_work(
+                &mut w,
+                self.config.triangle,
+                &mut it,
+                any,
+                &mut put,
+                c,
+                opened,
+            )
+        });
         if let Err(e) = r {
             let mut f = self.failure.lock().unwrap_or_else(|p| p.into_inner());
             f.get_or_insert_with(|| format!("breadth-first: reading the scene store: {e}"));

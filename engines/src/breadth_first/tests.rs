@@ -274,3 +274,34 @@ fn wrong_layout_is_refused() {
     let s = Settings::new("breadth-first", kv(&[("layout", "basic"), ("lazy", "on")]));
     assert!(BreadthFirstConfig::from_settings(s).is_err());
 }
+
+/// The calls of an in-memory trace may be served in any order (several threads take bands):
+/// each call's counters, the I/O ones included, are the same whichever call came before it.
+#[test]
+fn a_call_counts_the_same_whichever_call_came_before() {
+    let input = spd(Program::Gears, 1);
+    let (rays, _) = rays_for(&input.geometry, 2000);
+    let (a, b) = rays.split_at(1000);
+    // Call `first`, then `then`, on a fresh engine: the second call's counters.
+    let second = |first: &[Ray], then: &[Ray]| {
+        let e = build_engine("breadth-first", &input, kv(&[])).unwrap();
+        let mut hits = vec![Hit::MISS; first.len()];
+        e.intersect(first, &mut hits, &mut Counters::default());
+        let mut c = Counters::default();
+        let mut hits = vec![Hit::MISS; then.len()];
+        e.intersect(then, &mut hits, &mut c);
+        (c, hits)
+    };
+    // `b` alone on a fresh engine, after `a`, and after `b` itself.
+    let after_a = second(a, b);
+    let after_b = second(b, b);
+    let mut alone = Counters::default();
+    let e = build_engine("breadth-first", &input, kv(&[])).unwrap();
+    let mut hits = vec![Hit::MISS; b.len()];
+    e.intersect(b, &mut hits, &mut alone);
+    assert!(after_a.0.extra.get("io_bytes_read").copied().unwrap_or(0) > 0);
+    for (what, (c, h)) in [("after a", &after_a), ("after b", &after_b)] {
+        assert_eq!(c, &alone, "{what}: other counters than the call alone");
+        assert_eq!(h, &hits, "{what}: other hits");
+    }
+}
