@@ -162,20 +162,6 @@ def build(d):
     return md(["scene"] + [f"{e} ms" for e in engines], rows)
 
 
-def threads(d):
-    recs = records(d)
-    t = by_scene(recs)
-    engines = engines_of(recs)
-    rows = []
-    for s in scenes_of(t):
-        row = [s]
-        for e in engines:
-            ts = (t[s].get(e) or {}).get("thread_scaling")
-            row.append(fmt_ci(pairs_ci(t[s].get(e), ts["speedup"])) if ts else "–")
-        rows.append(row)
-    return md(["scene"] + [f"{e} speed-up at 2 threads" for e in engines], rows) + failures(recs)
-
-
 def grid(d):
     recs = records(d)
     t = by_scene(recs)
@@ -225,13 +211,161 @@ def goals(j):
     return f"{g}\n\n{f}"
 
 
+# The performance targets: each table judges one target on the runs of its own command.
+
+
+def paired(r):
+    """A run's paired time ratio to Embree as (estimate, lo, hi, exact), or None."""
+    p = (r or {}).get("paired_ratio")
+    return pairs_ci(r, p) if p else None
+
+
+def inverse(c):
+    """Speed from a time ratio: (1/estimate, 1/hi, 1/lo)."""
+    return None if c is None else (1 / c[0], 1 / c[2], 1 / c[1], c[3])
+
+
+def quotient(a, b):
+    """a ÷ b of two figures with intervals, the interval from their bounds (each side's 95 % interval at its
+    worst: wider than the interval of the quotient itself)."""
+    if a is None or b is None:
+        return None
+    return a[0] / b[0], a[1] / b[2], a[2] / b[1], a[3] and b[3]
+
+
+def met(c, bound, above=True):
+    """Whether the whole interval is past the bound ("yes"), only the estimate ("estimate only"), or neither."""
+    if c is None:
+        return "–"
+    lo, est, hi = c[1], c[0], c[2]
+    if above:
+        return "yes" if lo >= bound else ("estimate only" if est >= bound else "**no**")
+    return "yes" if hi <= bound else ("estimate only" if est <= bound else "**no**")
+
+
+def wide(d):
+    """bvh8 at least 1.1× and bvh4 at least 1.0× Embree's speed."""
+    recs = records(d)
+    t = by_scene(recs)
+    rows = []
+    for s in scenes_of(t):
+        b8, b4 = inverse(paired(t[s].get("bvh8"))), inverse(paired(t[s].get("bvh4")))
+        rows.append([s, fmt_ci(b8), met(b8, 1.1), fmt_ci(b4), met(b4, 1.0)])
+    return md(["scene", "bvh8 speed ÷ Embree's", "≥ 1.1", "bvh4 speed ÷ Embree's", "≥ 1.0"], rows) + failures(recs)
+
+
+def tinybvh(d):
+    """bvh8 against tinybvh's fastest layout, both timed in pairs with Embree."""
+    recs = records(d)
+    t = by_scene(recs)
+    rows = []
+    for s in scenes_of(t):
+        layouts = {e: paired(r) for e, r in t[s].items() if e.startswith("tinybvh")}
+        layouts = {e: c for e, c in layouts.items() if c}
+        if not layouts or "bvh8" not in t[s]:
+            continue
+        fastest = min(layouts, key=lambda e: layouts[e][0])
+        agree = lambda r: f"{(r.get('check') or {}).get('hit_agreement', float('nan')):.6f}"
+        b8 = paired(t[s]["bvh8"])
+        q = quotient(layouts[fastest], b8)
+        rows.append([s, fmt_ci(b8), fastest.replace("tinybvh[layout=", "").rstrip("]"), fmt_ci(layouts[fastest]),
+                     fmt_ci(q), met(q, 1.0), agree(t[s][fastest]), agree(t[s]["bvh8"])])
+    return md(["scene", "bvh8 time ÷ Embree's", "tinybvh's fastest layout", "its time ÷ Embree's",
+               "bvh8 speed ÷ tinybvh's", "≥ 1.0", "its hits as Embree's", "bvh8's hits as Embree's"],
+              rows) + failures(recs)
+
+
+def in_core(d):
+    """breadth-first at its defaults in memory: peak RSS against bvh8's, trace time against the grid's."""
+    recs = records(d)
+    t = by_scene(recs)
+    rows = []
+    for s in scenes_of(t):
+        bf, b8, g = t[s].get("breadth-first"), t[s].get("bvh8"), t[s].get("grid")
+        if not (bf and b8 and g):
+            continue
+        rss = bf["peak_rss_bytes"] / b8["peak_rss_bytes"]
+        q = quotient(paired(bf), paired(g))
+        rows.append([s, f"{bf['peak_rss_bytes'] / 2**20:.1f} / {b8['peak_rss_bytes'] / 2**20:.1f}", f"{rss:.2f}",
+                     "yes" if rss <= 2 else "**no**", fmt_ci(q), met(q, 1.5, above=False)])
+    return md(["scene", "peak RSS MiB, breadth-first / bvh8", "ratio", "≤ 2", "trace time ÷ the grid's", "≤ 1.5"],
+              rows) + failures(recs)
+
+
+def over_processes(dirs, scene, engine):
+    """One figure from runs of one process each (a binary without rounds): the mean of their pairs' medians on
+    the log scale, with Student's t 95 % interval over the processes."""
+    meds = []
+    for d in dirs:
+        r = by_scene(records(d)).get(scene, {}).get(engine)
+        if r and r.get("paired_ratio"):
+            meds.append(math.log(r["paired_ratio"]["median"]))
+    n = len(meds)
+    if n < 2:
+        return None
+    m = sum(meds) / n
+    sd = math.sqrt(sum((x - m) ** 2 for x in meds) / (n - 1))
+    t = {2: 12.706, 3: 4.303, 4: 3.182, 5: 2.776, 6: 2.571, 7: 2.447, 8: 2.365, 9: 2.306}.get(n, 2.262)
+    h = t * sd / math.sqrt(n)
+    return math.exp(m), math.exp(m - h), math.exp(m + h), True
+
+
+def grid_then(now, thens):
+    """The grid against the grid of the targets' day, each timed in pairs with Embree by its own binary: now over
+    the rounds of one run, then over one process per run."""
+    a = by_scene(records(now))
+    first = by_scene(records(thens[0]))
+    rows = []
+    for s in scenes_of(a):
+        n, o = a[s].get("grid"), (first.get(s) or {}).get("grid")
+        if not (n and o):
+            continue
+        old = over_processes(thens, s, "grid")
+        q = quotient(old, paired(n))
+        keys = ["primitive_tests", "cells_visited", "mailbox_skips", "box_tests", "shadow_cache_hits"]
+        same = all(n["counters"].get(k) == o["counters"].get(k) for k in keys)
+        rows.append([s, fmt_ci(old), fmt_ci(paired(n)), fmt_ci(q), met(q, 1.3), "yes" if same else "**no**"])
+    return md(["scene", "then: time ÷ Embree's", "now: time ÷ Embree's", "speed-up", "≥ 1.3", "same counters"],
+              rows) + failures(records(now))
+
+
+def two_threads(d):
+    """Every engine's speed-up at two threads (the median of its paired-threads samples; ✗ below 1.8), and the
+    CPU seconds its pool's threads used at two threads over those at one (medians): 1.00 when the split trace cost
+    no more CPU time."""
+    recs = records(d)
+    t = by_scene(recs)
+    engines = engines_of(recs)
+    rows = []
+    for s in scenes_of(t):
+        row = [s]
+        for e in engines:
+            r = t[s].get(e)
+            ts = (r or {}).get("thread_scaling")
+            if not ts:
+                row.append("–")
+                continue
+            c = pairs_ci(r, ts["speedup"])
+            growth = ts["threads_cpu_s"]["median"] / max(ts["one_thread_cpu_s"]["median"], 1e-12)
+            row.append(fmt_ci(c) + ("" if c[0] >= 1.8 else " ✗") + f" (CPU {growth:.2f})")
+        rows.append(row)
+    return md(["scene"] + engines, rows) + failures(recs)
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/benchmarks"
-    parts = [("speed", speed), ("speed", memory), ("build", build), ("threads", threads), ("grid", grid)]
+    parts = [("speed", speed), ("speed", memory), ("build", build), ("grid", grid),
+             ("wide", wide), ("tinybvh", tinybvh), ("in-core", in_core), ("two-threads", two_threads)]
     for sub, f in parts:
         d = os.path.join(out, sub)
         if records(d):
             print(f"## {f.__name__} ({sub}: {env_line(d)})\n\n{f(d)}\n")
+    now = os.path.join(out, "grid-now")
+    thens = sorted(os.path.join(out, d) for d in os.listdir(out) if d.startswith("grid-then")) \
+        if os.path.isdir(out) else []
+    if records(now) and thens and records(thens[0]):
+        print(f"## grid_then (grid-now: {env_line(now)}; grid-then: {env_line(thens[0])}, {len(thens)} processes)"
+              f"\n\n{grid_then(now, thens)}\n")
     if os.path.isdir(os.path.join(out, "ooc")):
         print(f"## ooc\n\n{ooc(os.path.join(out, 'ooc'))}\n")
     p = os.path.join(out, "goals", "kimura-simd.json")
