@@ -233,6 +233,39 @@ def quotient(a, b):
     return a[0] / b[0], a[1] / b[2], a[2] / b[1], a[3] and b[3]
 
 
+T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262, 10: 2.228}
+
+
+def round_medians(r):
+    """The median of each round's pairs of a run's paired ratio to Embree, in round order."""
+    p = (r or {}).get("paired_ratio") or {}
+    out, at = [], 0
+    for rd in (r or {}).get("rounds") or []:
+        k = rd.get("pairs", 0)
+        xs = sorted(p.get("samples", [])[at:at + k])
+        at += k
+        if xs:
+            n = len(xs)
+            out.append(xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2]))
+    return out
+
+
+def quotient_rounds(ra, rb):
+    """a ÷ b of two engines' paired ratios to Embree, round by round: round i of every job of a run ran in the
+    same pass over the jobs, so each round's quotient leaves out what moved both. The mean of the rounds' log
+    quotients over the rounds both ran, with Student's t 95 % interval; from the two intervals' bounds
+    ([`quotient`]) when fewer than two rounds are common."""
+    a, b = round_medians(ra), round_medians(rb)
+    n = min(len(a), len(b))
+    if n < 2:
+        return quotient(paired(ra), paired(rb))
+    d = [math.log(a[i] / b[i]) for i in range(n)]
+    m = sum(d) / n
+    sd = math.sqrt(sum((x - m) ** 2 for x in d) / (n - 1))
+    h = T95.get(n - 1, 1.96) * sd / math.sqrt(n)
+    return math.exp(m), math.exp(m - h), math.exp(m + h), True
+
+
 def met(c, bound, above=True):
     """Whether the whole interval is past the bound ("yes"), only the estimate ("estimate only"), or neither."""
     if c is None:
@@ -267,7 +300,7 @@ def tinybvh(d):
         fastest = min(layouts, key=lambda e: layouts[e][0])
         agree = lambda r: f"{(r.get('check') or {}).get('hit_agreement', float('nan')):.6f}"
         b8 = paired(t[s]["bvh8"])
-        q = quotient(layouts[fastest], b8)
+        q = quotient_rounds(t[s][fastest], t[s]["bvh8"])
         rows.append([s, fmt_ci(b8), fastest.replace("tinybvh[layout=", "").rstrip("]"), fmt_ci(layouts[fastest]),
                      fmt_ci(q), met(q, 1.0), agree(t[s][fastest]), agree(t[s]["bvh8"])])
     return md(["scene", "bvh8 time ÷ Embree's", "tinybvh's fastest layout", "its time ÷ Embree's",
@@ -285,7 +318,7 @@ def in_core(d):
         if not (bf and b8 and g):
             continue
         rss = bf["peak_rss_bytes"] / b8["peak_rss_bytes"]
-        q = quotient(paired(bf), paired(g))
+        q = quotient_rounds(bf, g)
         rows.append([s, f"{bf['peak_rss_bytes'] / 2**20:.1f} / {b8['peak_rss_bytes'] / 2**20:.1f}", f"{rss:.2f}",
                      "yes" if rss <= 2 else "**no**", fmt_ci(q), met(q, 1.5, above=False)])
     return md(["scene", "peak RSS MiB, breadth-first / bvh8", "ratio", "≤ 2", "trace time ÷ the grid's", "≤ 1.5"],
@@ -305,7 +338,7 @@ def over_processes(dirs, scene, engine):
         return None
     m = sum(meds) / n
     sd = math.sqrt(sum((x - m) ** 2 for x in meds) / (n - 1))
-    t = {2: 12.706, 3: 4.303, 4: 3.182, 5: 2.776, 6: 2.571, 7: 2.447, 8: 2.365, 9: 2.306}.get(n, 2.262)
+    t = T95.get(n - 1, 1.96)
     h = t * sd / math.sqrt(n)
     return math.exp(m), math.exp(m - h), math.exp(m + h), True
 
