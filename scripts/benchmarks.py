@@ -148,17 +148,18 @@ def memory(d):
     return md(["scene", "primitives"] + [f"{e} B/prim / peak MiB" for e in engines], rows)
 
 
-def build(d):
+def per_engine(d, cell):
+    """A table of one row per scene and one column per engine, each cell `cell(record)` (– without a run)."""
     recs = records(d)
     t = by_scene(recs)
     engines = engines_of(recs)
-    rows = []
-    for s in scenes_of(t):
-        row = [s]
-        for e in engines:
-            r = t[s].get(e)
-            row.append(fmt_ci(median_ci([x * 1e3 for x in r['time_s']['build']['samples']]), 1) if r else "–")
-        rows.append(row)
+    rows = [[s] + [cell(t[s][e]) if e in t[s] else "–" for e in engines] for s in scenes_of(t)]
+    return recs, engines, rows
+
+
+def build(d):
+    _, engines, rows = per_engine(
+        d, lambda r: fmt_ci(median_ci([x * 1e3 for x in r['time_s']['build']['samples']]), 1))
     return md(["scene"] + [f"{e} ms" for e in engines], rows)
 
 
@@ -366,22 +367,14 @@ def two_threads(d):
     """Every engine's speed-up at two threads (the median of its paired-threads samples; ✗ below 1.8), and the
     CPU seconds its pool's threads used at two threads over those at one (medians): 1.00 when the split trace cost
     no more CPU time."""
-    recs = records(d)
-    t = by_scene(recs)
-    engines = engines_of(recs)
-    rows = []
-    for s in scenes_of(t):
-        row = [s]
-        for e in engines:
-            r = t[s].get(e)
-            ts = (r or {}).get("thread_scaling")
-            if not ts:
-                row.append("–")
-                continue
-            c = pairs_ci(r, ts["speedup"])
-            growth = ts["threads_cpu_s"]["median"] / max(ts["one_thread_cpu_s"]["median"], 1e-12)
-            row.append(fmt_ci(c) + ("" if c[0] >= 1.8 else " ✗") + f" (CPU {growth:.2f})")
-        rows.append(row)
+    def cell(r):
+        ts = r.get("thread_scaling")
+        if not ts:
+            return "–"
+        c = pairs_ci(r, ts["speedup"])
+        growth = ts["threads_cpu_s"]["median"] / max(ts["one_thread_cpu_s"]["median"], 1e-12)
+        return fmt_ci(c) + ("" if c[0] >= 1.8 else " ✗") + f" (CPU {growth:.2f})"
+    recs, engines, rows = per_engine(d, cell)
     return md(["scene"] + engines, rows) + failures(recs)
 
 
