@@ -260,9 +260,16 @@ def quotient_rounds(ra, rb):
     n = min(len(a), len(b))
     if n < 2:
         return quotient(paired(ra), paired(rb))
-    d = [math.log(a[i] / b[i]) for i in range(n)]
-    m = sum(d) / n
-    sd = math.sqrt(sum((x - m) ** 2 for x in d) / (n - 1))
+    return log_mean_ci([math.log(a[i] / b[i]) for i in range(n)])
+
+
+def log_mean_ci(logs):
+    """exp of the mean of `logs` with Student's t 95 % interval, as (estimate, lo, hi, exact); None below two."""
+    n = len(logs)
+    if n < 2:
+        return None
+    m = sum(logs) / n
+    sd = math.sqrt(sum((x - m) ** 2 for x in logs) / (n - 1))
     h = T95.get(n - 1, 1.96) * sd / math.sqrt(n)
     return math.exp(m), math.exp(m - h), math.exp(m + h), True
 
@@ -334,14 +341,7 @@ def over_processes(dirs, scene, engine):
         r = by_scene(records(d)).get(scene, {}).get(engine)
         if r and r.get("paired_ratio"):
             meds.append(math.log(r["paired_ratio"]["median"]))
-    n = len(meds)
-    if n < 2:
-        return None
-    m = sum(meds) / n
-    sd = math.sqrt(sum((x - m) ** 2 for x in meds) / (n - 1))
-    t = T95.get(n - 1, 1.96)
-    h = t * sd / math.sqrt(n)
-    return math.exp(m), math.exp(m - h), math.exp(m + h), True
+    return log_mean_ci(meds)
 
 
 def grid_then(now, thens):

@@ -568,10 +568,7 @@ impl BreadthFirst {
         opened: IoCounters,
     ) -> std::io::Result<()> {
         let mut before = w.io();
-        before.bytes_read = before.bytes_read.saturating_sub(opened.bytes_read);
-        before.read_calls = before.read_calls.saturating_sub(opened.read_calls);
-        before.seeks = before.seeks.saturating_sub(opened.seeks);
-        before.codec_bytes = before.codec_bytes.saturating_sub(opened.codec_bytes);
+        before.sub(&opened);
         let r = w.trace(rays, any, triangle, out, c);
         let floor_tests = std::mem::take(&mut w.floor_tests);
         if floor_tests > 0 {

@@ -187,6 +187,16 @@ impl IoCounters {
         self.seeks += o.seeks;
         self.codec_bytes += o.codec_bytes;
     }
+
+    /// Takes `o` away (counts already in `self`: nothing goes below zero).
+    pub fn sub(&mut self, o: &IoCounters) {
+        self.bytes_read = self.bytes_read.saturating_sub(o.bytes_read);
+        self.bytes_written = self.bytes_written.saturating_sub(o.bytes_written);
+        self.read_calls = self.read_calls.saturating_sub(o.read_calls);
+        self.write_calls = self.write_calls.saturating_sub(o.write_calls);
+        self.seeks = self.seeks.saturating_sub(o.seeks);
+        self.codec_bytes = self.codec_bytes.saturating_sub(o.codec_bytes);
+    }
 }
 
 /// A file with its own buffer of a fixed size, reading forward (with forward seeks) or

@@ -357,11 +357,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                         "traced-in-memory",
                         &subject,
                         format!("32 MB machine; bound {} MiB", p.memory_limit_mib),
-                        format!(
-                            "peak RSS {:.1} MiB ({:.0} MB)",
-                            peak as f64 / 1048576.0,
-                            peak as f64 / 1e6
-                        ),
+                        super::params::peak_rss_text(peak),
                         Kind::Ordering,
                         Verdict::of(peak <= limit),
                     )

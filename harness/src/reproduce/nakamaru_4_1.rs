@@ -565,11 +565,7 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
                 "memory",
                 m.label(),
                 format!("{} MB machine; bound 320 MiB", p.memory_mib),
-                format!(
-                    "peak RSS {:.1} MiB ({:.0} MB)",
-                    peak as f64 / 1048576.0,
-                    peak as f64 / 1e6
-                ),
+                super::params::peak_rss_text(peak),
                 Kind::Ordering,
                 Verdict::of(peak <= 320 << 20),
             )

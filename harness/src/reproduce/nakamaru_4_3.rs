@@ -1344,11 +1344,7 @@ fn rows(p: &Published, measured: &[Measured], s: &Setup) -> Vec<Row> {
                     "memory",
                     m.row.clone(),
                     "256 MB machine; bound 320 MiB",
-                    format!(
-                        "peak RSS {:.1} MiB ({:.0} MB){of}",
-                        peak as f64 / 1048576.0,
-                        peak as f64 / 1e6
-                    ),
+                    format!("{}{of}", super::params::peak_rss_text(peak)),
                     Kind::Ordering,
                     Verdict::of(peak <= 320 << 20),
                 )

@@ -218,3 +218,13 @@ mod tests {
             .contains("unknown scene 'nope'"));
     }
 }
+
+/// A process's peak resident set as the memory rows show it beside the thesis's machines, which
+/// were sized in MB: `peak RSS 15.2 MiB (16 MB)`.
+pub fn peak_rss_text(peak: u64) -> String {
+    format!(
+        "peak RSS {:.1} MiB ({:.0} MB)",
+        peak as f64 / 1048576.0,
+        peak as f64 / 1e6
+    )
+}
