@@ -215,6 +215,12 @@ macro_rules! kernels {
         ///
         /// Always inlined: left to itself the compiler kept it out of line in the grid's walks,
         /// a call per test with the triangle copied to the stack for it.
+        ///
+        /// The ray's axis order is one of six; the test is written once per order with constant
+        /// axes ([`triangle_watertight_axes`]) and chosen by one branch, which follows the ray
+        /// and so is predicted. Picking each of the nine vertex coordinates by the ray's axis
+        /// indices at run time was a select of up to three values each. Both do the same
+        /// arithmetic, so the answers are the same to the bit.
         #[inline(always)]
         pub fn triangle_watertight(
             o: V,
@@ -225,15 +231,38 @@ macro_rules! kernels {
             v1: V,
             v2: V,
         ) -> Option<(T, T, T)> {
+            match (w.kz, w.kx) {
+                (2, 0) => triangle_watertight_axes::<0, 1, 2>(o, w, tmin, tmax, v0, v1, v2),
+                (2, _) => triangle_watertight_axes::<1, 0, 2>(o, w, tmin, tmax, v0, v1, v2),
+                (0, 1) => triangle_watertight_axes::<1, 2, 0>(o, w, tmin, tmax, v0, v1, v2),
+                (0, _) => triangle_watertight_axes::<2, 1, 0>(o, w, tmin, tmax, v0, v1, v2),
+                (_, 2) => triangle_watertight_axes::<2, 0, 1>(o, w, tmin, tmax, v0, v1, v2),
+                _ => triangle_watertight_axes::<0, 2, 1>(o, w, tmin, tmax, v0, v1, v2),
+            }
+        }
+
+        /// [`triangle_watertight`] for the ray whose axes are `(KX, KY, KZ)` (`w.kx`, `w.ky`,
+        /// `w.kz`; the shear `w.sx`, `w.sy`, `w.sz` is read from `w`).
+        #[inline(always)]
+        pub fn triangle_watertight_axes<const KX: usize, const KY: usize, const KZ: usize>(
+            o: V,
+            w: &WatertightRay,
+            tmin: T,
+            tmax: T,
+            v0: V,
+            v1: V,
+            v2: V,
+        ) -> Option<(T, T, T)> {
+            debug_assert_eq!((w.kx, w.ky, w.kz), (KX, KY, KZ));
             let a = v0 - o;
             let b = v1 - o;
             let c = v2 - o;
-            let ax = a[w.kx] - w.sx * a[w.kz];
-            let ay = a[w.ky] - w.sy * a[w.kz];
-            let bx = b[w.kx] - w.sx * b[w.kz];
-            let by = b[w.ky] - w.sy * b[w.kz];
-            let cx = c[w.kx] - w.sx * c[w.kz];
-            let cy = c[w.ky] - w.sy * c[w.kz];
+            let ax = a[KX] - w.sx * a[KZ];
+            let ay = a[KY] - w.sy * a[KZ];
+            let bx = b[KX] - w.sx * b[KZ];
+            let by = b[KY] - w.sy * b[KZ];
+            let cx = c[KX] - w.sx * c[KZ];
+            let cy = c[KY] - w.sy * c[KZ];
             let mut u = cx * by - cy * bx;
             let mut v = ax * cy - ay * cx;
             let mut ww = bx * ay - by * ax;
@@ -253,9 +282,9 @@ macro_rules! kernels {
             if det == 0.0 {
                 return None;
             }
-            let az = w.sz * a[w.kz];
-            let bz = w.sz * b[w.kz];
-            let cz = w.sz * c[w.kz];
+            let az = w.sz * a[KZ];
+            let bz = w.sz * b[KZ];
+            let cz = w.sz * c[KZ];
             let t = u * az + v * bz + ww * cz;
             let inv = 1.0 / det;
             let t = t * inv;

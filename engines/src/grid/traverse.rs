@@ -203,7 +203,7 @@ impl Grid {
     pub(super) fn walk(&self, ray: &Ray, mut visit: impl FnMut(usize, f32, f32) -> bool) {
         let res = self.cells.lattice.res;
         dda::walk(&self.cells.lattice, ray, |d, t_enter, t_wall| {
-            visit(d.index(res), t_enter, t_wall.min(d.t_end()))
+            visit(d.index(res), t_enter, dda::min_t(t_wall, d.t_end()))
         })
     }
 
@@ -265,7 +265,7 @@ impl Grid {
                     return r.tmax <= t_exit;
                 }
                 let piece = CullPiece::new(if CULL {
-                    segment_box(&r, t_enter, t_exit.min(r.tmax), g.pad)
+                    segment_box(&r, t_enter, dda::min_t(t_exit, r.tmax), g.pad)
                 } else {
                     (Vec3::ZERO, Vec3::ZERO)
                 });
