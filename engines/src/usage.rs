@@ -38,5 +38,5 @@ pub fn address_space_left() -> Option<u64> {
             line.split_whitespace().nth(1)?.parse::<u64>().ok()
         })
         .map_or(0, |kb| kb.saturating_mul(1024));
-    Some((lim.rlim_cur as u64).saturating_sub(mapped))
+    Some(lim.rlim_cur.saturating_sub(mapped))
 }

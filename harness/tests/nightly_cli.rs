@@ -362,10 +362,7 @@ fn dashboard_in_chromium(page: &Path, dir: &Path, metrics: usize, commit: &str, 
         .unwrap_or_else(|| panic!("no plot of {name}"));
     let plot = &dom[at..at + dom[at..].find("</section>").unwrap()];
     assert!(plot.contains("data-flag=\"regression\""), "{plot}");
-    assert!(
-        plot.contains(&format!("<span class=\"mark regression\"")),
-        "{plot}"
-    );
+    assert!(plot.contains("<span class=\"mark regression\""), "{plot}");
     assert!(
         plot.contains(&format!("regression night {night}")),
         "{plot}"

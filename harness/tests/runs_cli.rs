@@ -611,7 +611,10 @@ fn embree_leaves_no_thread_spinning_beside_the_trace() {
         .collect();
     // The untimed render, two repeats, the one-thread pool's untimed render and the pairs (at least
     // the one asked for; a fast trace gets more), two renders each.
-    assert!(lines.len() >= 6 && (lines.len() - 4) % 2 == 0, "{err}");
+    assert!(
+        lines.len() >= 6 && (lines.len() - 4).is_multiple_of(2),
+        "{err}"
+    );
     for l in &lines {
         let w: Vec<&str> = l.split_whitespace().collect();
         let threads: usize = w[3].parse().unwrap();

@@ -143,16 +143,20 @@ mod tests {
     fn the_quotient_pairs_each_round_with_embrees_same_round() {
         // Every round of the engine is twice Embree's, though the machine's speed moved 30 %
         // between rounds: the figure is 2 with an interval of zero width.
-        let mut timings = crate::results::Timings::default();
-        timings.trace_cpu = Spread::of(&[2.0, 2.6, 2.2]);
+        let timings = crate::results::Timings {
+            trace_cpu: Spread::of(&[2.0, 2.6, 2.2]),
+            ..Default::default()
+        };
         let r = RunRecord {
             rounds: rounds(&[0, 0, 0]),
             time_s: timings.clone(),
             ..Default::default()
         };
-        timings.trace_cpu = Spread::of(&[1.0, 1.3, 1.1]);
         let e = RunRecord {
-            time_s: timings,
+            time_s: crate::results::Timings {
+                trace_cpu: Spread::of(&[1.0, 1.3, 1.1]),
+                ..timings
+            },
             ..r.clone()
         };
         let q = quotient(&r, &e).unwrap().interval();

@@ -114,7 +114,8 @@ pub fn check_records(records: &[RunRecord], path: &str) -> Result<(), crate::err
                 .chain(&s.samples)
                 .any(|x| !(x.is_finite() && *x >= 0.0))
         });
-        if wrong || !(t.trace.median > 0.0) {
+        // Not above zero, or NaN.
+        if wrong || t.trace.median.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(bad(format!(
                 "run {}: a time that is negative, zero or not a number",
                 r.key

@@ -41,7 +41,8 @@ pub fn store(src: &Source, out: &Path, a: &SegmentArgs) -> Result<()> {
         return Err(input("--segment 0: a segment holds at least one object"));
     }
     let budget = match a.max_seconds {
-        Some(s) if !(s > 0.0) => {
+        // Not above zero, or NaN.
+        Some(s) if s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) => {
             return Err(input(format!("--max-seconds {s}: expected seconds > 0")))
         }
         // Longer than a Duration holds (1e308, inf): no limit.

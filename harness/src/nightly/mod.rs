@@ -578,7 +578,7 @@ pub fn summary_markdown(
     let bad: Vec<&Finding> = findings.iter().filter(|f| is_bad(f)).collect();
     s.push_str(&format!(
         "# Nightly `{suite}` at `{}`: {}\n\n{} metrics ({gated} gated), {}, {}.\n\n",
-        crate::output::head(&commit, 12),
+        crate::output::head(commit, 12),
         if bad.is_empty() {
             "no regression".to_string()
         } else {

@@ -452,9 +452,12 @@ fn empty_share(g: &GridPoint) -> f64 {
     g.empty_cells / g.cells.max(1.0)
 }
 
+/// A surveyed scene's grid and its bvh4 time.
+type Timed<'a> = (&'a GridPoint, f64);
+
 /// The survey's densest scene (fewest empty cells at n^(1/3) per axis) and its sparsest, each with
 /// its bvh4 time; none with fewer than two scenes.
-fn dense_and_sparse(survey: &[(GridPoint, f64)]) -> Option<((&GridPoint, f64), (&GridPoint, f64))> {
+fn dense_and_sparse(survey: &[(GridPoint, f64)]) -> Option<(Timed<'_>, Timed<'_>)> {
     let by = |a: &&(GridPoint, f64), b: &&(GridPoint, f64)| empty_share(&a.0).total_cmp(&empty_share(&b.0));
     let d = survey.iter().min_by(by)?;
     let s = survey.iter().max_by(by)?;

@@ -162,6 +162,16 @@ pub fn parse_set(id: &str, set: &[String]) -> Result<Vec<(String, String)>> {
         .collect()
 }
 
+/// A process's peak resident set as the memory rows show it beside the thesis's machines, which
+/// were sized in MB: `peak RSS 15.2 MiB (16 MB)`.
+pub fn peak_rss_text(peak: u64) -> String {
+    format!(
+        "peak RSS {:.1} MiB ({:.0} MB)",
+        peak as f64 / 1048576.0,
+        peak as f64 / 1e6
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,14 +227,4 @@ mod tests {
             .to_string()
             .contains("unknown scene 'nope'"));
     }
-}
-
-/// A process's peak resident set as the memory rows show it beside the thesis's machines, which
-/// were sized in MB: `peak RSS 15.2 MiB (16 MB)`.
-pub fn peak_rss_text(peak: u64) -> String {
-    format!(
-        "peak RSS {:.1} MiB ({:.0} MB)",
-        peak as f64 / 1048576.0,
-        peak as f64 / 1e6
-    )
 }

@@ -311,15 +311,6 @@ pub fn file_stem(name: &str) -> String {
         .collect()
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn stems_are_plain() {
-        assert_eq!(super::file_stem("mrays-balls4-tess3"), "mrays-balls4-tess3");
-        assert_eq!(super::file_stem("mrays-my scene/x"), "mrays-my_scene_x");
-    }
-}
-
 /// Trace time over Embree's by engine for one scene, each bar with its 95 % interval as an error
 /// bar (and, where the run timed pairs, the paired ratio as a bar of its own); none without an
 /// interval to draw.
@@ -360,4 +351,13 @@ fn ratio_by_engine(
             bars,
         })],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn stems_are_plain() {
+        assert_eq!(super::file_stem("mrays-balls4-tess3"), "mrays-balls4-tess3");
+        assert_eq!(super::file_stem("mrays-my scene/x"), "mrays-my_scene_x");
+    }
 }

@@ -358,7 +358,7 @@ fn primitive(
         }
         None => (0..one.positions.len() as u32).collect(),
     };
-    if idx.len() % 3 != 0 {
+    if !idx.len().is_multiple_of(3) {
         return Err(format!(
             "a triangle list of {} indices (not a multiple of 3)",
             idx.len()

@@ -468,7 +468,7 @@ mod tests {
         // A GLB with its binary chunk reads the same quad.
         let json = gltf_doc(r#"{"byteLength":60}"#, VIEWS, &format!("{POS},{IDX}"));
         let mut j = json.into_bytes();
-        while j.len() % 4 != 0 {
+        while !j.len().is_multiple_of(4) {
             j.push(b' ');
         }
         let bin = quad_bin();

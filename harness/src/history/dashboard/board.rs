@@ -260,6 +260,17 @@ pub fn build(h: &History, commit_url: Option<&str>) -> Result<Board> {
     })
 }
 
+/// A value as the tables print it: counts whole, small values with four significant digits.
+pub fn fmt_value(v: f64) -> String {
+    if v.abs() >= 1e4 && v.fract() == 0.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 100.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -285,16 +296,5 @@ mod tests {
         assert!(governs("time_ratio", "time_ratio"));
         assert!(governs("instructions", "instructions"));
         assert!(!governs("counters", "time_ratio"));
-    }
-}
-
-/// A value as the tables print it: counts whole, small values with four significant digits.
-pub fn fmt_value(v: f64) -> String {
-    if v.abs() >= 1e4 && v.fract() == 0.0 {
-        format!("{v:.0}")
-    } else if v.abs() >= 100.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.4}")
     }
 }
