@@ -30,11 +30,14 @@ use crate::geometry::TriangleTest;
 use crate::ray::{Hit, Ray};
 use crate::store::{BboxRecord, IoCounters, ObjectRecord, SceneReader};
 use std::io;
+use std::sync::Arc;
 
 /// What the engine works with during a call: the grid, the rays in memory and their
 /// registrations, and the two files.
 pub struct Work {
-    pub(super) voxels: Voxels,
+    /// The marked grid, read only once preprocessing has marked it: shared by the engine's
+    /// works (one per thread tracing at once, [`super::BreadthFirst`]).
+    pub(super) voxels: Arc<Voxels>,
     /// The rays registered in each voxel this pass.
     pub(super) registered: Registrations,
     pub(super) regs_capacity: usize,
@@ -50,7 +53,7 @@ pub struct Work {
     pub(super) scene: SceneReader,
     pub(super) record: ObjectRecord,
     /// The floor group: (object id, its record), held in memory.
-    pub(super) floor: Vec<(u32, ObjectRecord)>,
+    pub(super) floor: Arc<Vec<(u32, ObjectRecord)>>,
     /// Primitive tests of the floor group not yet in the counters (`bf_floor_tests`): counted
     /// here and added once per call, as a lookup of that key per test cost more than the test.
     pub(super) floor_tests: u64,
@@ -231,7 +234,7 @@ impl Work {
         let wt = WatertightRay::new(ray.dir);
         let mut best = Hit::MISS;
         let mut seg = ray;
-        'floor: for (fid, rec) in &self.floor {
+        'floor: for (fid, rec) in self.floor.iter() {
             for prim in &rec.prims {
                 c.primitive_tests += 1;
                 self.floor_tests += 1;

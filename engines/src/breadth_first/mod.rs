@@ -19,7 +19,7 @@
 //!
 //! | key | values | default | what |
 //! |---|---|---|---|
-//! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers |
+//! | `memory` | bytes (`32MiB`, `1GiB` …) | `1GiB` | everything the engine holds: grid, rays in memory, registrations, file buffers (a band traced while another thread's is swept holds rays, registrations and buffers of its own within this budget, over the same grid: [`BreadthFirst`]) |
 //! | `registration` | `fixed:N`, `thesis`, `inverse`, `inverse:N` | `inverse` | candidate voxels per ray per pass ([`config::Registration`]) |
 //! | `spill` | a directory | the system temp dir | where the store of an in-memory scene is written (removed on drop) |
 //! | `buffer` | bytes | `64KiB` | each file buffer (a compressed split store's readers hold one 128 KiB block, its compressed bytes and the block index instead: `store_reader_bytes`) |
@@ -97,15 +97,18 @@ mod tests;
 use crate::engine::{BuildInput, Counters, Engine, EngineError, EngineInfo, Settings};
 use crate::grid::build::{FLOOR_FLAT, FLOOR_SPAN};
 use crate::ray::{Hit, Ray};
-use crate::store::{IoCounters, ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface};
+use crate::store::{
+    Hierarchy, IoCounters, ObjectRecord, SceneReader, StoreHeader, StoreWriter, Surface,
+};
 use config::{BreadthFirstConfig, Count, Floor, Registration};
 use glam::Vec3;
 use hires::config::GridKind;
 use intersect::Work;
 use spill::SpillDir;
 use std::collections::BTreeMap;
+use std::io;
 use std::path::Path;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, TryLockError};
 use std::time::Instant;
 use voxels::{Voxels, PREALLOCATE};
 
@@ -141,10 +144,80 @@ fn is_floor_box(lo: Vec3, hi: Vec3, scene_extent: Vec3) -> bool {
     spans >= 2 && e.min_element() as f64 <= FLOOR_FLAT * e.max_element() as f64
 }
 
+/// What a work is made of besides its readers: the marked grid and the floor group (shared,
+/// read only), the hierarchy's files, and the sizes the budget gave.
+struct WorkParts {
+    extent: f32,
+    voxels: Arc<Voxels>,
+    floor: Arc<Vec<(u32, ObjectRecord)>>,
+    tree: Option<Hierarchy>,
+    capacity: usize,
+    initial: u32,
+}
+
+impl WorkParts {
+    fn work(
+        &self,
+        config: &BreadthFirstConfig,
+        scene: SceneReader,
+        tree: Option<tree::Tree>,
+        hires: Option<hires::HiRes>,
+    ) -> Work {
+        let regs_capacity = self.capacity * self.initial as usize;
+        Work {
+            extent: self.extent,
+            registered: if hires.is_some() {
+                voxels::Registrations::new(0, 0)
+            } else {
+                voxels::Registrations::new(self.voxels.count(), regs_capacity)
+            },
+            voxels: Arc::clone(&self.voxels),
+            regs_capacity,
+            slots: Vec::with_capacity(self.capacity.min(PREALLOCATE)),
+            capacity: self.capacity,
+            initial_count: self.initial,
+            inverse: matches!(
+                config.registration,
+                Registration::Inverse | Registration::InverseFrom(_)
+            ),
+            boundary: config.boundary,
+            prev_skip: config.prev_skip,
+            refill: config.refill,
+            scene,
+            record: ObjectRecord::default(),
+            floor: Arc::clone(&self.floor),
+            floor_tests: 0,
+            tree,
+            cold: config.cold,
+            hires,
+            max_passes: config.max_passes,
+            passes_done: 0,
+            progress: config.progress.then(std::time::Instant::now),
+        }
+    }
+
+    /// Another work over the same grid, with readers of its own.
+    fn twin(&self, header: &StoreHeader, config: &BreadthFirstConfig) -> io::Result<Work> {
+        let scene = SceneReader::open(header, config.buffer as usize, config.lazy)?;
+        let tree = match &self.tree {
+            Some(info) => Some(tree::Tree::open(info.clone(), config.buffer as usize)?),
+            None => None,
+        };
+        Ok(self.work(config, scene, tree, None))
+    }
+}
+
 pub struct BreadthFirst {
     config: BreadthFirstConfig,
     header: StoreHeader,
+    /// The work of the out-of-core workload and of every in-memory call that finds it free.
     work: Mutex<Work>,
+    /// Works made for in-memory calls that came while `work` was busy (another thread's band),
+    /// kept for the next such call: threads trace at once, each with its own rays in memory,
+    /// registrations and file readers, over the one grid.
+    spares: Mutex<Vec<Work>>,
+    /// What such a work is made from; `None` where calls take turns on `work`.
+    parts: Option<WorkParts>,
     failure: Mutex<Option<String>>,
     stats: BTreeMap<String, f64>,
     structure_bytes: u64,
@@ -478,41 +551,25 @@ impl BreadthFirst {
             .abs()
             .max(header.bounds[1].abs())
             .max_element();
-        let is_hr = hires.is_some();
-        let work = Work {
+        let parts = WorkParts {
             extent: if extent.is_finite() { extent } else { 0.0 },
-            registered: if is_hr {
-                voxels::Registrations::new(0, 0)
-            } else {
-                voxels::Registrations::new(voxels.count(), capacity * initial as usize)
-            },
-            voxels,
-            regs_capacity: capacity * initial as usize,
-            slots: Vec::with_capacity(capacity.min(PREALLOCATE)),
+            voxels: Arc::new(voxels),
+            floor: Arc::new(floor),
+            tree: tree.as_ref().map(|t| t.info.clone()),
             capacity,
-            initial_count: initial,
-            inverse: matches!(
-                config.registration,
-                Registration::Inverse | Registration::InverseFrom(_)
-            ),
-            boundary: config.boundary,
-            prev_skip: config.prev_skip,
-            refill: config.refill,
-            scene,
-            record: ObjectRecord::default(),
-            floor,
-            floor_tests: 0,
-            tree,
-            cold: config.cold,
-            hires,
-            max_passes: config.max_passes,
-            passes_done: 0,
-            progress: config.progress.then(std::time::Instant::now),
+            initial,
         };
+        // A work of its own for each thread tracing at once, except where a count runs over
+        // all calls (the pass cap and its progress lines) or the grid is the on-disk one (its
+        // block buffer and lower-grid pool are most of the budget).
+        let twins = hires.is_none() && config.max_passes.is_none() && !config.progress;
+        let work = parts.work(&config, scene, tree, hires);
         Ok(BreadthFirst {
             config,
             header,
             work: Mutex::new(work),
+            spares: Mutex::new(Vec::new()),
+            parts: twins.then_some(parts),
             failure: Mutex::new(None),
             stats,
             structure_bytes: grid_bytes,
@@ -610,27 +667,56 @@ impl BreadthFirst {
         c: &mut Counters,
         put: impl Fn(&mut T, Hit),
     ) {
+        let fail = |e: String| {
+            let mut f = self.failure.lock().unwrap_or_else(|p| p.into_inner());
+            f.get_or_insert(e);
+        };
+        let own = match self.work.try_lock() {
+            Ok(w) => Ok(w),
+            Err(TryLockError::Poisoned(p)) => Ok(p.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(()),
+        };
+        if let (Err(()), Some(parts)) = (&own, &self.parts) {
+            // Another thread traces on `work`: this call takes a spare, or makes one.
+            let spare = self.spares.lock().unwrap_or_else(|p| p.into_inner()).pop();
+            let mut w = match spare.map_or_else(|| parts.twin(&self.header, &self.config), Ok) {
+                Ok(w) => w,
+                Err(e) => return fail(format!("breadth-first: opening the scene store: {e}")),
+            };
+            self.answer_on(&mut w, rays, out, any, c, put, &fail);
+            self.spares
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(w);
+            return;
+        }
+        let mut w = own.unwrap_or_else(|()| self.work.lock().unwrap_or_else(|p| p.into_inner()));
+        self.answer_on(&mut w, rays, out, any, c, put, &fail);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn answer_on<T>(
+        &self,
+        w: &mut Work,
+        rays: &[Ray],
+        out: &mut [T],
+        any: bool,
+        c: &mut Counters,
+        put: impl Fn(&mut T, Hit),
+        fail: &dyn Fn(String),
+    ) {
         let mut it = rays.iter().enumerate().map(|(i, r)| (i as u32, *r));
-        let mut w = self.work.lock().unwrap_or_else(|p| p.into_inner());
         // The calls of an in-memory trace (one per band and query) may come in any order, from
-        // several threads. Each starts with the scene's readers as the engine opened them, so
-        // what it reads, and its I/O counters, do not depend on where the call before it left
-        // the file buffers (the lazy geometry reads end wherever that call's rays ended).
-        let r = Self::fresh_readers(&mut w, &self.header, &self.config).and_then(|opened| {
+        // several threads, to any of the engine's works. Each starts with the scene's readers as
+        // the engine opened them, so what it reads, and its I/O counters, do not depend on where
+        // the call before it left the file buffers (the lazy geometry reads end wherever that
+        // call's rays ended).
+        let r = Self::fresh_readers(w, &self.header, &self.config).and_then(|opened| {
             let mut put = |id: u32, h: Hit| put(&mut out[id as usize], h);
-            Self::trace_work(
-                &mut w,
-                self.config.triangle,
-                &mut it,
-                any,
-                &mut put,
-                c,
-                opened,
-            )
+            Self::trace_work(w, self.config.triangle, &mut it, any, &mut put, c, opened)
         });
         if let Err(e) = r {
-            let mut f = self.failure.lock().unwrap_or_else(|p| p.into_inner());
-            f.get_or_insert_with(|| format!("breadth-first: reading the scene store: {e}"));
+            fail(format!("breadth-first: reading the scene store: {e}"));
         }
     }
 }

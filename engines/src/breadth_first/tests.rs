@@ -305,3 +305,61 @@ fn a_call_counts_the_same_whichever_call_came_before() {
         assert_eq!(h, &hits, "{what}: other hits");
     }
 }
+
+/// A call made while another holds the engine's work (another thread's band) traces on a work
+/// of its own over the same grid, with the hierarchy too, and answers and counts as it would
+/// on the engine's work; calls from two threads at once do the same.
+#[test]
+fn calls_at_once_answer_and_count_as_calls_in_turn() {
+    let input = spd(Program::Gears, 1);
+    let (closest, any) = rays_for(&input.geometry, 2000);
+    for sets in [&[][..], &[("hierarchy", "on")][..]] {
+        let config = Settings::new("breadth-first", kv(sets));
+        let e =
+            BreadthFirst::from_scene(&input, BreadthFirstConfig::from_settings(config).unwrap())
+                .unwrap();
+        let call = |rays: &[Ray], shadow: bool| {
+            let mut c = Counters::default();
+            if shadow {
+                let mut o = vec![false; rays.len()];
+                e.occluded(rays, &mut o, &mut c);
+                (
+                    c,
+                    o.iter()
+                        .map(|&b| f32::from(u8::from(b)))
+                        .collect::<Vec<_>>(),
+                )
+            } else {
+                let mut h = vec![Hit::MISS; rays.len()];
+                e.intersect(rays, &mut h, &mut c);
+                (c, h.iter().map(|h| h.t).collect())
+            }
+        };
+        let bands: Vec<(&[Ray], bool)> = closest
+            .chunks(250)
+            .map(|b| (b, false))
+            .chain(any.chunks(250).map(|b| (b, true)))
+            .collect();
+        let in_turn: Vec<_> = bands.iter().map(|&(b, s)| call(b, s)).collect();
+        {
+            let _held = e.work.lock().unwrap();
+            for (i, &(b, s)) in bands.iter().enumerate() {
+                assert_eq!(call(b, s), in_turn[i], "{sets:?}: band {i} on a spare work");
+            }
+        }
+        assert_eq!(
+            e.spares.lock().unwrap().len(),
+            1,
+            "{sets:?}: one spare, kept"
+        );
+        let at_once: Vec<_> = std::thread::scope(|s| {
+            let halves: Vec<_> = bands
+                .chunks(bands.len() / 2)
+                .map(|h| s.spawn(|| h.iter().map(|&(b, sh)| call(b, sh)).collect::<Vec<_>>()))
+                .collect();
+            halves.into_iter().flat_map(|h| h.join().unwrap()).collect()
+        });
+        assert_eq!(at_once, in_turn, "{sets:?}: two threads at once");
+        assert!(e.failure().is_none());
+    }
+}
