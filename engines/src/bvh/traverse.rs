@@ -96,7 +96,19 @@ struct Tally {
     prim_hits: u64,
 }
 
+/// A node visit in a ray's packed visit count: nodes above bit 32, their boxes below (one
+/// scalar add a node; two separate counts were kept in a vector register, two inserts and
+/// an add a node).
+const NODE_VISIT: u64 = 1 << 32;
+
 impl Tally {
+    /// A ray's packed visits ([`NODE_VISIT`]) added to the counts.
+    #[inline(always)]
+    fn add_visits(&mut self, visits: u64) {
+        self.nodes += visits >> 32;
+        self.boxes += visits & 0xffff_ffff;
+    }
+
     fn add_to(&self, c: &mut Counters, rays: usize) {
         c.rays += rays as u64;
         c.nodes_visited += self.nodes;
@@ -324,11 +336,11 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const 
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
+    let mut visits = 0u64;
     loop {
         if !is_leaf(cur) {
             let node = &bvh.nodes[cur as usize];
-            tally.nodes += 1;
-            tally.boxes += node.len as u64;
+            visits += NODE_VISIT | node.len as u64;
             let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
@@ -483,6 +495,7 @@ fn closest<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const 
         // Next: the nearest pending entry not beyond the closest hit so far.
         loop {
             if sp == 0 {
+                tally.add_visits(visits);
                 return best;
             }
             sp -= 1;
@@ -516,11 +529,11 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
     let mut dist = [0.0f32; N];
     let mut sp = 0usize;
     let mut cur = bvh.root;
+    let mut visits = 0u64;
     loop {
         if !is_leaf(cur) {
             let node = &bvh.nodes[cur as usize];
-            tally.nodes += 1;
-            tally.boxes += node.len as u64;
+            visits += NODE_VISIT | node.len as u64;
             let mut mask = node_test::<N, T, OCT>(node, &tr, tmin, tmax, &mut dist);
             if mask != 0 {
                 let i = mask.trailing_zeros() as usize;
@@ -555,6 +568,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
                     };
                     tally.prims += count.min((first + 1) * PACKET) as u64;
                     tally.prim_hits += m.count_ones() as u64;
+                    tally.add_visits(visits);
                     return true;
                 }
                 k += 2;
@@ -565,6 +579,7 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
                     // The leaf stops at this packet: its triangles and those before it.
                     tally.prims += count.min((k + 1) * PACKET) as u64;
                     tally.prim_hits += mask.count_ones() as u64;
+                    tally.add_visits(visits);
                     return true;
                 }
             }
@@ -579,11 +594,13 @@ fn any<const N: usize, T: ChildTest<N>, P: PairKernel, const W: bool, const OCT:
                     .is_some()
                 {
                     tally.prim_hits += 1;
+                    tally.add_visits(visits);
                     return true;
                 }
             }
         }
         if sp == 0 {
+            tally.add_visits(visits);
             return false;
         }
         sp -= 1;
