@@ -51,10 +51,18 @@ impl Lattice {
     }
 
     /// The cell coordinates of point `p`, clamped into the grid.
-    #[inline]
+    ///
+    /// Written per axis: `[0, 1, 2].map` was compiled as a call of its own that picked each
+    /// coordinate by a run-time index (2–3 % of the grid's time on mount6, once a ray).
+    #[inline(always)]
     pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
         let q = (p - self.lo) * self.inv_cell;
-        [0, 1, 2].map(|i| (q[i].max(0.0) as u32).min(self.res[i] - 1))
+        let axis = |x: f32, res: u32| (x.max(0.0) as u32).min(res - 1);
+        [
+            axis(q.x, self.res[0]),
+            axis(q.y, self.res[1]),
+            axis(q.z, self.res[2]),
+        ]
     }
 
     /// Linear index of cell (x, y, z).
@@ -163,7 +171,8 @@ impl Dda {
     /// The current cell as (x, y, z).
     #[inline(always)]
     pub fn voxel(&self) -> [u32; 3] {
-        self.idx.map(|i| i as u32)
+        let [x, y, z] = self.idx;
+        [x as u32, y as u32, z as u32]
     }
 
     /// The current cell's index `x + res_x·(y + res_y·z)`.

@@ -70,6 +70,7 @@ impl Default for ShadowCache {
 }
 
 impl ShadowCache {
+    #[inline]
     fn slot(&self, key: &Key) -> Option<usize> {
         (0..self.len).find(|&i| (self.ends[i] - key.end).length_squared() <= key.tol2)
     }
