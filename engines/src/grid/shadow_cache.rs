@@ -70,13 +70,13 @@ impl Default for ShadowCache {
 }
 
 impl ShadowCache {
-    #[inline]
+    #[inline(always)]
     fn slot(&self, key: &Key) -> Option<usize> {
         (0..self.len).find(|&i| (self.ends[i] - key.end).length_squared() <= key.tol2)
     }
 
     /// The primitive that last blocked this light, if any.
-    #[inline]
+    #[inline(always)]
     pub fn blocker(&self, key: &Key) -> Option<u32> {
         self.slot(key)
             .map(|i| self.prims[i])
@@ -91,6 +91,7 @@ impl ShadowCache {
     }
 
     /// Tracing found `prim` blocking this light.
+    #[inline]
     pub fn remember(&mut self, key: &Key, prim: u32) {
         let i = match self.slot(key) {
             Some(i) => i,
