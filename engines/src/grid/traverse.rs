@@ -384,11 +384,15 @@ impl Grid {
 }
 
 /// The bounding box of the ray's piece from `t0` to `t1`, grown by `pad` against rounding.
+/// A cell's `t0` and `t1` are finite, so the ends have no NaN and plain comparisons order
+/// them (`Vec3::min` and `max` spent five more instructions each passing NaN by).
 #[inline(always)]
 fn segment_box(ray: &Ray, t0: f32, t1: f32, pad: Vec3) -> (Vec3, Vec3) {
     let a = ray.at(t0);
     let b = ray.at(t1);
-    (a.min(b) - pad, a.max(b) + pad)
+    let lo = Vec3::select(a.cmplt(b), a, b);
+    let hi = Vec3::select(a.cmplt(b), b, a);
+    (lo - pad, hi + pad)
 }
 
 /// The cells a ray visits, in order, as (x, y, z): for tests and debugging (seed 002 §1.7's
