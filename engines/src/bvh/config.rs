@@ -15,7 +15,9 @@
 //! | `sah_block` | the SAH counts primitives in blocks of this many (Embree's `sahBlockSize`: a packet leaf of 1–4 triangles costs one test), 1, 2, 4, 8 or 16 | 4 for bvh4/bvh8 with packets and `simd=on`, else 1 |
 //! | `packet` | `off`: one ray at a time; `8`, `16`: packets of 8 or 16 consecutive rays of a batch traverse together, their boxes tested in AVX2 lanes (`packet.rs`; needs `simd=on` and a CPU with AVX2 + FMA, else rays go one at a time and `build_stats.packet_rays` says 1) | `off` |
 //! | `packet_cull` | `on`: packets test an 8-wide node's boxes against their interval ray first and only the children it passes lane by lane (`packet.rs`); `off`: every child lane by lane | `on` |
-//! | `build_threads` | threads of the binned SAH build with Embree's leaf rule (the default tree of triangle scenes; `build_sah::binary_blocks_threads`): the subtrees of the top splits are built on threads of their own; the tree is the same whatever the count | 1 |
+//! | `build_threads` | threads of the binned SAH build with Embree's leaf rule (the default tree of triangle scenes; `build_sah::binary_blocks_threads`): the subtrees of the top splits are built on threads of their own; the tree is the same whatever the count. A tree with spatial splits (`spatial`) is built on one thread | 1 |
+//! | `spatial` | extra references the spatial splits may make, as a fraction of the triangles (Stich, Friedrich and Dietrich 2009; Embree's default builder for triangles): a node may cut space instead of its list, referencing a triangle that crosses the cut on both sides, each reference bounded by its own part (`build_sah::spatial`). For the binned SAH tree with Embree's leaf rule, scenes of triangles only (with spheres or cones, or a `leaf` given, the tree is built without). `0`: none | `1` |
+//! | `spatial_min` | the fewest references of a node whose spatial splits are searched, 2 or more | `128` |
 //! | `split_leaves` | `on`: node slots left free split leaf-sized subtrees further (`collapse.rs`); `off`: leaves keep up to `leaf` primitives | `off` with packets, else `on` |
 //!
 //! `leaf` is an upper bound when `max_leaf` is `leaf` (bvh2, `packets=off`, or `leaf` given);
@@ -163,6 +165,10 @@ pub struct Config {
     pub packet_cull: bool,
     /// Threads of the build (`build_sah::binary_blocks_threads`).
     pub build_threads: usize,
+    /// Extra references the spatial splits may make, as a fraction of the triangles (0: none).
+    pub spatial: f32,
+    /// The fewest references of a node whose spatial splits are searched.
+    pub spatial_min: usize,
 }
 
 impl Config {
@@ -211,12 +217,28 @@ impl Config {
         let packet = settings.get("packet", PacketSize::Off)?;
         let packet_cull = settings.get("packet_cull", OnOff(true))?.0;
         let build_threads = settings.get("build_threads", 1usize)?;
+        let spatial = settings.get("spatial", 1.0f32)?;
+        let spatial_min = settings.get("spatial_min", 128usize)?;
         settings.finish()?;
         if !(1..=64).contains(&build_threads) {
             return Err(bad(
                 "build_threads",
                 build_threads.to_string(),
                 "must be from 1 to 64",
+            ));
+        }
+        if !(0.0..=4.0).contains(&spatial) {
+            return Err(bad(
+                "spatial",
+                spatial.to_string(),
+                "must be from 0 (no spatial splits) to 4 (extra references per triangle)",
+            ));
+        }
+        if spatial_min < 2 {
+            return Err(bad(
+                "spatial_min",
+                spatial_min.to_string(),
+                "must be at least 2",
             ));
         }
         if packet != PacketSize::Off && (!simd || width == 2) {
@@ -282,6 +304,8 @@ impl Config {
             packet,
             packet_cull,
             build_threads,
+            spatial,
+            spatial_min,
         })
     }
 }

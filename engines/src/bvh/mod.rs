@@ -2,7 +2,8 @@
 //! N-wide, with the children's boxes stored side by side and a SIMD ray–N-box test.
 //!
 //! Pipeline: primitive boxes ([`tree::BuildPrims`]) → a builder (object median, full-sweep
-//! SAH, binned SAH; [`config::Builder`]) → a binary tree collapsed to N-wide
+//! SAH, binned SAH, on triangle scenes with spatial splits: [`build_sah::spatial`];
+//! [`config::Builder`]) → a binary tree collapsed to N-wide
 //! ([`collapse`]), or 001's own N-ary construction ([`config::WideMethod::Direct`]) → flat
 //! N-wide nodes ([`node`]) → traversal ([`traverse`]) with the scalar, SSE or AVX2 slab test
 //! ([`box_test`], picked at run time by [`dispatch`]), or with `packet=8|16` packets of rays in
@@ -109,11 +110,11 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     // spheres or cones in the scene (tested one by one) the SAH's blocks would be wrong, and
     // on balls4 and rings7 that tree cost 1-3% more traversal instructions than the one below,
     // so those scenes keep it.
-    let packable = config.packets
-        && geometry
-            .prims
-            .iter()
-            .all(|p| matches!(p, Prim::Triangle(_)));
+    let triangles = geometry
+        .prims
+        .iter()
+        .all(|p| matches!(p, Prim::Triangle(_)));
+    let packable = config.packets && triangles;
     let block_leaves = width > 2
         && config.builder != Builder::Median
         && config.max_leaf > leaf
@@ -132,6 +133,18 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
     };
     phases.mark("leaf rule");
     let binary = match config.builder {
+        // Spatial splits clip triangles only.
+        Builder::SahBinned if block_leaves && triangles && config.spatial > 0.0 => {
+            build_sah::spatial_blocks(
+                geometry,
+                &rule,
+                build_sah::SpatialSettings {
+                    bins: config.bins,
+                    budget: config.spatial,
+                    min_refs: config.spatial_min,
+                },
+            )
+        }
         Builder::SahSweep if block_leaves => {
             build_sah::binary_blocks(build_sah::Sweep::new(prims()).with_block(block), &rule)
         }
@@ -264,8 +277,13 @@ pub fn build_bvh<const N: usize>(
     }
     let tree = build_tree(geometry, config);
     let mut phases = Phases::new();
+    // A tree with spatial splits references some triangles more than once.
     debug_assert_eq!(
-        tree.validate(&BuildPrims::new(geometry), N),
+        if tree.order.len() > n {
+            tree.validate_shared(&BuildPrims::new(geometry), N)
+        } else {
+            tree.validate(&BuildPrims::new(geometry), N)
+        },
         Ok(()),
         "builder broke an invariant"
     );

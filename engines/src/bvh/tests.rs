@@ -548,18 +548,24 @@ fn packets_answer_as_single_rays() {
 /// The two-thread build makes the one-thread build's tree, node for node.
 #[test]
 fn threads_build_the_same_tree() {
+    // The threaded build is the binned SAH's: spatial splits (the default for triangle scenes)
+    // build on one thread, so they are off here.
     // gears4: 36,610 triangles, so the top splits (ranges of ≥ 8,192) go to threads. balls2
     // tessellated: its top split cuts the floor's few triangles from the spheres', a side too
     // small to fork (built in place while the other side forks on).
     for (program, sf, tessellate) in [(Program::Gears, 4, None), (Program::Balls, 2, Some(3))] {
         let inp = input(program, sf, tessellate);
-        let one = Config::parse(8, Settings::new("bvh8", vec![])).unwrap();
+        let off = || ("spatial".to_string(), "0".to_string());
+        let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
         let base = build_tree(&inp.geometry, &one);
         assert!(base.nodes.len() > 1000);
         for threads in ["2", "3"] {
             let two = Config::parse(
                 8,
-                Settings::new("bvh8", vec![("build_threads".into(), threads.into())]),
+                Settings::new(
+                    "bvh8",
+                    vec![("build_threads".into(), threads.into()), off()],
+                ),
             )
             .unwrap();
             let t = build_tree(&inp.geometry, &two);
@@ -575,14 +581,19 @@ fn threads_build_the_same_tree() {
 #[test]
 fn threads_build_the_same_engine() {
     // gears4: 36,610 triangles, above every threshold of the threaded parts (8,192).
+    // Spatial splits off: they build on one thread (`threads_build_the_same_tree`).
     let inp = input(Program::Gears, 4, None);
-    let one = Config::parse(8, Settings::new("bvh8", vec![])).unwrap();
+    let off = || ("spatial".to_string(), "0".to_string());
+    let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
     let (base, base_stats) = build_bvh::<8>(&inp.geometry, &one).unwrap();
     assert!(base.packets.len() > 1000);
     for threads in ["2", "3"] {
         let more = Config::parse(
             8,
-            Settings::new("bvh8", vec![("build_threads".into(), threads.into())]),
+            Settings::new(
+                "bvh8",
+                vec![("build_threads".into(), threads.into()), off()],
+            ),
         )
         .unwrap();
         let (b, s) = build_bvh::<8>(&inp.geometry, &more).unwrap();
@@ -598,5 +609,49 @@ fn threads_build_the_same_engine() {
             "{threads} threads"
         );
         assert_eq!(s, base_stats, "{threads} threads");
+    }
+}
+
+/// Spatial splits (the default tree of triangle scenes) reference some triangles in several
+/// leaves, each bounded by its part: the tree keeps the shared invariants, and the engines
+/// find the brute-force loop's hits and blockers exactly, as without them.
+#[test]
+fn spatial_splits_answer_as_without() {
+    let scenes = [
+        (Program::Gears, 2, None),
+        (Program::Teapot, 2, None),
+        (Program::Balls, 1, Some(3)),
+    ];
+    for (si, &(program, sf, tess)) in scenes.iter().enumerate() {
+        let inp = input(program, sf, tess);
+        let n = inp.geometry.prims.len();
+        let rays = rays(&inp.geometry, 400, 91 + si as u64);
+        let brute: Vec<Hit> = rays.iter().map(|r| brute_force(&inp.geometry, r)).collect();
+        for width in [4, 8] {
+            for (budget, min) in [("1", "128"), ("4", "2")] {
+                let kv = [("spatial", budget), ("spatial_min", min)];
+                let label = format!("bvh{width} {kv:?} on {program}{sf}");
+                let settings = kv
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), v.to_string()))
+                    .collect();
+                let config = Config::parse(width, Settings::new("bvh", settings)).unwrap();
+                let tree = build_tree(&inp.geometry, &config);
+                tree.validate_shared(&BuildPrims::new(&inp.geometry), width)
+                    .unwrap_or_else(|e| panic!("{label}: {e}"));
+                if program == Program::Gears && min == "2" {
+                    assert!(tree.order.len() > n, "{label}: no triangle was split");
+                }
+                let e = engine(&inp, width, &kv);
+                let (got, _) = closest(e.as_ref(), &rays);
+                for (i, (g, b)) in got.iter().zip(&brute).enumerate() {
+                    assert!(agree(g, b), "{label}: ray {i}: {g:?} vs brute force {b:?}");
+                }
+                let any = occluded(e.as_ref(), &rays);
+                for (a, h) in any.iter().zip(&got) {
+                    assert_eq!(*a, h.is_hit(), "{label}");
+                }
+            }
+        }
     }
 }

@@ -80,6 +80,21 @@ impl BuildTree {
     /// Checks the invariants every builder must keep: each primitive in exactly one leaf, each
     /// box enclosing its children, arity within `width`, depth within [`MAX_DEPTH`].
     pub fn validate(&self, prims: &BuildPrims, width: usize) -> Result<(), String> {
+        self.check(prims, width, false)
+    }
+
+    /// [`BuildTree::validate`] for a tree with spatial splits (`build_sah::spatial`): a
+    /// primitive may be in several leaves, and a leaf then bounds only its part, so only a
+    /// primitive in one leaf must lie inside that leaf's box.
+    pub fn validate_shared(&self, prims: &BuildPrims, width: usize) -> Result<(), String> {
+        self.check(prims, width, true)
+    }
+
+    fn check(&self, prims: &BuildPrims, width: usize, shared: bool) -> Result<(), String> {
+        let mut leaves = vec![0u32; prims.bounds.len()];
+        for &p in &self.order {
+            leaves[p as usize] += 1;
+        }
         let mut seen = vec![false; prims.bounds.len()];
         let mut stack = vec![(0u32, 0usize)];
         while let Some((i, depth)) = stack.pop() {
@@ -93,10 +108,12 @@ impl BuildTree {
                         return Err(format!("leaf {i} is empty"));
                     }
                     for &p in &self.order[first as usize..(first + count) as usize] {
-                        if std::mem::replace(&mut seen[p as usize], true) {
+                        if std::mem::replace(&mut seen[p as usize], true) && !shared {
                             return Err(format!("primitive {p} in two leaves"));
                         }
-                        if n.bounds.union(&prims.bounds[p as usize]) != n.bounds {
+                        if leaves[p as usize] == 1
+                            && n.bounds.union(&prims.bounds[p as usize]) != n.bounds
+                        {
                             return Err(format!("leaf {i} does not enclose primitive {p}"));
                         }
                     }

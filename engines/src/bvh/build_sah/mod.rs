@@ -1,7 +1,8 @@
 //! SAH builders of seed 001 (Kimura 2007), one file per algorithm, with the shared SAH bits
 //! here: the split search is [`sweep`] (exact full sweep, 001 §1.5) or [`binned`] (Wald 2007),
 //! and a tree is made from its splits by [`binary`] or by 001's N-ary "stepwise construction"
-//! ([`nary`]).
+//! ([`nary`]). [`spatial`] is the binned search with spatial splits (Stich et al. 2009), for
+//! scenes of triangles.
 //!
 //! The binary split cost is 001's Eq. 3.4 (from Wald, Boulos and Shirley 2007):
 //! `2·T_AABB + (A(S1)/A(S))·N(S1)·T_tri + (A(S2)/A(S))·N(S2)·T_tri`. 001 splits down to one
@@ -11,6 +12,7 @@
 pub mod binary;
 pub mod binned;
 pub mod nary;
+pub mod spatial;
 pub mod sweep;
 
 #[cfg(test)]
@@ -19,6 +21,7 @@ mod tests;
 pub use binary::{binary, binary_blocks, binary_blocks_threads, BlockLeaves};
 pub use binned::Binned;
 pub use nary::wide_same_axis;
+pub use spatial::{spatial_blocks, SpatialSettings};
 pub use sweep::Sweep;
 
 use super::config::{T_AABB, T_TRI};

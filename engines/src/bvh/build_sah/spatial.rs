@@ -1,0 +1,723 @@
+//! Spatial splits (Stich, Friedrich and Dietrich 2009, "Spatial Splits in Bounding Volume
+//! Hierarchies", §3–§4; Embree's default builder for triangles, `BVHBuilderFastSpatialSAH`):
+//! a node may cut space instead of its list of triangles, so a long triangle crossing the cut
+//! is referenced on both sides, each reference bounded by its own part of the triangle. Long
+//! thin triangles (gears' ear-clipped faces, a teapot's seams) then no longer stretch the boxes
+//! of their neighbours.
+//!
+//! At each node the binned object split (Wald 2007, as [`super::Binned`]) is searched first;
+//! where its two boxes overlap by more than `alpha` of the root's area, the spatial split is
+//! searched too: the node's box is cut into equal bins per axis, each reference clipped into
+//! the bins it spans (entering the first, leaving the last), and the planes between bins costed
+//! as the object split's are. Straddling references go to one side only where that costs less
+//! than splitting them ("reference unsplitting", §4.4). Duplicates are bounded by a budget of
+//! extra references shared out down the tree in proportion to the references of each side.
+//!
+//! The tree is the binary tree of [`super::binary_blocks`] (Embree's leaf rule, SAH counts in
+//! blocks), for collapsing into a wide tree; its order holds a triangle once per reference.
+//! Triangles only: spheres and cones are not clipped.
+
+use super::{blocks, split_cost, BlockLeaves};
+use crate::bvh::config::{T_AABB, T_TRI};
+use crate::bvh::tree::{BuildKind, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
+use crate::geometry::aabb::Aabb;
+use crate::geometry::{Geometry, Prim};
+use glam::Vec3A;
+
+/// Bins per axis of the spatial search (Embree's fast spatial builder uses 16).
+const SPATIAL_BINS: usize = 16;
+
+/// Stich et al.'s α: the least overlap of the object split's two boxes, as a fraction of the
+/// root's area, for which a spatial split is searched.
+const ALPHA: f32 = 1e-5;
+
+/// The least overlap of the object split's two boxes as a fraction of the node's own area for
+/// which a spatial split is searched (Embree's threshold): below it the two sides hardly share
+/// space, and a spatial split seldom pays for its search.
+const NODE_OVERLAP: f32 = 0.1;
+
+/// One reference: a triangle and the box of its part on this side of every cut above.
+#[derive(Clone, Copy, Debug)]
+struct Ref {
+    b: Bx,
+    id: u32,
+}
+
+/// What the spatial builder is given besides the geometry.
+#[derive(Clone, Copy, Debug)]
+pub struct SpatialSettings {
+    /// Bins per axis of the object split search.
+    pub bins: usize,
+    /// Extra references allowed, as a fraction of the triangles.
+    pub budget: f32,
+    /// The fewest references of a node whose spatial splits are searched: a search clips
+    /// every reference into the bins it spans, on three axes, which for small nodes costs more
+    /// build time than their splits save in tracing.
+    pub min_refs: usize,
+}
+
+/// A binary tree over `geometry`'s triangles with spatial splits, leaves by `rule`.
+pub fn spatial_blocks(geometry: &Geometry, rule: &BlockLeaves, s: SpatialSettings) -> BuildTree {
+    let tris: Vec<[Vec3A; 3]> = geometry
+        .prims
+        .iter()
+        .map(|p| match p {
+            Prim::Triangle(v) => v.map(Vec3A::from),
+            // Not a triangle: a point box never split (callers pass triangle scenes only).
+            other => {
+                let (lo, hi) = other.bounds();
+                [lo.into(), hi.into(), hi.into()]
+            }
+        })
+        .collect();
+    let refs: Vec<Ref> = geometry
+        .prims
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (lo, hi) = p.bounds();
+            Ref {
+                b: Bx::new(lo.into(), hi.into()),
+                id: i as u32,
+            }
+        })
+        .collect();
+    let mut bounds = Bx::EMPTY;
+    for r in &refs {
+        bounds.grow(&r.b);
+    }
+    let n = refs.len();
+    let mut b = Build {
+        tris: &tris,
+        rule,
+        bins: s.bins.clamp(2, 256),
+        min_overlap: ALPHA * bounds.half_area(),
+        min_refs: s.min_refs,
+        scratch: Vec::new(),
+        tree: BuildTree {
+            nodes: Vec::with_capacity(2 * n / rule.min.max(1) + 1),
+            order: Vec::with_capacity(n + n / 4),
+        },
+    };
+    let budget = (s.budget.max(0.0) * n as f32) as usize;
+    if n > 0 {
+        b.node(refs, bounds, 0, budget);
+    }
+    b.tree
+}
+
+struct Build<'a> {
+    tris: &'a [[Vec3A; 3]],
+    rule: &'a BlockLeaves<'a>,
+    bins: usize,
+    min_overlap: f32,
+    min_refs: usize,
+    /// The object search's bins, three axes of `bins` each.
+    scratch: Vec<(Bx, usize)>,
+    tree: BuildTree,
+}
+
+/// A split found by a search: its SAH numerator (`A_L·N_L + A_R·N_R` in blocks), the sides'
+/// boxes and counts, and where it cuts.
+#[derive(Clone, Copy, Debug)]
+struct Found {
+    weighted: f32,
+    axis: usize,
+    /// Object split: the first bin of the right side. Spatial: the plane's coordinate.
+    at: f32,
+    spatial: bool,
+    /// The bins of the object split's axis.
+    map: BinMap,
+    lb: Bx,
+    rb: Bx,
+    nl: usize,
+    nr: usize,
+}
+
+impl Build<'_> {
+    fn leaf(&mut self, refs: &[Ref], bounds: Bx) -> u32 {
+        let first = self.tree.order.len() as u32;
+        self.tree.order.extend(refs.iter().map(|r| r.id));
+        self.tree.push(
+            bounds.aabb(),
+            BuildKind::Leaf {
+                first,
+                count: refs.len() as u32,
+            },
+        )
+    }
+
+    fn node(&mut self, mut refs: Vec<Ref>, bounds: Bx, depth: usize, budget: usize) -> u32 {
+        let n = refs.len();
+        if n == 1 || n <= self.rule.min {
+            return self.leaf(&refs, bounds);
+        }
+        let block = self.rule.block;
+        let median = depth >= SAH_MEDIAN_DEPTH;
+        let mut best = if median { None } else { self.object(&refs) };
+        if !median {
+            let overlap = best.map_or(f32::INFINITY, |f| overlap_area(&f.lb, &f.rb));
+            if budget > 0
+                && n >= self.min_refs
+                && overlap > self.min_overlap
+                && overlap >= NODE_OVERLAP * bounds.half_area()
+            {
+                if let Some(sp) = self.spatial(&refs, &bounds) {
+                    if best.is_none_or(|o| sp.weighted < o.weighted) {
+                        best = Some(sp);
+                    }
+                }
+            }
+        }
+        let weighted = best.map_or(f32::INFINITY, |f| f.weighted);
+        let cost = split_cost(weighted, bounds.half_area());
+        let leaf_cost = blocks(n, block) as f32 * T_TRI;
+        if n <= self.rule.max && leaf_cost <= cost - T_AABB {
+            return self.leaf(&refs, bounds);
+        }
+        let (left, right) = match best {
+            Some(f) if f.spatial => self.partition_spatial(refs, &f),
+            Some(f) => {
+                let k = f.at as usize;
+                let (l, r): (Vec<Ref>, Vec<Ref>) = refs
+                    .into_iter()
+                    .partition(|r| f.map.bin(r.b.centre()[f.axis]) < k);
+                (l, r)
+            }
+            None => {
+                // No plane separates the centres (or below the SAH's depth): the object median
+                // on the axis of the centres' greatest extent.
+                let mut cb = Bx::EMPTY;
+                for r in &refs {
+                    cb.grow_point(r.b.centre());
+                }
+                let axis = cb.largest_axis();
+                let mid = n / 2;
+                refs.select_nth_unstable_by(mid, |a, b| {
+                    a.b.centre()[axis].total_cmp(&b.b.centre()[axis])
+                });
+                let r = refs.split_off(mid);
+                (refs, r)
+            }
+        };
+        let (left, right) = if left.is_empty() || right.is_empty() {
+            let mut all = left;
+            all.extend(right);
+            let r = all.split_off(all.len() / 2);
+            (all, r)
+        } else {
+            (left, right)
+        };
+        let extra = (left.len() + right.len()).saturating_sub(n);
+        let rest = budget.saturating_sub(extra);
+        let total = (left.len() + right.len()) as f64;
+        let lbudget = (rest as f64 * left.len() as f64 / total) as usize;
+        let rbudget = rest - lbudget;
+        let lb = union(&left);
+        let rb = union(&right);
+        let me = self
+            .tree
+            .push(bounds.aabb(), BuildKind::Leaf { first: 0, count: 0 });
+        let mut children = [0; MAX_WIDTH];
+        children[0] = self.node(left, lb, depth + 1, lbudget);
+        children[1] = self.node(right, rb, depth + 1, rbudget);
+        self.tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
+        me
+    }
+
+    /// The best object split (binned centres), or `None` when the centres coincide. One pass
+    /// bins the references on all three axes.
+    fn object(&mut self, refs: &[Ref]) -> Option<Found> {
+        let block = self.rule.block;
+        let nb = self.bins;
+        let mut cb = Bx::EMPTY;
+        for r in refs {
+            cb.grow_point(r.b.centre());
+        }
+        let maps = [0, 1, 2].map(|a| BinMap::new(cb.lo[a], cb.hi[a], nb));
+        let bins = &mut self.scratch;
+        bins.clear();
+        bins.resize(3 * nb, (Bx::EMPTY, 0));
+        for r in refs {
+            let c = r.b.centre();
+            let k = [
+                maps[0].bin(c.x),
+                nb + maps[1].bin(c.y),
+                2 * nb + maps[2].bin(c.z),
+            ];
+            for k in k {
+                bins[k].0.grow(&r.b);
+                bins[k].1 += 1;
+            }
+        }
+        let mut best: Option<Found> = None;
+        let mut right = [(0.0f32, 0usize); 256];
+        for (axis, map) in maps.iter().enumerate() {
+            if map.scale == 0.0 {
+                continue;
+            }
+            let bins = &bins[axis * nb..(axis + 1) * nb];
+            sweep(bins, &mut right[..nb], block, |k, weighted, nl, nr| {
+                if best.is_none_or(|b| weighted < b.weighted) {
+                    best = Some(Found {
+                        weighted,
+                        axis,
+                        at: k as f32,
+                        spatial: false,
+                        map: *map,
+                        lb: Bx::EMPTY,
+                        rb: Bx::EMPTY,
+                        nl,
+                        nr,
+                    });
+                }
+            });
+            if let Some(f) = best.as_mut().filter(|f| f.axis == axis) {
+                let k = f.at as usize;
+                (f.lb, f.rb) = (union_bins(&bins[..k]), union_bins(&bins[k..]));
+            }
+        }
+        best
+    }
+
+    /// The best spatial split of the node's box `bounds`, or `None` when it is flat.
+    fn spatial(&self, refs: &[Ref], bounds: &Bx) -> Option<Found> {
+        let block = self.rule.block;
+        let nb = SPATIAL_BINS;
+        let mut best: Option<Found> = None;
+        // Per bin: the box of the parts in it, references entering, references leaving.
+        let mut bins = vec![(Bx::EMPTY, 0usize, 0usize); nb];
+        let mut enter = vec![(Bx::EMPTY, 0usize); nb];
+        let mut right = vec![(0.0f32, 0usize); nb];
+        for axis in 0..3 {
+            let map = BinMap::new(bounds.lo[axis], bounds.hi[axis], nb);
+            if map.scale == 0.0 {
+                continue;
+            }
+            bins.fill((Bx::EMPTY, 0, 0));
+            for r in refs {
+                let first = map.bin(r.b.lo[axis]);
+                let last = map.bin(r.b.hi[axis]);
+                bins[first].1 += 1;
+                bins[last].2 += 1;
+                if first == last {
+                    bins[first].0.grow(&r.b);
+                } else {
+                    parts(
+                        &self.tris[r.id as usize],
+                        &r.b,
+                        axis,
+                        &map,
+                        first,
+                        last,
+                        |k, b| bins[k].0.grow(b),
+                    );
+                }
+            }
+            // A left side counts the references entering its bins, a right side those leaving.
+            for k in 0..nb {
+                enter[k] = (bins[k].0, bins[k].1);
+            }
+            let mut found = None;
+            let leaving: Vec<(Bx, usize)> = bins.iter().map(|b| (b.0, b.2)).collect();
+            sweep_two(
+                &enter,
+                &leaving,
+                &mut right,
+                block,
+                |k, weighted, nl, nr| {
+                    if best.is_none_or(|b| weighted < b.weighted)
+                        && found.is_none_or(|(_, w, _, _)| weighted < w)
+                    {
+                        found = Some((k, weighted, nl, nr));
+                    }
+                },
+            );
+            if let Some((k, weighted, nl, nr)) = found {
+                best = Some(Found {
+                    weighted,
+                    axis,
+                    at: map.plane(k),
+                    spatial: true,
+                    map,
+                    lb: union_bins(&enter[..k]),
+                    rb: union_bins(&enter[k..]),
+                    nl,
+                    nr,
+                });
+            }
+        }
+        best
+    }
+
+    /// The references of a spatial split's two sides: whole where they lie on one side,
+    /// else kept whole on the cheaper side or split (Stich et al. §4.4).
+    fn partition_spatial(&self, refs: Vec<Ref>, f: &Found) -> (Vec<Ref>, Vec<Ref>) {
+        let (axis, pos) = (f.axis, f.at);
+        let mut left = Vec::with_capacity(f.nl);
+        let mut right = Vec::with_capacity(f.nr);
+        let mut straddle = Vec::new();
+        let (mut lb, mut rb) = (Bx::EMPTY, Bx::EMPTY);
+        for r in refs {
+            if r.b.hi[axis] <= pos {
+                lb.grow(&r.b);
+                left.push(r);
+            } else if r.b.lo[axis] >= pos {
+                rb.grow(&r.b);
+                right.push(r);
+            } else {
+                straddle.push(r);
+            }
+        }
+        let (mut nl, mut nr) = (
+            (left.len() + straddle.len()) as f32,
+            (right.len() + straddle.len()) as f32,
+        );
+        // The straddlers' parts on each side, for the unsplitting costs.
+        let parts: Vec<(Bx, Bx)> = straddle
+            .iter()
+            .map(|r| clip(&self.tris[r.id as usize], &r.b, axis, pos))
+            .collect();
+        for (l, r) in &parts {
+            lb.grow(l);
+            rb.grow(r);
+        }
+        for (r, (pl, pr)) in straddle.into_iter().zip(parts) {
+            let (al, ar) = (lb.half_area(), rb.half_area());
+            let split = al * nl + ar * nr;
+            let whole_left = lb.union(&r.b).half_area() * nl + ar * (nr - 1.0);
+            let whole_right = al * (nl - 1.0) + rb.union(&r.b).half_area() * nr;
+            if whole_left < split && whole_left <= whole_right {
+                lb.grow(&r.b);
+                nr -= 1.0;
+                left.push(r);
+            } else if whole_right < split {
+                rb.grow(&r.b);
+                nl -= 1.0;
+                right.push(r);
+            } else {
+                if !pl.is_empty() {
+                    left.push(Ref { b: pl, id: r.id });
+                }
+                if !pr.is_empty() {
+                    right.push(Ref { b: pr, id: r.id });
+                }
+            }
+        }
+        (left, right)
+    }
+}
+
+/// Equal bins over `[lo, hi]` on one axis.
+#[derive(Clone, Copy, Debug)]
+struct BinMap {
+    lo: f32,
+    scale: f32,
+    width: f32,
+    last: usize,
+}
+
+impl BinMap {
+    fn new(lo: f32, hi: f32, nb: usize) -> BinMap {
+        let ext = hi - lo;
+        let ok = ext > 0.0 && ext.is_finite();
+        BinMap {
+            lo,
+            scale: if ok {
+                nb as f32 * (1.0 - 1e-6) / ext
+            } else {
+                0.0
+            },
+            width: if ok { ext / nb as f32 } else { 0.0 },
+            last: nb - 1,
+        }
+    }
+
+    fn bin(&self, x: f32) -> usize {
+        (((x - self.lo) * self.scale).max(0.0) as usize).min(self.last)
+    }
+
+    /// The coordinate of the plane before bin `k`.
+    fn plane(&self, k: usize) -> f32 {
+        self.lo + k as f32 * self.width
+    }
+}
+
+/// Calls `visit(k, A_L·blocks(N_L) + A_R·blocks(N_R), N_L, N_R)` for each plane `k` (1 to
+/// nb − 1, before bin k) with primitives on both sides; bins are (box, count).
+fn sweep(
+    bins: &[(Bx, usize)],
+    right: &mut [(f32, usize)],
+    block: usize,
+    visit: impl FnMut(usize, f32, usize, usize),
+) {
+    sweep_two(bins, bins, right, block, visit)
+}
+
+/// [`sweep`] with the left side's counts from `left` and the right side's from `right_bins`
+/// (a spatial search counts references entering and leaving; the boxes are the same).
+fn sweep_two(
+    left_bins: &[(Bx, usize)],
+    right_bins: &[(Bx, usize)],
+    right: &mut [(f32, usize)],
+    block: usize,
+    mut visit: impl FnMut(usize, f32, usize, usize),
+) {
+    let nb = left_bins.len();
+    let mut b = Bx::EMPTY;
+    let mut c = 0;
+    for k in (1..nb).rev() {
+        b.grow(&right_bins[k].0);
+        c += right_bins[k].1;
+        right[k] = (b.half_area(), c);
+    }
+    let mut b = Bx::EMPTY;
+    let mut c = 0;
+    for k in 1..nb {
+        b.grow(&left_bins[k - 1].0);
+        c += left_bins[k - 1].1;
+        let (ar, cr) = right[k];
+        if c == 0 || cr == 0 {
+            continue;
+        }
+        let weighted = b.half_area() * blocks(c, block) as f32 + ar * blocks(cr, block) as f32;
+        visit(k, weighted, c, cr);
+    }
+}
+
+fn union_bins(bins: &[(Bx, usize)]) -> Bx {
+    let mut b = Bx::EMPTY;
+    for (x, _) in bins {
+        b.grow(x);
+    }
+    b
+}
+
+fn union(refs: &[Ref]) -> Bx {
+    let mut b = Bx::EMPTY;
+    for r in refs {
+        b.grow(&r.b);
+    }
+    b
+}
+
+/// Half the area of the overlap of two boxes (0 when apart).
+fn overlap_area(a: &Bx, b: &Bx) -> f32 {
+    Bx::new(a.lo.max(b.lo), a.hi.min(b.hi)).half_area()
+}
+
+/// The common part of two boxes, or the empty box. Chosen by selects, not a branch: a
+/// triangle's part in a bin is empty often and unpredictably (the spatial search's most
+/// mispredicted branch on gears4).
+#[inline(always)]
+fn intersect(a: &Bx, b: &Bx) -> Bx {
+    let (lo, hi) = (a.lo.max(b.lo), a.hi.min(b.hi));
+    let empty = glam::BVec3A::splat(lo.cmpgt(hi).any());
+    Bx::new(
+        Vec3A::select(empty, Vec3A::INFINITY, lo),
+        Vec3A::select(empty, Vec3A::NEG_INFINITY, hi),
+    )
+}
+
+/// Calls `visit(k, part)` with the box of triangle `t`'s part in each bin `k` from `first` to
+/// `last` of `map` on `axis`, each cut to the reference's box `b`. The triangle's section by a
+/// plane is a segment from its longest edge (in `axis`) to one of the two others, so each bin's
+/// part is bounded by the sections at its two walls and the vertices between them: one section
+/// per plane crossed, where clipping the triangle at each plane in turn went over its three
+/// edges for each (most of the build's time on gears4).
+fn parts(
+    t: &[Vec3A; 3],
+    b: &Bx,
+    axis: usize,
+    map: &BinMap,
+    first: usize,
+    last: usize,
+    visit: impl FnMut(usize, &Bx),
+) {
+    match axis {
+        0 => parts_on::<0>(t, b, map, first, last, visit),
+        1 => parts_on::<1>(t, b, map, first, last, visit),
+        _ => parts_on::<2>(t, b, map, first, last, visit),
+    }
+}
+
+/// Coordinate `A` of `v` (a constant lane).
+#[inline(always)]
+fn at<const A: usize>(v: Vec3A) -> f32 {
+    match A {
+        0 => v.x,
+        1 => v.y,
+        _ => v.z,
+    }
+}
+
+/// The point of segment `p`–`q` at coordinate `x` on axis `A` (`p` when the segment is flat
+/// on `A`), with that coordinate set to `x` exactly.
+#[inline(always)]
+fn crossing<const A: usize>(p: Vec3A, q: Vec3A, x: f32) -> Vec3A {
+    let d = at::<A>(q) - at::<A>(p);
+    let mut s = if d > 0.0 {
+        p + (q - p) * ((x - at::<A>(p)) / d)
+    } else {
+        p
+    };
+    s[A] = x;
+    s
+}
+
+/// [`parts`] on axis `A` (a constant, so the coordinate picks are fixed lanes).
+#[inline(always)]
+fn parts_on<const A: usize>(
+    t: &[Vec3A; 3],
+    b: &Bx,
+    map: &BinMap,
+    first: usize,
+    last: usize,
+    mut visit: impl FnMut(usize, &Bx),
+) {
+    // The vertices in order along A: a, m, c.
+    let [mut a, mut m, mut c] = *t;
+    if at::<A>(a) > at::<A>(m) {
+        std::mem::swap(&mut a, &mut m);
+    }
+    if at::<A>(m) > at::<A>(c) {
+        std::mem::swap(&mut m, &mut c);
+    }
+    if at::<A>(a) > at::<A>(m) {
+        std::mem::swap(&mut a, &mut m);
+    }
+    let mid = at::<A>(m);
+    // The section at x (a ≤ x ≤ c on A) as a box: from the long edge a–c to a–m or m–c.
+    let section = |x: f32| {
+        let long = crossing::<A>(a, c, x);
+        let short = if x <= mid {
+            crossing::<A>(a, m, x)
+        } else {
+            crossing::<A>(m, c, x)
+        };
+        Bx::new(long.min(short), long.max(short))
+    };
+    let lo = at::<A>(b.lo).max(at::<A>(a));
+    // (A clipped box may reach past the triangle by a rounding: never below `lo`.)
+    let hi = at::<A>(b.hi).min(at::<A>(c)).max(lo);
+    let mut from = lo;
+    let mut enter = section(lo);
+    for k in first..=last {
+        let next = if k == last {
+            hi
+        } else {
+            map.plane(k + 1).max(lo).min(hi)
+        };
+        let leave = section(next);
+        let mut part = enter.union(&leave);
+        // The end vertices lie on the sections; the middle one is added to the bins it lies
+        // in (both, on their common wall: an edge flat on the axis has no single crossing).
+        if mid >= from && mid <= next {
+            part.grow_point(m);
+        }
+        visit(k, &intersect(&part, b));
+        from = next;
+        enter = leave;
+    }
+}
+
+/// The boxes of triangle `t`'s parts below and above the plane `axis = pos`, each cut to the
+/// reference's box `b` (Embree's `splitTriangle`): the vertices on each side and the edges'
+/// crossings of the plane.
+#[inline]
+fn clip(t: &[Vec3A; 3], b: &Bx, axis: usize, pos: f32) -> (Bx, Bx) {
+    match axis {
+        0 => clip_on::<0>(t, b, pos),
+        1 => clip_on::<1>(t, b, pos),
+        _ => clip_on::<2>(t, b, pos),
+    }
+}
+
+/// [`clip`] on axis `A` (a constant, so the coordinate picks are fixed lanes: the build spent
+/// most of its time here).
+#[inline(always)]
+fn clip_on<const A: usize>(t: &[Vec3A; 3], b: &Bx, pos: f32) -> (Bx, Bx) {
+    let mut l = Bx::EMPTY;
+    let mut r = Bx::EMPTY;
+    for i in 0..3 {
+        let (v0, v1) = (t[i], t[(i + 1) % 3]);
+        let (a0, a1) = (v0[A], v1[A]);
+        if a0 <= pos {
+            l.grow_point(v0);
+        }
+        if a0 >= pos {
+            r.grow_point(v0);
+        }
+        if (a0 < pos && pos < a1) || (a1 < pos && pos < a0) {
+            let mut p = v0 + (v1 - v0) * ((pos - a0) / (a1 - a0));
+            p[A] = pos;
+            l.grow_point(p);
+            r.grow_point(p);
+        }
+    }
+    (intersect(&l, b), intersect(&r, b))
+}
+
+/// A box in SIMD registers (as [`super::Binned`]'s): the spatial search grows boxes for every
+/// part of every reference, and `Vec3A`'s min and max are single SSE instructions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Bx {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Bx {
+    const EMPTY: Bx = Bx {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+    };
+
+    #[inline(always)]
+    fn new(lo: Vec3A, hi: Vec3A) -> Bx {
+        Bx { lo, hi }
+    }
+
+    #[inline(always)]
+    fn is_empty(&self) -> bool {
+        self.lo.cmpgt(self.hi).any()
+    }
+
+    #[inline(always)]
+    fn grow(&mut self, o: &Bx) {
+        self.lo = self.lo.min(o.lo);
+        self.hi = self.hi.max(o.hi);
+    }
+
+    #[inline(always)]
+    fn union(&self, o: &Bx) -> Bx {
+        let mut b = *self;
+        b.grow(o);
+        b
+    }
+
+    #[inline(always)]
+    fn grow_point(&mut self, p: Vec3A) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    #[inline(always)]
+    fn centre(&self) -> Vec3A {
+        (self.lo + self.hi) * 0.5
+    }
+
+    /// Half the surface area; 0 for an empty box.
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let e = (self.hi - self.lo).max(Vec3A::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    fn largest_axis(&self) -> usize {
+        Aabb::new(self.lo.into(), self.hi.into()).largest_axis()
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.lo.into(), self.hi.into())
+    }
+}
