@@ -198,6 +198,25 @@ impl Dda {
         }
     }
 
+    /// [`Dda::advance`], moving `cell` by the stepped axis's `stride` as well.
+    #[inline(always)]
+    fn advance_cell(&mut self, res: [u32; 3], cell: &mut usize, stride: &[usize; 3]) -> bool {
+        let (tx, ty, tz) = (self.t_next[0], self.t_next[1], self.t_next[2]);
+        if min_t(min_t(tx, ty), tz) >= self.t_end {
+            return false;
+        }
+        if tx <= ty && tx <= tz {
+            *cell = cell.wrapping_add(stride[0]);
+            self.step_axis::<0>(res)
+        } else if ty <= tz {
+            *cell = cell.wrapping_add(stride[1]);
+            self.step_axis::<1>(res)
+        } else {
+            *cell = cell.wrapping_add(stride[2]);
+            self.step_axis::<2>(res)
+        }
+    }
+
     #[inline(always)]
     fn step_axis<const A: usize>(&mut self, res: [u32; 3]) -> bool {
         self.idx[A] += self.step[A];
@@ -225,19 +244,31 @@ pub fn min_t(a: f32, b: f32) -> f32 {
     }
 }
 
-/// Calls `visit(walk, t_enter, t_wall)` for each cell `ray` crosses within `[tmin, tmax]`, near
-/// to far, until it returns true or the ray leaves the grid or ends. `t_wall` is where the ray
-/// crosses the cell's exit wall (not clipped to the ray's end: clip with [`Dda::t_end`]); the
-/// ray ends in the cell whose `t_wall` reaches it.
+/// Calls `visit(walk, cell, t_enter, t_wall)` for each cell `ray` crosses within `[tmin, tmax]`,
+/// near to far, until it returns true or the ray leaves the grid or ends. `cell` is the cell's
+/// index ([`Lattice::index`]); `t_wall` is where the ray crosses the cell's exit wall (not
+/// clipped to the ray's end: clip with [`Dda::t_end`]); the ray ends in the cell whose `t_wall`
+/// reaches it.
+///
+/// The index is kept beside the walk and moved by the stepped axis's signed stride, one add
+/// where [`Dda::index`] was two multiplications and two adds a cell (−1.5 % instructions of the
+/// grid engine on mount6, callgrind, 128²).
 #[inline(always)]
-pub fn walk(g: &Lattice, ray: &Ray, mut visit: impl FnMut(&Dda, f32, f32) -> bool) {
+pub fn walk(g: &Lattice, ray: &Ray, mut visit: impl FnMut(&Dda, usize, f32, f32) -> bool) {
     let Some((mut d, mut t_enter)) = Dda::start_at(ray, g) else {
         return;
     };
     let res = g.res;
+    let mut cell = g.index(d.voxel());
+    // Per axis, the change of the index for one step (negative ones as wrapping adds).
+    let stride = [
+        d.step[0] as isize as usize,
+        (d.step[1] as isize as usize).wrapping_mul(res[0] as usize),
+        (d.step[2] as isize as usize).wrapping_mul(res[0] as usize * res[1] as usize),
+    ];
     loop {
         let t_wall = d.t_wall();
-        if visit(&d, t_enter, t_wall) || !d.advance(res) {
+        if visit(&d, cell, t_enter, t_wall) || !d.advance_cell(res, &mut cell, &stride) {
             return;
         }
         t_enter = t_wall;

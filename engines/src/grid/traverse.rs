@@ -201,9 +201,8 @@ impl Grid {
     /// or ends: the shared 3D-DDA ([`crate::geometry::dda`]), `t_exit` clipped to the ray's end.
     #[inline(always)]
     pub(super) fn walk(&self, ray: &Ray, mut visit: impl FnMut(usize, f32, f32) -> bool) {
-        let res = self.cells.lattice.res;
-        dda::walk(&self.cells.lattice, ray, |d, t_enter, t_wall| {
-            visit(d.index(res), t_enter, dda::min_t(t_wall, d.t_end()))
+        dda::walk(&self.cells.lattice, ray, |d, cell, t_enter, t_wall| {
+            visit(cell, t_enter, dda::min_t(t_wall, d.t_end()))
         })
     }
 

@@ -169,9 +169,8 @@ impl ObjectSpace {
         let mut r = *ray;
         let mut best = u32::MAX;
         let (mut bu, mut bv) = (0.0, 0.0);
-        let res = g.lattice.res;
-        dda::walk(&g.lattice, ray, |d, _, t_exit| {
-            let s = d.index(res) as u32;
+        dda::walk(&g.lattice, ray, |_, cell, _, t_exit| {
+            let s = cell as u32;
             c.cells_visited += 1;
             let list = g.prims_in(s as usize);
             if list.is_empty() {

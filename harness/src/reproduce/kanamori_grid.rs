@@ -265,8 +265,8 @@ fn dda_check(scene: &'static str, sf: u32, lattice: &Lattice, rays: &[Ray]) -> D
     for (i, ray) in rays.iter().enumerate() {
         let stamp = i as u32;
         let mut visited = 0u64;
-        dda::walk(lattice, ray, |d, _, _| {
-            seen[d.index(res)] = stamp;
+        dda::walk(lattice, ray, |_, cell, _, _| {
+            seen[cell] = stamp;
             visited += 1;
             false
         });
