@@ -258,11 +258,12 @@ impl Grid {
             let segment = r;
             self.walk(&segment, |cell, t_enter, t_exit| {
                 n.cells += 1;
-                let list = g.prims_in(cell);
-                if list.is_empty() {
+                let (a, b) = g.span(cell);
+                if a == b {
                     n.empty += 1;
                     return r.tmax <= t_exit;
                 }
+                let list = &g.refs[a..b];
                 let piece = CullPiece::new(if CULL {
                     segment_box(&r, t_enter, dda::min_t(t_exit, r.tmax), g.pad)
                 } else {
@@ -345,11 +346,12 @@ impl Grid {
             let mut n = WalkCounts::default();
             self.walk(ray, |cell, t_enter, t_exit| {
                 n.cells += 1;
-                let list = g.prims_in(cell);
-                if list.is_empty() {
+                let (a, b) = g.span(cell);
+                if a == b {
                     n.empty += 1;
                     return false;
                 }
+                let list = &g.refs[a..b];
                 let piece = CullPiece::new(if CULL {
                     segment_box(ray, t_enter, t_exit, g.pad)
                 } else {
