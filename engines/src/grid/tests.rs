@@ -403,6 +403,16 @@ fn compact_layout_and_build_stats() {
     assert!(c.prims_in(c.lattice.index([1, 1, 0])).is_empty());
     assert!(c.prims_in(c.lattice.index([1, 1, 1])).is_empty());
     assert!(exact.structure_bytes() >= (65 + 8) * 4);
+    // A resolution with an axis of no cells, which the parser refuses, is refused when built in
+    // code too: the walk reads every lattice cell's offsets unchecked.
+    let zero = GridConfig {
+        resolution: Resolution::Explicit([0, 4, 4]),
+        ..GridConfig::default()
+    };
+    assert!(matches!(
+        Grid::build(&input, zero),
+        Err(EngineError::Build { .. })
+    ));
 }
 
 #[test]

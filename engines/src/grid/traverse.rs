@@ -258,12 +258,17 @@ impl Grid {
             let segment = r;
             self.walk(&segment, |cell, t_enter, t_exit| {
                 n.cells += 1;
-                let (a, b) = g.span(cell);
-                if a == b {
+                // SAFETY: the walk's cells are the lattice's (each axis within its resolution,
+                // which `build::build` makes at least 1), and the grid's cells come from
+                // `build::build`, whose `offsets` has one entry a cell and one more, ascending to
+                // `refs.len()`.
+                let span = unsafe { g.span_unchecked(cell) };
+                if span.0 == span.1 {
                     n.empty += 1;
                     return r.tmax <= t_exit;
                 }
-                let list = &g.refs[a..b];
+                // SAFETY: `span` is a cell's range in `build::build`'s layout (above).
+                let list = unsafe { g.refs_unchecked(span) };
                 let piece = CullPiece::new(if CULL {
                     segment_box(&r, t_enter, dda::min_t(t_exit, r.tmax), g.pad)
                 } else {
@@ -346,12 +351,17 @@ impl Grid {
             let mut n = WalkCounts::default();
             self.walk(ray, |cell, t_enter, t_exit| {
                 n.cells += 1;
-                let (a, b) = g.span(cell);
-                if a == b {
+                // SAFETY: the walk's cells are the lattice's (each axis within its resolution,
+                // which `build::build` makes at least 1), and the grid's cells come from
+                // `build::build`, whose `offsets` has one entry a cell and one more, ascending to
+                // `refs.len()`.
+                let span = unsafe { g.span_unchecked(cell) };
+                if span.0 == span.1 {
                     n.empty += 1;
                     return false;
                 }
-                let list = &g.refs[a..b];
+                // SAFETY: `span` is a cell's range in `build::build`'s layout (above).
+                let list = unsafe { g.refs_unchecked(span) };
                 let piece = CullPiece::new(if CULL {
                     segment_box(ray, t_enter, t_exit, g.pad)
                 } else {
