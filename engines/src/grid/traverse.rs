@@ -69,8 +69,16 @@ impl WalkCounts {
     /// The scan keeps its counts in locals and adds them once: the big cells of balls and tree
     /// have hundreds of references that the culling test rejects, and counting each through
     /// the walk's captured counts was a load and a store per reference, one after the other.
+    ///
+    /// A reference reads its stamp and box unchecked: a compare and a branch less per
+    /// reference, the walk's most frequent step, and the scan's registers left to the walk
+    /// (−3.5 % instructions on mount6, −6 % on rings7, callgrind, 128²).
+    ///
+    /// # Safety
+    /// Every entry of `list` is below `stamps.len()` (with `MB`) and `bounds.len()` (with
+    /// `CULL`).
     #[inline(always)]
-    fn next_admitted<const MB: bool, const CULL: bool>(
+    unsafe fn next_admitted<const MB: bool, const CULL: bool>(
         &mut self,
         list: &[u32],
         at: &mut usize,
@@ -91,15 +99,19 @@ impl WalkCounts {
             };
             k += 1;
             let i = p as usize;
-            if MB && stamps[i] == stamp {
+            debug_assert!((!MB || i < stamps.len()) && (!CULL || i < bounds.len()));
+            // SAFETY: `i < stamps.len()` with `MB` (the caller's promise).
+            if MB && unsafe { *stamps.get_unchecked(i) } == stamp {
                 skips += 1;
                 continue;
             }
-            if CULL && piece.apart(&bounds[i]) {
+            // SAFETY: `i < bounds.len()` with `CULL` (the caller's promise).
+            if CULL && piece.apart(unsafe { bounds.get_unchecked(i) }) {
                 continue;
             }
             if MB {
-                stamps[i] = stamp;
+                // SAFETY: as the stamp's read above.
+                unsafe { *stamps.get_unchecked_mut(i) = stamp };
             }
             break Some(p);
         };
@@ -275,9 +287,11 @@ impl Grid {
                     (Vec3::ZERO, Vec3::ZERO)
                 });
                 let mut at = 0;
-                while let Some(p) =
+                // SAFETY: a cell's references index `geometry.prims` (`build::build` registers
+                // primitive indices), and `per_prim` cuts `stamps` and `bounds` to its length.
+                while let Some(p) = unsafe {
                     n.next_admitted::<MB, CULL>(list, &mut at, stamps, stamp, bounds, &piece)
-                {
+                } {
                     let prim = &prims[p as usize];
                     if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
                         hits += 1;
@@ -368,9 +382,11 @@ impl Grid {
                     (Vec3::ZERO, Vec3::ZERO)
                 });
                 let mut at = 0;
-                while let Some(p) =
+                // SAFETY: a cell's references index `geometry.prims` (`build::build` registers
+                // primitive indices), and `per_prim` cuts `stamps` and `bounds` to its length.
+                while let Some(p) = unsafe {
                     n.next_admitted::<MB, CULL>(list, &mut at, stamps, stamp, bounds, &piece)
-                {
+                } {
                     let prim = &prims[p as usize];
                     if prim.intersect(ray, test, &s.wt).is_some() {
                         blocker = p;
