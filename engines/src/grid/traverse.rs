@@ -292,7 +292,10 @@ impl Grid {
                 while let Some(p) = unsafe {
                     n.next_admitted::<MB, CULL>(list, &mut at, stamps, stamp, bounds, &piece)
                 } {
-                    let prim = &prims[p as usize];
+                    // Unchecked: −2.6 % instructions on mount6, −1.2 % on rings7 (callgrind,
+                    // 128²). The any-hit walk keeps its check: unchecked there, rings7 rose 0.3 %.
+                    // SAFETY: `p` is a cell's reference, an index of `geometry.prims` (above).
+                    let prim = unsafe { prims.get_unchecked(p as usize) };
                     if let Some((t, u, v)) = prim.intersect(&r, test, &s.wt) {
                         hits += 1;
                         (r.tmax, best, bu, bv) = (t, p, u, v);
