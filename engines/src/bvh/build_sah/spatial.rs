@@ -289,7 +289,10 @@ impl Build<'_> {
         let mut bins = vec![(Bx::EMPTY, 0usize, 0usize); nb];
         let mut enter = vec![(Bx::EMPTY, 0usize); nb];
         let mut right = vec![(0.0f32, 0usize); nb];
-        for axis in 0..3 {
+        // The node's longest axis only: on gears4 searching all three gave a tree of about the
+        // same node visits and triangle tests (within 1 %) at three times the search's cost.
+        let longest = bounds.largest_axis();
+        for axis in longest..longest + 1 {
             let map = BinMap::new(bounds.lo[axis], bounds.hi[axis], nb);
             if map.scale == 0.0 {
                 continue;
