@@ -1,5 +1,5 @@
 //! Spatial splits (Stich, Friedrich and Dietrich 2009, "Spatial Splits in Bounding Volume
-//! Hierarchies", §3–§4; Embree's default builder for triangles, `BVHBuilderFastSpatialSAH`):
+//! Hierarchies", §3–§4; as Embree's spatial-split builder, `BVHBuilderFastSpatialSAH`):
 //! a node may cut space instead of its list of triangles, so a long triangle crossing the cut
 //! is referenced on both sides, each reference bounded by its own part of the triangle. Long
 //! thin triangles (gears' ear-clipped faces, a teapot's seams) then no longer stretch the boxes
