@@ -185,34 +185,43 @@ impl Dda {
     /// Steps into the next cell; false when the ray ends first or leaves the grid (`res`).
     #[inline(always)]
     pub fn advance(&mut self, res: [u32; 3]) -> bool {
-        let (tx, ty, tz) = (self.t_next[0], self.t_next[1], self.t_next[2]);
-        if min_t(min_t(tx, ty), tz) >= self.t_end {
-            return false;
-        }
-        if tx <= ty && tx <= tz {
-            self.step_axis::<0>(res)
-        } else if ty <= tz {
-            self.step_axis::<1>(res)
-        } else {
-            self.step_axis::<2>(res)
-        }
+        self.step::<false>(res, &mut 0, &[0; 3])
     }
 
     /// [`Dda::advance`], moving `cell` by the stepped axis's `stride` as well.
     #[inline(always)]
     fn advance_cell(&mut self, res: [u32; 3], cell: &mut usize, stride: &[usize; 3]) -> bool {
+        self.step::<true>(res, cell, stride)
+    }
+
+    /// The one step of both: `INDEX` says whether `cell` moves (a constant, so the walk
+    /// without an index carries no adds: with zero strides instead, breadth-first's walk ran
+    /// 0.3 % more instructions).
+    #[inline(always)]
+    fn step<const INDEX: bool>(
+        &mut self,
+        res: [u32; 3],
+        cell: &mut usize,
+        stride: &[usize; 3],
+    ) -> bool {
         let (tx, ty, tz) = (self.t_next[0], self.t_next[1], self.t_next[2]);
         if min_t(min_t(tx, ty), tz) >= self.t_end {
             return false;
         }
         if tx <= ty && tx <= tz {
-            *cell = cell.wrapping_add(stride[0]);
+            if INDEX {
+                *cell = cell.wrapping_add(stride[0]);
+            }
             self.step_axis::<0>(res)
         } else if ty <= tz {
-            *cell = cell.wrapping_add(stride[1]);
+            if INDEX {
+                *cell = cell.wrapping_add(stride[1]);
+            }
             self.step_axis::<1>(res)
         } else {
-            *cell = cell.wrapping_add(stride[2]);
+            if INDEX {
+                *cell = cell.wrapping_add(stride[2]);
+            }
             self.step_axis::<2>(res)
         }
     }

@@ -8,44 +8,66 @@ use glam::Vec3A;
 
 /// A box in SIMD registers (glam's `Vec3A`): the binned builder's inner loops grow boxes
 /// millions of times, and `Vec3A`'s min/max are single SSE instructions.
+/// Also the spatial builder's box ([`super::spatial`]).
 #[derive(Clone, Copy, Debug)]
-struct Box3A {
-    lo: Vec3A,
-    hi: Vec3A,
+pub(super) struct Box3A {
+    pub(super) lo: Vec3A,
+    pub(super) hi: Vec3A,
 }
 
 impl Box3A {
-    const EMPTY: Box3A = Box3A {
+    pub(super) const EMPTY: Box3A = Box3A {
         lo: Vec3A::INFINITY,
         hi: Vec3A::NEG_INFINITY,
     };
 
     #[inline(always)]
-    fn grow(&mut self, b: &Box3A) {
+    pub(super) fn grow(&mut self, b: &Box3A) {
         self.lo = self.lo.min(b.lo);
         self.hi = self.hi.max(b.hi);
     }
 
     #[inline(always)]
-    fn grow_point(&mut self, p: Vec3A) {
+    pub(super) fn grow_point(&mut self, p: Vec3A) {
         self.lo = self.lo.min(p);
         self.hi = self.hi.max(p);
     }
 
     /// The box centre, computed as `BuildPrims` does (`Aabb::centre`).
     #[inline(always)]
-    fn centre(&self) -> Vec3A {
+    pub(super) fn centre(&self) -> Vec3A {
         (self.lo + self.hi) * 0.5
     }
 
     #[inline(always)]
-    fn half_area(&self) -> f32 {
+    pub(super) fn half_area(&self) -> f32 {
         let e = (self.hi - self.lo).max(Vec3A::ZERO);
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 
-    fn aabb(&self) -> Aabb {
+    pub(super) fn aabb(&self) -> Aabb {
         Aabb::new(self.lo.into(), self.hi.into())
+    }
+
+    #[inline(always)]
+    pub(super) fn new(lo: Vec3A, hi: Vec3A) -> Box3A {
+        Box3A { lo, hi }
+    }
+
+    #[inline(always)]
+    pub(super) fn is_empty(&self) -> bool {
+        self.lo.cmpgt(self.hi).any()
+    }
+
+    #[inline(always)]
+    pub(super) fn union(&self, o: &Box3A) -> Box3A {
+        let mut b = *self;
+        b.grow(o);
+        b
+    }
+
+    pub(super) fn largest_axis(&self) -> usize {
+        self.aabb().largest_axis()
     }
 }
 

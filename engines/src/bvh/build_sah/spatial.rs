@@ -17,10 +17,10 @@
 //! blocks), for collapsing into a wide tree; its order holds a triangle once per reference.
 //! Triangles only: spheres and cones are not clipped.
 
+use super::binned::Box3A as Bx;
 use super::{blocks, split_cost, BlockLeaves};
 use crate::bvh::config::{T_AABB, T_TRI};
 use crate::bvh::tree::{BuildKind, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
-use crate::geometry::aabb::Aabb;
 use crate::geometry::{Geometry, Prim};
 use glam::Vec3A;
 
@@ -659,68 +659,4 @@ fn clip_on<const A: usize>(t: &[Vec3A; 3], b: &Bx, pos: f32) -> (Bx, Bx) {
         }
     }
     (intersect(&l, b), intersect(&r, b))
-}
-
-/// A box in SIMD registers (as [`super::Binned`]'s): the spatial search grows boxes for every
-/// part of every reference, and `Vec3A`'s min and max are single SSE instructions.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Bx {
-    lo: Vec3A,
-    hi: Vec3A,
-}
-
-impl Bx {
-    const EMPTY: Bx = Bx {
-        lo: Vec3A::INFINITY,
-        hi: Vec3A::NEG_INFINITY,
-    };
-
-    #[inline(always)]
-    fn new(lo: Vec3A, hi: Vec3A) -> Bx {
-        Bx { lo, hi }
-    }
-
-    #[inline(always)]
-    fn is_empty(&self) -> bool {
-        self.lo.cmpgt(self.hi).any()
-    }
-
-    #[inline(always)]
-    fn grow(&mut self, o: &Bx) {
-        self.lo = self.lo.min(o.lo);
-        self.hi = self.hi.max(o.hi);
-    }
-
-    #[inline(always)]
-    fn union(&self, o: &Bx) -> Bx {
-        let mut b = *self;
-        b.grow(o);
-        b
-    }
-
-    #[inline(always)]
-    fn grow_point(&mut self, p: Vec3A) {
-        self.lo = self.lo.min(p);
-        self.hi = self.hi.max(p);
-    }
-
-    #[inline(always)]
-    fn centre(&self) -> Vec3A {
-        (self.lo + self.hi) * 0.5
-    }
-
-    /// Half the surface area; 0 for an empty box.
-    #[inline(always)]
-    fn half_area(&self) -> f32 {
-        let e = (self.hi - self.lo).max(Vec3A::ZERO);
-        e.x * e.y + e.y * e.z + e.z * e.x
-    }
-
-    fn largest_axis(&self) -> usize {
-        Aabb::new(self.lo.into(), self.hi.into()).largest_axis()
-    }
-
-    fn aabb(&self) -> Aabb {
-        Aabb::new(self.lo.into(), self.hi.into())
-    }
 }
