@@ -139,16 +139,17 @@ impl Bin {
 /// truncating then clamping gives the same bins (both are monotone and `last` is a whole
 /// number), and a NaN goes to bin 0 either way. glam's `as_uvec3` converted lane by lane with
 /// Rust's saturating casts, 23% of the build's instructions with the clamp (callgrind).
-#[derive(Clone, Copy)]
-struct BinMap {
+/// Also the spatial builder's object split search ([`super::spatial`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BinMap {
     lo: Vec3A,
-    scale: Vec3A,
+    pub(super) scale: Vec3A,
     last: Vec3A,
 }
 
 impl BinMap {
     /// `nb` equal bins per axis over the centroid bounds `cb`.
-    fn new(cb: &Aabb, nb: usize) -> BinMap {
+    pub(super) fn new(cb: &Aabb, nb: usize) -> BinMap {
         let ext = Vec3A::from(cb.extent());
         // Bins per unit length on each axis; 0 on a flat axis puts everything in bin 0, where
         // no plane has primitives on both sides.
@@ -165,7 +166,7 @@ impl BinMap {
     }
 
     #[inline(always)]
-    fn bin_of(&self, c: Vec3A) -> [u32; 4] {
+    pub(super) fn bin_of(&self, c: Vec3A) -> [u32; 4] {
         let t = ((c - self.lo) * self.scale).max(Vec3A::ZERO).min(self.last);
         truncate(t)
     }

@@ -17,7 +17,7 @@
 //! blocks), for collapsing into a wide tree; its order holds a triangle once per reference.
 //! Triangles only: spheres and cones are not clipped.
 
-use super::binned::Box3A as Bx;
+use super::binned::{BinMap as CentreMap, Box3A as Bx};
 use super::{blocks, split_cost, BlockLeaves};
 use crate::bvh::config::{T_AABB, T_TRI};
 use crate::bvh::tree::{BuildKind, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
@@ -93,7 +93,8 @@ pub fn spatial_blocks(geometry: &Geometry, rule: &BlockLeaves, s: SpatialSetting
         bins: s.bins.clamp(2, 256),
         min_overlap: ALPHA * bounds.half_area(),
         min_refs: s.min_refs,
-        scratch: Vec::new(),
+        scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
+        right: Box::new([(0.0, 0); 256]),
         tree: BuildTree {
             nodes: Vec::with_capacity(2 * n / rule.min.max(1) + 1),
             order: Vec::with_capacity(n + n / 4),
@@ -112,25 +113,31 @@ struct Build<'a> {
     bins: usize,
     min_overlap: f32,
     min_refs: usize,
-    /// The object search's bins, three axes of `bins` each.
-    scratch: Vec<(Bx, usize)>,
+    /// The object search's bins: per axis 256, indexed by a `u8` bin number (no bounds check).
+    scratch: Box<[[(Bx, usize); 256]; 3]>,
+    /// The object sweep's right sides (area, count) before each bin (written before read: a
+    /// fresh array was 4 KB zeroed per node).
+    right: Box<[(f32, usize); 256]>,
     tree: BuildTree,
 }
 
+/// Where a split cuts: an object split between two bins of the centres (the right side's
+/// first), or a spatial split at a plane.
+#[derive(Clone, Copy, Debug)]
+enum Cut {
+    Object { map: CentreMap, first: usize },
+    Spatial { plane: f32 },
+}
+
 /// A split found by a search: its SAH numerator (`A_L·N_L + A_R·N_R` in blocks), the sides'
-/// boxes and counts, and where it cuts.
+/// boxes, the right side's count, and where it cuts.
 #[derive(Clone, Copy, Debug)]
 struct Found {
     weighted: f32,
     axis: usize,
-    /// Object split: the first bin of the right side. Spatial: the plane's coordinate.
-    at: f32,
-    spatial: bool,
-    /// The bins of the object split's axis.
-    map: BinMap,
+    cut: Cut,
     lb: Bx,
     rb: Bx,
-    nl: usize,
     nr: usize,
 }
 
@@ -176,13 +183,28 @@ impl Build<'_> {
             return self.leaf(&refs, bounds);
         }
         let (left, right) = match best {
-            Some(f) if f.spatial => self.partition_spatial(refs, &f),
-            Some(f) => {
-                let k = f.at as usize;
-                let (l, r): (Vec<Ref>, Vec<Ref>) = refs
-                    .into_iter()
-                    .partition(|r| f.map.bin(r.b.centre()[f.axis]) < k);
-                (l, r)
+            Some(Found {
+                cut: Cut::Spatial { plane },
+                axis,
+                nr,
+                ..
+            }) => self.partition_spatial(refs, axis, plane, nr),
+            Some(Found {
+                cut: Cut::Object { map, first },
+                axis,
+                nr,
+                ..
+            }) => {
+                // The left side stays in the node's vector, in order.
+                let mut right = Vec::with_capacity(nr);
+                refs.retain(|r| {
+                    let left = (map.bin_of(r.b.centre())[axis] as usize) < first;
+                    if !left {
+                        right.push(*r);
+                    }
+                    left
+                });
+                (refs, right)
             }
             None => {
                 // No plane separates the centres (or below the SAH's depth): the object median
@@ -225,8 +247,9 @@ impl Build<'_> {
         me
     }
 
-    /// The best object split (binned centres), or `None` when the centres coincide. One pass
-    /// bins the references on all three axes.
+    /// The best object split (binned centres, [`super::Binned`]'s map: the three axes'
+    /// bins in one SSE computation), or `None` when the centres coincide. One pass bins the
+    /// references on all three axes.
     fn object(&mut self, refs: &[Ref]) -> Option<Found> {
         let block = self.rule.block;
         let nb = self.bins;
@@ -234,47 +257,43 @@ impl Build<'_> {
         for r in refs {
             cb.grow_point(r.b.centre());
         }
-        let maps = [0, 1, 2].map(|a| BinMap::new(cb.lo[a], cb.hi[a], nb));
-        let bins = &mut self.scratch;
-        bins.clear();
-        bins.resize(3 * nb, (Bx::EMPTY, 0));
+        let map = CentreMap::new(&cb.aabb(), nb);
+        let bins = &mut *self.scratch;
+        for axis in bins.iter_mut() {
+            axis[..nb].fill((Bx::EMPTY, 0));
+        }
         for r in refs {
-            let c = r.b.centre();
-            let k = [
-                maps[0].bin(c.x),
-                nb + maps[1].bin(c.y),
-                2 * nb + maps[2].bin(c.z),
-            ];
-            for k in k {
-                bins[k].0.grow(&r.b);
-                bins[k].1 += 1;
+            let k = map.bin_of(r.b.centre());
+            for (a, bins) in bins.iter_mut().enumerate() {
+                // k < nb ≤ 256: the u8 is the bin itself, and indexes the 256 bins unchecked.
+                let bin = &mut bins[k[a] as u8 as usize];
+                bin.0.grow(&r.b);
+                bin.1 += 1;
             }
         }
+        let right = &mut *self.right;
         let mut best: Option<Found> = None;
-        let mut right = [(0.0f32, 0usize); 256];
-        for (axis, map) in maps.iter().enumerate() {
-            if map.scale == 0.0 {
+        for (axis, bins) in bins.iter().enumerate() {
+            if map.scale[axis] == 0.0 {
                 continue;
             }
-            let bins = &bins[axis * nb..(axis + 1) * nb];
-            sweep(bins, &mut right[..nb], block, |k, weighted, nl, nr| {
+            let bins = &bins[..nb];
+            sweep(bins, &mut right[..nb], block, |k, weighted, _, nr| {
                 if best.is_none_or(|b| weighted < b.weighted) {
                     best = Some(Found {
                         weighted,
                         axis,
-                        at: k as f32,
-                        spatial: false,
-                        map: *map,
+                        cut: Cut::Object { map, first: k },
                         lb: Bx::EMPTY,
                         rb: Bx::EMPTY,
-                        nl,
                         nr,
                     });
                 }
             });
             if let Some(f) = best.as_mut().filter(|f| f.axis == axis) {
-                let k = f.at as usize;
-                (f.lb, f.rb) = (union_bins(&bins[..k]), union_bins(&bins[k..]));
+                if let Cut::Object { first: k, .. } = f.cut {
+                    (f.lb, f.rb) = (union_bins(&bins[..k]), union_bins(&bins[k..]));
+                }
             }
         }
         best
@@ -282,96 +301,90 @@ impl Build<'_> {
 
     /// The best spatial split of the node's box `bounds`, or `None` when it is flat.
     fn spatial(&self, refs: &[Ref], bounds: &Bx) -> Option<Found> {
-        let block = self.rule.block;
-        let nb = SPATIAL_BINS;
-        let mut best: Option<Found> = None;
-        // Per bin: the box of the parts in it, references entering, references leaving.
-        let mut bins = vec![(Bx::EMPTY, 0usize, 0usize); nb];
-        let mut enter = vec![(Bx::EMPTY, 0usize); nb];
-        let mut right = vec![(0.0f32, 0usize); nb];
+        const NB: usize = SPATIAL_BINS;
         // The node's longest axis only: on gears4 searching all three gave a tree of about the
         // same node visits and triangle tests (within 1 %) at three times the search's cost.
-        let longest = bounds.largest_axis();
-        for axis in longest..longest + 1 {
-            let map = BinMap::new(bounds.lo[axis], bounds.hi[axis], nb);
-            if map.scale == 0.0 {
-                continue;
-            }
-            bins.fill((Bx::EMPTY, 0, 0));
-            for r in refs {
-                let first = map.bin(r.b.lo[axis]);
-                let last = map.bin(r.b.hi[axis]);
-                bins[first].1 += 1;
-                bins[last].2 += 1;
-                if first == last {
-                    bins[first].0.grow(&r.b);
-                } else {
-                    parts(
-                        &self.tris[r.id as usize],
-                        &r.b,
-                        axis,
-                        &map,
-                        first,
-                        last,
-                        |k, b| bins[k].0.grow(b),
-                    );
-                }
-            }
-            // A left side counts the references entering its bins, a right side those leaving.
-            for k in 0..nb {
-                enter[k] = (bins[k].0, bins[k].1);
-            }
-            let mut found = None;
-            let leaving: Vec<(Bx, usize)> = bins.iter().map(|b| (b.0, b.2)).collect();
-            sweep_two(
-                &enter,
-                &leaving,
-                &mut right,
-                block,
-                |k, weighted, nl, nr| {
-                    if best.is_none_or(|b| weighted < b.weighted)
-                        && found.is_none_or(|(_, w, _, _)| weighted < w)
-                    {
-                        found = Some((k, weighted, nl, nr));
-                    }
-                },
-            );
-            if let Some((k, weighted, nl, nr)) = found {
-                best = Some(Found {
-                    weighted,
+        let axis = bounds.largest_axis();
+        let map = PlaneMap::new(bounds.lo[axis], bounds.hi[axis], NB);
+        if map.scale == 0.0 {
+            return None;
+        }
+        // Per bin: the box of the parts in it with the references entering it (a left side
+        // counts those), and the same box with the references leaving it (a right side's).
+        let mut enter = [(Bx::EMPTY, 0usize); NB];
+        let mut leave = [0usize; NB];
+        for r in refs {
+            let first = map.bin(r.b.lo[axis]);
+            let last = map.bin(r.b.hi[axis]);
+            enter[first].1 += 1;
+            leave[last] += 1;
+            if first == last {
+                enter[first].0.grow(&r.b);
+            } else {
+                parts(
+                    &self.tris[r.id as usize],
+                    &r.b,
                     axis,
-                    at: map.plane(k),
-                    spatial: true,
-                    map,
-                    lb: union_bins(&enter[..k]),
-                    rb: union_bins(&enter[k..]),
-                    nl,
-                    nr,
-                });
+                    &map,
+                    first,
+                    last,
+                    |k, b| enter[k].0.grow(b),
+                );
             }
         }
-        best
+        let leaving: [(Bx, usize); NB] = std::array::from_fn(|k| (enter[k].0, leave[k]));
+        let mut right = [(0.0f32, 0usize); NB];
+        let mut found = None;
+        sweep_two(
+            &enter,
+            &leaving,
+            &mut right,
+            self.rule.block,
+            |k, weighted, _, nr| {
+                if found.is_none_or(|(_, w, _)| weighted < w) {
+                    found = Some((k, weighted, nr));
+                }
+            },
+        );
+        found.map(|(k, weighted, nr)| Found {
+            weighted,
+            axis,
+            cut: Cut::Spatial {
+                plane: map.plane(k),
+            },
+            lb: union_bins(&enter[..k]),
+            rb: union_bins(&enter[k..]),
+            nr,
+        })
     }
 
     /// The references of a spatial split's two sides: whole where they lie on one side,
-    /// else kept whole on the cheaper side or split (Stich et al. §4.4).
-    fn partition_spatial(&self, refs: Vec<Ref>, f: &Found) -> (Vec<Ref>, Vec<Ref>) {
-        let (axis, pos) = (f.axis, f.at);
-        let mut left = Vec::with_capacity(f.nl);
-        let mut right = Vec::with_capacity(f.nr);
+    /// else kept whole on the cheaper side or split (Stich et al. §4.4). The left side is
+    /// made in the node's vector (it holds at most one reference of each of the node's).
+    fn partition_spatial(
+        &self,
+        mut left: Vec<Ref>,
+        axis: usize,
+        pos: f32,
+        nr: usize,
+    ) -> (Vec<Ref>, Vec<Ref>) {
+        let mut right = Vec::with_capacity(nr);
         let mut straddle = Vec::new();
         let (mut lb, mut rb) = (Bx::EMPTY, Bx::EMPTY);
-        for r in refs {
+        left.retain(|r| {
             if r.b.hi[axis] <= pos {
                 lb.grow(&r.b);
-                left.push(r);
-            } else if r.b.lo[axis] >= pos {
-                rb.grow(&r.b);
-                right.push(r);
+                true
             } else {
-                straddle.push(r);
+                if r.b.lo[axis] >= pos {
+                    rb.grow(&r.b);
+                    right.push(*r);
+                } else {
+                    straddle.push(*r);
+                }
+                false
             }
-        }
+        });
         let (mut nl, mut nr) = (
             (left.len() + straddle.len()) as f32,
             (right.len() + straddle.len()) as f32,
@@ -411,20 +424,20 @@ impl Build<'_> {
     }
 }
 
-/// Equal bins over `[lo, hi]` on one axis.
+/// The spatial search's equal bins over `[lo, hi]` on one axis, and the planes between them.
 #[derive(Clone, Copy, Debug)]
-struct BinMap {
+struct PlaneMap {
     lo: f32,
     scale: f32,
     width: f32,
     last: usize,
 }
 
-impl BinMap {
-    fn new(lo: f32, hi: f32, nb: usize) -> BinMap {
+impl PlaneMap {
+    fn new(lo: f32, hi: f32, nb: usize) -> PlaneMap {
         let ext = hi - lo;
         let ok = ext > 0.0 && ext.is_finite();
-        BinMap {
+        PlaneMap {
             lo,
             scale: if ok {
                 nb as f32 * (1.0 - 1e-6) / ext
@@ -436,8 +449,15 @@ impl BinMap {
         }
     }
 
+    /// `⌊(x − lo)·scale⌋` clamped to `[0, last]`, clamped on floats before the conversion
+    /// as [`CentreMap`] does (the same bins: both are monotone and `last` is a whole number):
+    /// Rust's saturating cast was the build's costliest line on gears4 (callgrind).
+    #[inline(always)]
     fn bin(&self, x: f32) -> usize {
-        (((x - self.lo) * self.scale).max(0.0) as usize).min(self.last)
+        let t = ((x - self.lo) * self.scale).max(0.0).min(self.last as f32);
+        // SAFETY: `t` is finite and in `[0, last]` (`max` of a NaN and 0 is 0), so it is a
+        // value the conversion takes exactly.
+        unsafe { t.to_int_unchecked::<u32>() as usize }
     }
 
     /// The coordinate of the plane before bin `k`.
@@ -515,6 +535,42 @@ fn overlap_area(a: &Bx, b: &Bx) -> f32 {
 #[inline(always)]
 fn intersect(a: &Bx, b: &Bx) -> Bx {
     let (lo, hi) = (a.lo.max(b.lo), a.hi.min(b.hi));
+    empty_if_inverted(lo, hi)
+}
+
+/// The box `lo`–`hi`, or the empty box when `lo` passes `hi` on any axis. The axes' three
+/// comparisons are or-ed into every lane by two shuffles (glam's `any` and a splat of the
+/// answer went through a general register and back: a fifth of the spatial search on gears4).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn empty_if_inverted(lo: Vec3A, hi: Vec3A) -> Bx {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE is part of every x86_64 target. The fourth lane is not part of a `Vec3A`'s
+    // value, so what is selected there does not matter.
+    unsafe {
+        let (l, h): (__m128, __m128) = (lo.into(), hi.into());
+        let m = _mm_cmpgt_ps(l, h);
+        // Lanes x, y, z: (y, z, x) and (z, x, y).
+        let any = _mm_or_ps(
+            m,
+            _mm_or_ps(
+                _mm_shuffle_ps::<0b00_00_10_01>(m, m),
+                _mm_shuffle_ps::<0b00_01_00_10>(m, m),
+            ),
+        );
+        let pick = |empty: __m128, v: __m128| {
+            _mm_or_ps(_mm_and_ps(any, empty), _mm_andnot_ps(any, v))
+        };
+        Bx::new(
+            pick(_mm_set1_ps(f32::INFINITY), l).into(),
+            pick(_mm_set1_ps(f32::NEG_INFINITY), h).into(),
+        )
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn empty_if_inverted(lo: Vec3A, hi: Vec3A) -> Bx {
     let empty = glam::BVec3A::splat(lo.cmpgt(hi).any());
     Bx::new(
         Vec3A::select(empty, Vec3A::INFINITY, lo),
@@ -532,7 +588,7 @@ fn parts(
     t: &[Vec3A; 3],
     b: &Bx,
     axis: usize,
-    map: &BinMap,
+    map: &PlaneMap,
     first: usize,
     last: usize,
     visit: impl FnMut(usize, &Bx),
@@ -573,7 +629,7 @@ fn crossing<const A: usize>(p: Vec3A, q: Vec3A, x: f32) -> Vec3A {
 fn parts_on<const A: usize>(
     t: &[Vec3A; 3],
     b: &Bx,
-    map: &BinMap,
+    map: &PlaneMap,
     first: usize,
     last: usize,
     mut visit: impl FnMut(usize, &Bx),
