@@ -85,6 +85,13 @@ fn killed_run_leaves_valid_results_and_resume_completes_it() {
     child.kill().unwrap();
     child.wait().unwrap();
     let before = records(&dir);
+    let env = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("env.json")).unwrap()).unwrap()
+    };
+    let started = env(&dir)["started_at"].clone();
+    assert!(started.is_string(), "{started}");
+    // A later second, so a rewritten start would show.
+    std::thread::sleep(Duration::from_millis(1100));
     assert!(
         !before.is_empty() && before.len() < 6,
         "killed after {} of 6 runs",
@@ -116,6 +123,8 @@ fn killed_run_leaves_valid_results_and_resume_completes_it() {
     }
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.matches("already done").count(), before.len(), "{err}");
+    // The directory is dated by its first run, not by the resume.
+    assert_eq!(env(&dir)["started_at"], started);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

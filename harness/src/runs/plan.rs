@@ -215,7 +215,17 @@ impl ResultsDir {
                 records.len()
             );
         }
-        let env = crate::measure::environment::capture();
+        let mut env = crate::measure::environment::capture();
+        if resume && !records.is_empty() {
+            // The directory's runs began when its first run did: a resumed run keeps that
+            // start (reports date the results by it).
+            let before = std::fs::read(dir.join("env.json")).ok().and_then(|b| {
+                serde_json::from_slice::<rtbench_reports::Environment>(&b).ok()
+            });
+            if let Some(before) = before.filter(|b| !b.started_at.is_empty()) {
+                env.started_at = before.started_at;
+            }
+        }
         let text = serde_json::to_string_pretty(&env).expect("environment serialises");
         write_atomic(&dir.join("env.json"), |w| {
             std::io::Write::write_all(w, text.as_bytes())

@@ -94,6 +94,7 @@ pub fn spatial_blocks(geometry: &Geometry, rule: &BlockLeaves, s: SpatialSetting
         min_overlap: ALPHA * bounds.half_area(),
         min_refs: s.min_refs,
         scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
+        filled: Box::new([0; 256]),
         right: Box::new([(0.0, 0); 256]),
         tree: BuildTree {
             nodes: Vec::with_capacity(2 * n / rule.min.max(1) + 1),
@@ -113,10 +114,12 @@ struct Build<'a> {
     bins: usize,
     min_overlap: f32,
     min_refs: usize,
-    /// The object search's bins: per axis 256, indexed by a `u8` bin number (no bounds check).
+    /// The object search's bins: per axis 256, indexed by a `u8` bin number (no bounds check),
+    /// all empty between searches.
     scratch: Box<[[(Bx, usize); 256]; 3]>,
-    /// The object sweep's right sides (area, count) before each bin (written before read: a
-    /// fresh array was 4 KB zeroed per node).
+    /// The object search's filled bins of one axis, and the right side (area, count) of the
+    /// plane before each (written before read: a fresh array was 4 KB zeroed per node).
+    filled: Box<[u8; 256]>,
     right: Box<[(f32, usize); 256]>,
     tree: BuildTree,
 }
@@ -258,10 +261,8 @@ impl Build<'_> {
             cb.grow_point(r.b.centre());
         }
         let map = CentreMap::new(&cb.aabb(), nb);
+        // Every bin is empty between searches (each axis's used bins are emptied below).
         let bins = &mut *self.scratch;
-        for axis in bins.iter_mut() {
-            axis[..nb].fill((Bx::EMPTY, 0));
-        }
         for r in refs {
             let k = map.bin_of(r.b.centre());
             for (a, bins) in bins.iter_mut().enumerate() {
@@ -271,29 +272,59 @@ impl Build<'_> {
                 bin.1 += 1;
             }
         }
-        let right = &mut *self.right;
+        let (filled, right) = (&mut *self.filled, &mut *self.right);
         let mut best: Option<Found> = None;
-        for (axis, bins) in bins.iter().enumerate() {
-            if map.scale[axis] == 0.0 {
-                continue;
+        for (axis, bins) in bins.iter_mut().enumerate() {
+            // The filled bins, `filled[..m]` in order. An empty bin leaves both sides' boxes
+            // and counts as they were, so the plane after it costs what the plane before it
+            // does and never wins (ties keep the first plane): the sweeps run over the filled
+            // bins only, as `Binned`'s do.
+            let mut m = 0;
+            for (k, bin) in bins[..nb].iter().enumerate() {
+                // m ≤ k < 256: the u8 indexes unchecked.
+                filled[m as u8 as usize] = k as u8;
+                m += (bin.1 != 0) as usize;
             }
-            let bins = &bins[..nb];
-            sweep(bins, &mut right[..nb], block, |k, weighted, _, nr| {
-                if best.is_none_or(|b| weighted < b.weighted) {
-                    best = Some(Found {
-                        weighted,
-                        axis,
-                        cut: Cut::Object { map, first: k },
-                        lb: Bx::EMPTY,
-                        rb: Bx::EMPTY,
-                        nr,
-                    });
+            if map.scale[axis] != 0.0 {
+                // The plane after filled bin i − 1: the right side's area and count from a
+                // sweep down, the left side's on the way up.
+                let mut acc = Bx::EMPTY;
+                let mut count = 0;
+                for i in (1..m).rev() {
+                    let bin = &bins[filled[i] as usize];
+                    acc.grow(&bin.0);
+                    count += bin.1;
+                    right[i as u8 as usize] = (acc.half_area(), count);
                 }
-            });
-            if let Some(f) = best.as_mut().filter(|f| f.axis == axis) {
-                if let Cut::Object { first: k, .. } = f.cut {
-                    (f.lb, f.rb) = (union_bins(&bins[..k]), union_bins(&bins[k..]));
+                let mut l = Bx::EMPTY;
+                let mut lc = 0;
+                let mut won = None;
+                for i in 1..m {
+                    let bin = &bins[filled[i - 1] as usize];
+                    l.grow(&bin.0);
+                    lc += bin.1;
+                    let (ar, rc) = right[i as u8 as usize];
+                    let weighted =
+                        l.half_area() * blocks(lc, block) as f32 + ar * blocks(rc, block) as f32;
+                    if best.is_none_or(|b| weighted < b.weighted) {
+                        let first = filled[i - 1] as usize + 1;
+                        won = Some(first);
+                        best = Some(Found {
+                            weighted,
+                            axis,
+                            cut: Cut::Object { map, first },
+                            lb: l,
+                            rb: Bx::EMPTY,
+                            nr: rc,
+                        });
+                    }
                 }
+                if let (Some(first), Some(f)) = (won, best.as_mut()) {
+                    f.rb = union_bins(&bins[first..nb]);
+                }
+            }
+            for &k in &filled[..m] {
+                bins[k as usize] = (Bx::EMPTY, 0);
             }
         }
         best
@@ -335,7 +366,7 @@ impl Build<'_> {
         let leaving: [(Bx, usize); NB] = std::array::from_fn(|k| (enter[k].0, leave[k]));
         let mut right = [(0.0f32, 0usize); NB];
         let mut found = None;
-        sweep_two(
+        sweep(
             &enter,
             &leaving,
             &mut right,
@@ -467,19 +498,10 @@ impl PlaneMap {
 }
 
 /// Calls `visit(k, A_L·blocks(N_L) + A_R·blocks(N_R), N_L, N_R)` for each plane `k` (1 to
-/// nb − 1, before bin k) with primitives on both sides; bins are (box, count).
+/// nb − 1, before bin k) with references on both sides; bins are (box, count), the left
+/// side's counts from `left_bins` and the right side's from `right_bins` (a spatial search
+/// counts references entering and leaving; the boxes are the same).
 fn sweep(
-    bins: &[(Bx, usize)],
-    right: &mut [(f32, usize)],
-    block: usize,
-    visit: impl FnMut(usize, f32, usize, usize),
-) {
-    sweep_two(bins, bins, right, block, visit)
-}
-
-/// [`sweep`] with the left side's counts from `left` and the right side's from `right_bins`
-/// (a spatial search counts references entering and leaving; the boxes are the same).
-fn sweep_two(
     left_bins: &[(Bx, usize)],
     right_bins: &[(Bx, usize)],
     right: &mut [(f32, usize)],
