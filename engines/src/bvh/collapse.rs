@@ -200,7 +200,7 @@ pub fn collapse_threads(
     let mut wide = [0u32; MAX_WIDTH];
     let mut slot = 0;
     for (t, roots) in parts {
-        let at = out.append_shifted(&t.nodes, threads);
+        let at = out.append_shifted(&t.nodes, 0, threads);
         for r in roots {
             wide[slot] = r + at;
             slot += 1;

@@ -143,6 +143,7 @@ pub fn build_tree(geometry: &Geometry, config: &Config) -> BuildTree {
                     budget: config.spatial,
                     min_refs: config.spatial_min,
                 },
+                config.build_threads,
             )
         }
         Builder::SahSweep if block_leaves => {

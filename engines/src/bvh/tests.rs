@@ -548,29 +548,32 @@ fn packets_answer_as_single_rays() {
 /// The two-thread build makes the one-thread build's tree, node for node.
 #[test]
 fn threads_build_the_same_tree() {
-    // The threaded build is the binned SAH's: spatial splits (the default for triangle scenes)
-    // build on one thread, so they are off here.
     // gears4: 36,610 triangles, so the top splits (ranges of ≥ 8,192) go to threads. balls2
     // tessellated: its top split cuts the floor's few triangles from the spheres', a side too
-    // small to fork (built in place while the other side forks on).
-    for (program, sf, tessellate) in [(Program::Gears, 4, None), (Program::Balls, 2, Some(3))] {
-        let inp = input(program, sf, tessellate);
-        let off = || ("spatial".to_string(), "0".to_string());
-        let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
-        let base = build_tree(&inp.geometry, &one);
-        assert!(base.nodes.len() > 1000);
-        for threads in ["2", "3"] {
-            let two = Config::parse(
-                8,
-                Settings::new(
-                    "bvh8",
-                    vec![("build_threads".into(), threads.into()), off()],
-                ),
-            )
-            .unwrap();
-            let t = build_tree(&inp.geometry, &two);
-            assert_eq!(t.order, base.order, "{program:?} {threads} threads");
-            assert_eq!(t.nodes, base.nodes, "{program:?} {threads} threads");
+    // small to fork (built in place while the other side forks on). Both the binned SAH's
+    // threaded build (`spatial=0`) and the spatial-split build (the default for triangles).
+    for spatial in ["0", "1"] {
+        for (program, sf, tessellate) in [(Program::Gears, 4, None), (Program::Balls, 2, Some(3))]
+        {
+            let inp = input(program, sf, tessellate);
+            let off = || ("spatial".to_string(), spatial.to_string());
+            let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
+            let base = build_tree(&inp.geometry, &one);
+            assert!(base.nodes.len() > 1000);
+            for threads in ["2", "3"] {
+                let two = Config::parse(
+                    8,
+                    Settings::new(
+                        "bvh8",
+                        vec![("build_threads".into(), threads.into()), off()],
+                    ),
+                )
+                .unwrap();
+                let t = build_tree(&inp.geometry, &two);
+                let what = format!("{program:?} spatial={spatial} {threads} threads");
+                assert_eq!(t.order, base.order, "{what}");
+                assert_eq!(t.nodes, base.nodes, "{what}");
+            }
         }
     }
 }

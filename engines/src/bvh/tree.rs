@@ -49,8 +49,9 @@ impl BuildTree {
     /// Appends the nodes of a tree built on its own (children numbered from its node 0),
     /// renumbered by where they land, copied on `threads` threads ([`extend_par`]); gives where
     /// its node 0 landed. Copying a subtree built on another thread (hundreds of thousands of
-    /// nodes) was a pass on one thread alone.
-    pub fn append_shifted(&mut self, sub: &[BuildNode], threads: usize) -> u32 {
+    /// nodes) was a pass on one thread alone. Its leaves' first positions are moved on by
+    /// `first_shift` (a subtree with an order of its own; 0 for one that shares this tree's).
+    pub fn append_shifted(&mut self, sub: &[BuildNode], first_shift: u32, threads: usize) -> u32 {
         let at = self.nodes.len() as u32;
         let threads = if sub.len() < 2 * PARALLEL_MIN {
             1
@@ -59,10 +60,13 @@ impl BuildTree {
         };
         extend_par(&mut self.nodes, sub.len(), threads, |i| {
             let mut node = sub[i];
-            if let BuildKind::Inner { children, len } = &mut node.kind {
-                for c in &mut children[..*len as usize] {
-                    *c += at;
+            match &mut node.kind {
+                BuildKind::Inner { children, len } => {
+                    for c in &mut children[..*len as usize] {
+                        *c += at;
+                    }
                 }
+                BuildKind::Leaf { first, .. } => *first += first_shift,
             }
             node
         });

@@ -101,7 +101,7 @@ fn block_node<S: Splitter>(
 
 /// Ranges smaller than this are never handed to another thread (a thread costs more than
 /// building a few thousand primitives).
-const FORK_MIN: usize = 4096;
+pub(super) const FORK_MIN: usize = 4096;
 
 /// [`binary_blocks`] over the binned search on `threads` threads: the ranges on both sides of
 /// the top `⌈log2 threads⌉ + 2` levels of splits (not counting splits with a side below
@@ -206,7 +206,7 @@ fn fork_node(
         );
         right.join().expect("a build thread panicked")
     });
-    children[1] = tree.append_shifted(&right.nodes, threads);
+    children[1] = tree.append_shifted(&right.nodes, 0, threads);
     tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
     me
 }

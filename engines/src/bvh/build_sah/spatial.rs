@@ -18,6 +18,7 @@
 //! Triangles only: spheres and cones are not clipped.
 
 use super::binned::{BinMap as CentreMap, Box3A as Bx};
+use super::binary::FORK_MIN;
 use super::{blocks, split_cost, BlockLeaves};
 use crate::bvh::config::{T_AABB, T_TRI};
 use crate::bvh::tree::{BuildKind, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
@@ -56,8 +57,19 @@ pub struct SpatialSettings {
     pub min_refs: usize,
 }
 
-/// A binary tree over `geometry`'s triangles with spatial splits, leaves by `rule`.
-pub fn spatial_blocks(geometry: &Geometry, rule: &BlockLeaves, s: SpatialSettings) -> BuildTree {
+/// A binary tree over `geometry`'s triangles with spatial splits, leaves by `rule`, built on
+/// `threads` threads: the two sides of each of the top `⌈log2 threads⌉ + 2` levels of splits
+/// (not counting splits with a side below [`FORK_MIN`] references) are built at once, the
+/// right side on a thread of its own into a tree of its own, appended after the left side
+/// where the one-thread build puts it. A side's subtree depends only on its references, its
+/// depth and its share of the budget, so the tree is the same node for node at any count
+/// (test `bvh::tests::threads_build_the_same_tree`).
+pub fn spatial_blocks(
+    geometry: &Geometry,
+    rule: &BlockLeaves,
+    s: SpatialSettings,
+    threads: usize,
+) -> BuildTree {
     let tris: Vec<[Vec3A; 3]> = geometry
         .prims
         .iter()
@@ -96,14 +108,17 @@ pub fn spatial_blocks(geometry: &Geometry, rule: &BlockLeaves, s: SpatialSetting
         scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
         filled: Box::new([0; 256]),
         right: Box::new([(0.0, 0); 256]),
-        tree: BuildTree {
-            nodes: Vec::with_capacity(2 * n / rule.min.max(1) + 1),
-            order: Vec::with_capacity(n + n / 4),
-        },
-    };
+        tree: BuildTree::default(),
+    }
+    .for_refs(n);
     let budget = (s.budget.max(0.0) * n as f32) as usize;
+    let forks = if threads > 1 {
+        threads.next_power_of_two().trailing_zeros() as usize + 2
+    } else {
+        0
+    };
     if n > 0 {
-        b.node(refs, bounds, 0, budget);
+        b.node(refs, bounds, 0, budget, forks);
     }
     b.tree
 }
@@ -144,7 +159,33 @@ struct Found {
     nr: usize,
 }
 
-impl Build<'_> {
+impl<'a> Build<'a> {
+    /// This build with an empty tree reserved for about `n` references.
+    fn for_refs(mut self, n: usize) -> Build<'a> {
+        self.tree = BuildTree {
+            nodes: Vec::with_capacity(2 * n / self.rule.min.max(1) + 1),
+            order: Vec::with_capacity(n + n / 4),
+        };
+        self
+    }
+
+    /// A build of the same settings with scratch and a tree of its own, for a side built on
+    /// another thread.
+    fn fresh(&self, n: usize) -> Build<'a> {
+        Build {
+            tris: self.tris,
+            rule: self.rule,
+            bins: self.bins,
+            min_overlap: self.min_overlap,
+            min_refs: self.min_refs,
+            scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
+            filled: Box::new([0; 256]),
+            right: Box::new([(0.0, 0); 256]),
+            tree: BuildTree::default(),
+        }
+        .for_refs(n)
+    }
+
     fn leaf(&mut self, refs: &[Ref], bounds: Bx) -> u32 {
         let first = self.tree.order.len() as u32;
         self.tree.order.extend(refs.iter().map(|r| r.id));
@@ -157,7 +198,16 @@ impl Build<'_> {
         )
     }
 
-    fn node(&mut self, mut refs: Vec<Ref>, bounds: Bx, depth: usize, budget: usize) -> u32 {
+    /// The subtree of `refs` in `bounds`, its splits sharing `budget` extra references; its
+    /// top `forks` levels of splits build their two sides at once.
+    fn node(
+        &mut self,
+        mut refs: Vec<Ref>,
+        bounds: Bx,
+        depth: usize,
+        budget: usize,
+        forks: usize,
+    ) -> u32 {
         let n = refs.len();
         if n == 1 || n <= self.rule.min {
             return self.leaf(&refs, bounds);
@@ -244,8 +294,24 @@ impl Build<'_> {
             .tree
             .push(bounds.aabb(), BuildKind::Leaf { first: 0, count: 0 });
         let mut children = [0; MAX_WIDTH];
-        children[0] = self.node(left, lb, depth + 1, lbudget);
-        children[1] = self.node(right, rb, depth + 1, rbudget);
+        if forks > 0 && left.len().min(right.len()) >= FORK_MIN {
+            let mut other = self.fresh(right.len());
+            let sub = std::thread::scope(|scope| {
+                let h = scope.spawn(move || {
+                    other.node(right, rb, depth + 1, rbudget, forks - 1);
+                    other.tree
+                });
+                children[0] = self.node(left, lb, depth + 1, lbudget, forks - 1);
+                h.join().expect("a build thread panicked")
+            });
+            let shift = self.tree.order.len() as u32;
+            children[1] = self.tree.append_shifted(&sub.nodes, shift, 1);
+            self.tree.order.extend_from_slice(&sub.order);
+        } else {
+            // (A side too small for a thread: the other may still fork below.)
+            children[0] = self.node(left, lb, depth + 1, lbudget, forks);
+            children[1] = self.node(right, rb, depth + 1, rbudget, forks);
+        }
         self.tree.nodes[me as usize].kind = BuildKind::Inner { children, len: 2 };
         me
     }
