@@ -553,23 +553,12 @@ fn threads_build_the_same_tree() {
     // small to fork (built in place while the other side forks on). Both the binned SAH's
     // threaded build (`spatial=0`) and the spatial-split build (the default for triangles).
     for spatial in ["0", "1"] {
-        for (program, sf, tessellate) in [(Program::Gears, 4, None), (Program::Balls, 2, Some(3))]
-        {
+        for (program, sf, tessellate) in [(Program::Gears, 4, None), (Program::Balls, 2, Some(3))] {
             let inp = input(program, sf, tessellate);
-            let off = || ("spatial".to_string(), spatial.to_string());
-            let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
-            let base = build_tree(&inp.geometry, &one);
+            let base = build_tree(&inp.geometry, &threads_config("1", spatial));
             assert!(base.nodes.len() > 1000);
             for threads in ["2", "3"] {
-                let two = Config::parse(
-                    8,
-                    Settings::new(
-                        "bvh8",
-                        vec![("build_threads".into(), threads.into()), off()],
-                    ),
-                )
-                .unwrap();
-                let t = build_tree(&inp.geometry, &two);
+                let t = build_tree(&inp.geometry, &threads_config(threads, spatial));
                 let what = format!("{program:?} spatial={spatial} {threads} threads");
                 assert_eq!(t.order, base.order, "{what}");
                 assert_eq!(t.nodes, base.nodes, "{what}");
@@ -578,40 +567,47 @@ fn threads_build_the_same_tree() {
     }
 }
 
+/// bvh8's settings with `build_threads` and `spatial` set.
+fn threads_config(threads: &str, spatial: &str) -> Config {
+    let set = |k: &str, v: &str| (k.to_string(), v.to_string());
+    Config::parse(
+        8,
+        Settings::new(
+            "bvh8",
+            vec![set("build_threads", threads), set("spatial", spatial)],
+        ),
+    )
+    .unwrap()
+}
+
 /// The two-thread engine build (primitive boxes, the top split's binning, statistics beside the
 /// leaf layout on threads) makes the one-thread build's engine: the same wide nodes, leaf
 /// packets, scalar primitives and statistics.
 #[test]
 fn threads_build_the_same_engine() {
-    // gears4: 36,610 triangles, above every threshold of the threaded parts (8,192).
-    // Spatial splits off: they build on one thread (`threads_build_the_same_tree`).
+    // gears4: 36,610 triangles, above every threshold of the threaded parts (8,192); with and
+    // without spatial splits.
     let inp = input(Program::Gears, 4, None);
-    let off = || ("spatial".to_string(), "0".to_string());
-    let one = Config::parse(8, Settings::new("bvh8", vec![off()])).unwrap();
-    let (base, base_stats) = build_bvh::<8>(&inp.geometry, &one).unwrap();
-    assert!(base.packets.len() > 1000);
-    for threads in ["2", "3"] {
-        let more = Config::parse(
-            8,
-            Settings::new(
-                "bvh8",
-                vec![("build_threads".into(), threads.into()), off()],
-            ),
-        )
-        .unwrap();
-        let (b, s) = build_bvh::<8>(&inp.geometry, &more).unwrap();
-        assert_eq!(b.root, base.root, "{threads} threads");
-        assert_eq!(b.nodes, base.nodes, "{threads} threads");
-        assert_eq!(b.prims, base.prims, "{threads} threads");
-        assert_eq!(b.objects, base.objects, "{threads} threads");
-        assert_eq!(b.extent.to_bits(), base.extent.to_bits());
-        // Debug prints every float of a packet exactly (shortest round trip, signs of zero).
-        assert_eq!(
-            format!("{:?}", b.packets),
-            format!("{:?}", base.packets),
-            "{threads} threads"
-        );
-        assert_eq!(s, base_stats, "{threads} threads");
+    for spatial in ["0", "1"] {
+        let (base, base_stats) =
+            build_bvh::<8>(&inp.geometry, &threads_config("1", spatial)).unwrap();
+        assert!(base.packets.len() > 1000);
+        for threads in ["2", "3"] {
+            let (b, s) = build_bvh::<8>(&inp.geometry, &threads_config(threads, spatial)).unwrap();
+            let what = format!("spatial={spatial} {threads} threads");
+            assert_eq!(b.root, base.root, "{what}");
+            assert_eq!(b.nodes, base.nodes, "{what}");
+            assert_eq!(b.prims, base.prims, "{what}");
+            assert_eq!(b.objects, base.objects, "{what}");
+            assert_eq!(b.extent.to_bits(), base.extent.to_bits());
+            // Debug prints every float of a packet exactly (shortest round trip, signs of zero).
+            assert_eq!(
+                format!("{:?}", b.packets),
+                format!("{:?}", base.packets),
+                "{what}"
+            );
+            assert_eq!(s, base_stats, "{what}");
+        }
     }
 }
 

@@ -219,9 +219,9 @@ impl ResultsDir {
         if resume && !records.is_empty() {
             // The directory's runs began when its first run did: a resumed run keeps that
             // start (reports date the results by it).
-            let before = std::fs::read(dir.join("env.json")).ok().and_then(|b| {
-                serde_json::from_slice::<rtbench_reports::Environment>(&b).ok()
-            });
+            let before = std::fs::read(dir.join("env.json"))
+                .ok()
+                .and_then(|b| serde_json::from_slice::<rtbench_reports::Environment>(&b).ok());
             if let Some(before) = before.filter(|b| !b.started_at.is_empty()) {
                 env.started_at = before.started_at;
             }

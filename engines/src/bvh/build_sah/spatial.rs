@@ -17,8 +17,8 @@
 //! blocks), for collapsing into a wide tree; its order holds a triangle once per reference.
 //! Triangles only: spheres and cones are not clipped.
 
-use super::binned::{BinMap as CentreMap, Box3A as Bx};
 use super::binary::FORK_MIN;
+use super::binned::{BinMap as CentreMap, Box3A as Bx};
 use super::{blocks, split_cost, BlockLeaves};
 use crate::bvh::config::{T_AABB, T_TRI};
 use crate::bvh::tree::{BuildKind, BuildTree, MAX_WIDTH, SAH_MEDIAN_DEPTH};
@@ -646,9 +646,8 @@ fn empty_if_inverted(lo: Vec3A, hi: Vec3A) -> Bx {
                 _mm_shuffle_ps::<0b00_01_00_10>(m, m),
             ),
         );
-        let pick = |empty: __m128, v: __m128| {
-            _mm_or_ps(_mm_and_ps(any, empty), _mm_andnot_ps(any, v))
-        };
+        let pick =
+            |empty: __m128, v: __m128| _mm_or_ps(_mm_and_ps(any, empty), _mm_andnot_ps(any, v));
         Bx::new(
             pick(_mm_set1_ps(f32::INFINITY), l).into(),
             pick(_mm_set1_ps(f32::NEG_INFINITY), h).into(),
