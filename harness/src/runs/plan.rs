@@ -219,9 +219,8 @@ impl ResultsDir {
         if resume && !records.is_empty() {
             // The directory's runs began when its first run did: a resumed run keeps that
             // start (reports date the results by it).
-            let before = std::fs::read(dir.join("env.json"))
-                .ok()
-                .and_then(|b| serde_json::from_slice::<rtbench_reports::Environment>(&b).ok());
+            // (An unreadable env.json is rewritten whole, as on a fresh start.)
+            let before = rtbench_reports::read_environment(dir).ok().flatten();
             if let Some(before) = before.filter(|b| !b.started_at.is_empty()) {
                 env.started_at = before.started_at;
             }

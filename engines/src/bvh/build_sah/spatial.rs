@@ -99,18 +99,16 @@ pub fn spatial_blocks(
         bounds.grow(&r.b);
     }
     let n = refs.len();
-    let mut b = Build {
-        tris: &tris,
-        rule,
-        bins: s.bins.clamp(2, 256),
-        min_overlap: ALPHA * bounds.half_area(),
-        min_refs: s.min_refs,
-        scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
-        filled: Box::new([0; 256]),
-        right: Box::new([(0.0, 0); 256]),
-        tree: BuildTree::default(),
-    }
-    .for_refs(n);
+    let mut b = Build::new(
+        Params {
+            tris: &tris,
+            rule,
+            bins: s.bins.clamp(2, 256),
+            min_overlap: ALPHA * bounds.half_area(),
+            min_refs: s.min_refs,
+        },
+        n,
+    );
     let budget = (s.budget.max(0.0) * n as f32) as usize;
     let forks = if threads > 1 {
         threads.next_power_of_two().trailing_zeros() as usize + 2
@@ -123,12 +121,19 @@ pub fn spatial_blocks(
     b.tree
 }
 
-struct Build<'a> {
+/// What every node of one build reads.
+#[derive(Clone, Copy)]
+struct Params<'a> {
     tris: &'a [[Vec3A; 3]],
     rule: &'a BlockLeaves<'a>,
     bins: usize,
     min_overlap: f32,
     min_refs: usize,
+}
+
+/// A build's settings, its search scratch and the tree it makes (one per thread).
+struct Build<'a> {
+    p: Params<'a>,
     /// The object search's bins: per axis 256, indexed by a `u8` bin number (no bounds check),
     /// all empty between searches.
     scratch: Box<[[(Bx, usize); 256]; 3]>,
@@ -160,30 +165,18 @@ struct Found {
 }
 
 impl<'a> Build<'a> {
-    /// This build with an empty tree reserved for about `n` references.
-    fn for_refs(mut self, n: usize) -> Build<'a> {
-        self.tree = BuildTree {
-            nodes: Vec::with_capacity(2 * n / self.rule.min.max(1) + 1),
-            order: Vec::with_capacity(n + n / 4),
-        };
-        self
-    }
-
-    /// A build of the same settings with scratch and a tree of its own, for a side built on
-    /// another thread.
-    fn fresh(&self, n: usize) -> Build<'a> {
+    /// A build with empty scratch and a tree reserved for about `n` references.
+    fn new(p: Params<'a>, n: usize) -> Build<'a> {
         Build {
-            tris: self.tris,
-            rule: self.rule,
-            bins: self.bins,
-            min_overlap: self.min_overlap,
-            min_refs: self.min_refs,
+            p,
             scratch: Box::new([[(Bx::EMPTY, 0); 256]; 3]),
             filled: Box::new([0; 256]),
             right: Box::new([(0.0, 0); 256]),
-            tree: BuildTree::default(),
+            tree: BuildTree {
+                nodes: Vec::with_capacity(2 * n / p.rule.min.max(1) + 1),
+                order: Vec::with_capacity(n + n / 4),
+            },
         }
-        .for_refs(n)
     }
 
     fn leaf(&mut self, refs: &[Ref], bounds: Bx) -> u32 {
@@ -209,17 +202,17 @@ impl<'a> Build<'a> {
         forks: usize,
     ) -> u32 {
         let n = refs.len();
-        if n == 1 || n <= self.rule.min {
+        if n == 1 || n <= self.p.rule.min {
             return self.leaf(&refs, bounds);
         }
-        let block = self.rule.block;
+        let block = self.p.rule.block;
         let median = depth >= SAH_MEDIAN_DEPTH;
         let mut best = if median { None } else { self.object(&refs) };
         if !median {
             let overlap = best.map_or(f32::INFINITY, |f| overlap_area(&f.lb, &f.rb));
             if budget > 0
-                && n >= self.min_refs
-                && overlap > self.min_overlap
+                && n >= self.p.min_refs
+                && overlap > self.p.min_overlap
                 && overlap >= NODE_OVERLAP * bounds.half_area()
             {
                 if let Some(sp) = self.spatial(&refs, &bounds) {
@@ -232,7 +225,7 @@ impl<'a> Build<'a> {
         let weighted = best.map_or(f32::INFINITY, |f| f.weighted);
         let cost = split_cost(weighted, bounds.half_area());
         let leaf_cost = blocks(n, block) as f32 * T_TRI;
-        if n <= self.rule.max && leaf_cost <= cost - T_AABB {
+        if n <= self.p.rule.max && leaf_cost <= cost - T_AABB {
             return self.leaf(&refs, bounds);
         }
         let (left, right) = match best {
@@ -295,7 +288,7 @@ impl<'a> Build<'a> {
             .push(bounds.aabb(), BuildKind::Leaf { first: 0, count: 0 });
         let mut children = [0; MAX_WIDTH];
         if forks > 0 && left.len().min(right.len()) >= FORK_MIN {
-            let mut other = self.fresh(right.len());
+            let mut other = Build::new(self.p, right.len());
             let sub = std::thread::scope(|scope| {
                 let h = scope.spawn(move || {
                     other.node(right, rb, depth + 1, rbudget, forks - 1);
@@ -320,8 +313,8 @@ impl<'a> Build<'a> {
     /// bins in one SSE computation), or `None` when the centres coincide. One pass bins the
     /// references on all three axes.
     fn object(&mut self, refs: &[Ref]) -> Option<Found> {
-        let block = self.rule.block;
-        let nb = self.bins;
+        let block = self.p.rule.block;
+        let nb = self.p.bins;
         let mut cb = Bx::EMPTY;
         for r in refs {
             cb.grow_point(r.b.centre());
@@ -419,7 +412,7 @@ impl<'a> Build<'a> {
                 enter[first].0.grow(&r.b);
             } else {
                 parts(
-                    &self.tris[r.id as usize],
+                    &self.p.tris[r.id as usize],
                     &r.b,
                     axis,
                     &map,
@@ -436,7 +429,7 @@ impl<'a> Build<'a> {
             &enter,
             &leaving,
             &mut right,
-            self.rule.block,
+            self.p.rule.block,
             |k, weighted, _, nr| {
                 if found.is_none_or(|(_, w, _)| weighted < w) {
                     found = Some((k, weighted, nr));
@@ -489,7 +482,7 @@ impl<'a> Build<'a> {
         // The straddlers' parts on each side, for the unsplitting costs.
         let parts: Vec<(Bx, Bx)> = straddle
             .iter()
-            .map(|r| clip(&self.tris[r.id as usize], &r.b, axis, pos))
+            .map(|r| clip(&self.p.tris[r.id as usize], &r.b, axis, pos))
             .collect();
         for (l, r) in &parts {
             lb.grow(l);
