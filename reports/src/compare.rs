@@ -13,8 +13,12 @@
 //!   noise they are. A regression
 //!   needs the whole interval above +threshold, an improvement the whole interval below −threshold; a
 //!   change whose estimate passes the threshold while its interval reaches back inside is reported as
-//!   "too few samples to decide", and so is a run with fewer than two samples on a side. Embree's own
-//!   times are the yardstick (ratio 1) and are not compared; its counters are;
+//!   "too few samples to decide", and so is a run with fewer than two samples on a side. Sets of one
+//!   process a run (`run --rounds 1`, `sweep`) decide no change of time either way: their
+//!   intervals are of one process's samples, which cannot show the few percent by which two
+//!   processes of one build differ (two such runs of one commit at 8² "regressed" by 11 %, interval
+//!   [+6.9 %, +15.6 %]), so a change past the threshold is reported as undecided, with the rounds
+//!   it needs. Embree's own times are the yardstick (ratio 1) and are not compared; its counters are;
 //! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), the
 //!   speed-up's change is judged the same way on its pairs (Embree's too: it measures how the harness
 //!   splits the trace as much as Embree).
@@ -58,7 +62,8 @@ pub enum FindingKind {
     /// tolerance: a fall is a regression, a rise an improvement.
     ThreadSpeedup,
     /// A time ratio or speed-up whose change could not be decided: fewer than two samples on a
-    /// side, or an estimate past the threshold with an interval that reaches back inside it.
+    /// side, an estimate past the threshold with an interval that reaches back inside it, or a
+    /// change past the threshold where a side ran in one process.
     Undecided,
 }
 
@@ -150,7 +155,7 @@ impl Comparison {
         }
         let _ = writeln!(
             s,
-            "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%, judged on 95 % intervals ({} too few samples to decide)\n",
+            "- **matched runs**: {}; {} trace-time ratios and {} counters compared; threshold {}%, judged on 95 % intervals ({} undecided)\n",
             self.matched,
             self.times_compared,
             self.counters_compared,
@@ -216,6 +221,14 @@ impl Comparison {
                 );
             }
             s.push('\n');
+            // A note's row does not say why it is one (undecided, unmatched, not compared): its
+            // message does.
+            if title == "Notes" {
+                for f in list {
+                    let _ = writeln!(s, "- {}", f.message);
+                }
+                s.push('\n');
+            }
         }
         s
     }
@@ -536,6 +549,7 @@ fn compare_times(
                 samples: [pa.samples.len(), pb.samples.len()],
                 unit: "samples",
                 higher_is_worse: true,
+                one_process: true,
             },
             c,
         );
@@ -596,6 +610,7 @@ fn compare_times(
             samples: [ea.len() + sa.len(), eb.len() + sb.len()],
             unit: "samples",
             higher_is_worse: true,
+            one_process: true,
         },
         c,
     );
@@ -632,6 +647,7 @@ fn compare_scaling(ra: &RunRecord, rb: &RunRecord, c: &mut Comparison) {
             samples: [pa.samples.len(), pb.samples.len()],
             unit: "samples",
             higher_is_worse: false,
+            one_process: true,
         },
         c,
     );
@@ -654,6 +670,7 @@ fn by_rounds(
         samples: [a.n, b.n],
         unit: "rounds",
         higher_is_worse,
+        one_process: false,
     }
 }
 
@@ -690,11 +707,15 @@ struct Judged<'a> {
     unit: &'a str,
     /// A rise is a regression (a time ratio), else a fall is (a speed-up).
     higher_is_worse: bool,
+    /// A side's samples are of one process (it has no rounds): a change past the threshold is not
+    /// decided.
+    one_process: bool,
 }
 
 /// Decides on the interval of the change: a regression or improvement only when the whole 95 %
-/// interval lies past ±threshold; "too few samples to decide" when a side has fewer than two
-/// samples, or when the estimate passes the threshold but the interval reaches back inside.
+/// interval lies past ±threshold and both sides ran in rounds; undecided when a side has fewer
+/// than two samples, when the estimate passes the threshold but the interval reaches back
+/// inside, or when the interval passes it but a side ran in one process.
 fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
     let thr = c.threshold_pct;
     let [na, nb] = j.samples;
@@ -752,6 +773,20 @@ fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
         message: String::new(),
     };
     match verdict {
+        Some(_) if j.one_process => {
+            c.undecided += 1;
+            f.kind = FindingKind::Undecided;
+            f.message = format!(
+                "{}: {} {} → {} ({}%; {interval_text}, past the threshold {}%): not decided: a side ran in one process, whose samples cannot show how far two processes of one build differ; run both with --rounds 2 or more, and as many repeats ({n_text})",
+                ra.key,
+                j.what,
+                number::ratio(j.old),
+                number::ratio(j.new),
+                signed(est),
+                number::short(thr, 3)
+            );
+            c.notes.push(f);
+        }
         Some(regressed) => {
             let word = match (j.higher_is_worse, est > 0.0) {
                 (true, true) => "slower relative to Embree",

@@ -16,6 +16,38 @@ fn base() -> Vec<RunRecord> {
     v
 }
 
+/// `set` as `run --rounds 3` records it: each run's three repeats (and its pairs, a third a round)
+/// from three processes. Embree's second and first repeats change places, so each round's ratio
+/// to Embree differs from the next by about 1 %, as rounds do.
+fn in_rounds(set: &mut [RunRecord]) {
+    for r in set.iter_mut() {
+        if r.engine == "embree" {
+            r.time_s.trace.samples.swap(0, 1);
+        }
+        let third = |n: usize| n / 3;
+        r.rounds = vec![
+            rtbench_reports::Round {
+                repeats: third(r.time_s.trace.samples.len()),
+                pairs: third(r.paired_ratio.as_ref().map_or(0, |p| p.samples.len())),
+                thread_pairs: third(
+                    r.thread_scaling
+                        .as_ref()
+                        .map_or(0, |t| t.speedup.samples.len())
+                ),
+            };
+            3
+        ];
+    }
+}
+
+/// [`compare_sets`] with both sets in rounds ([`in_rounds`]).
+fn compare_rounds(a: &[RunRecord], b: &[RunRecord], threshold: f64) -> Comparison {
+    let (mut a, mut b) = (a.to_vec(), b.to_vec());
+    in_rounds(&mut a);
+    in_rounds(&mut b);
+    compare_sets(&a, &b, threshold)
+}
+
 fn compare_sets(a: &[RunRecord], b: &[RunRecord], threshold: f64) -> Comparison {
     let (da, db) = (TempDir::new("cmp-a"), TempDir::new("cmp-b"));
     write_set(da.path(), a);
@@ -58,7 +90,7 @@ fn slower_relative_to_embree_is_a_regression() {
     // The whole machine 30% slower (cancels), and bvh2 on balls4 15% slower than that.
     b.iter_mut().for_each(|r| scale_trace(r, 1.3));
     scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
-    let c = compare_sets(&base(), &b, 5.0);
+    let c = compare_rounds(&base(), &b, 5.0);
     assert!(c.is_regression());
     assert_eq!(c.regressions.len(), 1, "{}", c.to_markdown());
     let f = &c.regressions[0];
@@ -72,11 +104,7 @@ fn slower_relative_to_embree_is_a_regression() {
     assert!((f.tolerance_pct.unwrap() - 5.0).abs() < 1e-9);
     let [lo, hi] = f.interval_pct.unwrap();
     assert!(lo > 5.0 && lo < 15.0 && hi > 15.0, "{lo} {hi}");
-    assert_eq!(
-        f.samples,
-        Some([6, 6]),
-        "three repeats of bvh2 and of Embree, each set"
-    );
+    assert_eq!(f.samples, Some([3, 3]), "three rounds a set");
     assert!(
         (f.old.as_f64().unwrap() - 2.0).abs() < 1e-12
             && (f.new.as_f64().unwrap() - 2.3).abs() < 1e-12
@@ -90,51 +118,75 @@ fn slower_relative_to_embree_is_a_regression() {
     assert!(
         md.contains("**1 regression.**")
             && md.contains("| `bvh2/balls4@1` | trace time / Embree | 2.00 | 2.30 | +15% | [+")
-            && md.contains("| 6/6 | 5% |"),
+            && md.contains("| 3/3 | 5% |"),
         "{md}"
     );
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["regressions"][0]["key"], "bvh2/balls4@1");
     assert_eq!(json["regressions"][0]["kind"], "time_ratio");
+
+    // The same change between sets of one process a run is not decided: one process's repeats
+    // cannot show how far two processes differ.
+    let c = compare_sets(&base(), &b, 5.0);
+    assert!(!c.is_regression(), "{}", c.to_markdown());
+    assert_eq!(c.undecided, 1);
+    let f = &c.notes[0];
+    assert_eq!(
+        (f.kind, f.key.as_str()),
+        (FindingKind::Undecided, "bvh2/balls4@1")
+    );
+    assert!(
+        f.message
+            .contains("past the threshold 5%): not decided: a side ran in one process")
+            && f.message.contains("--rounds 2 or more")
+            && f.message.contains("6 samples in A, 6 in B"),
+        "{}",
+        f.message
+    );
+    assert!(
+        c.to_markdown().contains("(1 undecided)"),
+        "{}",
+        c.to_markdown()
+    );
 }
 
 #[test]
 fn a_regression_needs_its_whole_interval_past_the_threshold() {
     let mut b = base();
     scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
-    let c = compare_sets(&base(), &b, 10.0);
+    let c = compare_rounds(&base(), &b, 10.0);
     assert!(c.is_regression(), "{}", c.to_markdown());
     let [lo, _] = c.regressions[0].interval_pct.unwrap();
     // The estimate is past 14.9% but the interval reaches back inside: no verdict, said so.
-    let c = compare_sets(&base(), &b, 14.9);
+    let c = compare_rounds(&base(), &b, 14.9);
     assert!(!c.is_regression());
     assert_eq!(c.undecided, 1);
     assert_eq!(c.notes[0].kind, FindingKind::Undecided);
     assert!(
         c.notes[0].message.contains("too few samples to decide")
-            && c.notes[0].message.contains("6 samples in A, 6 in B"),
+            && c.notes[0].message.contains("3 rounds in A, 3 in B"),
         "{}",
         c.notes[0].message
     );
     assert!(lo < 14.9);
     // Inside the threshold: nothing to say.
-    let c = compare_sets(&base(), &b, 15.1);
+    let c = compare_rounds(&base(), &b, 15.1);
     assert!(
         !c.is_regression() && c.notes.is_empty(),
         "{}",
         c.to_markdown()
     );
 
-    // A run whose own repeats are noisy (±10%) needs more to count: its interval is wider.
+    // A run whose rounds are noisy (±10%) needs more to count: its interval is wider.
     let mut a = base();
     find(&mut a, "bvh2/balls4@1").time_s.trace = samples(8.0, 0.2);
     let mut b = a.clone();
     scale_trace(find(&mut b, "bvh2/balls4@1"), 1.15);
-    let c = compare_sets(&a, &b, 5.0);
+    let c = compare_rounds(&a, &b, 5.0);
     assert!(!c.is_regression(), "{}", c.to_markdown());
     assert_eq!(c.undecided, 1);
     scale_trace(find(&mut b, "bvh2/balls4@1"), 1.5);
-    let c = compare_sets(&a, &b, 5.0);
+    let c = compare_rounds(&a, &b, 5.0);
     assert!(c.is_regression(), "{}", c.to_markdown());
 
     // One repeat a side has no spread to judge by: too few samples, never a guess.
@@ -158,7 +210,7 @@ fn a_regression_needs_its_whole_interval_past_the_threshold() {
 fn faster_relative_to_embree_is_an_improvement() {
     let mut b = base();
     scale_trace(find(&mut b, "grid/balls3@1"), 0.8);
-    let c = compare_sets(&base(), &b, 5.0);
+    let c = compare_rounds(&base(), &b, 5.0);
     assert!(!c.is_regression());
     assert_eq!(c.improvements.len(), 1);
     assert_eq!(c.improvements[0].key, "grid/balls3@1");
@@ -312,7 +364,7 @@ fn paired_ratios_are_compared_when_both_runs_have_them() {
     // ...while the pairs timed in one process say grid is as fast as before.
     pair(find(&mut a, "grid/balls3@1"), 0.5);
     pair(find(&mut b, "grid/balls3@1"), 0.5);
-    let c = compare_sets(&a, &b, 5.0);
+    let c = compare_rounds(&a, &b, 5.0);
     assert!(
         c.regressions
             .iter()
@@ -324,7 +376,7 @@ fn paired_ratios_are_compared_when_both_runs_have_them() {
     assert!(c.regressions.iter().any(|f| f.key == "bvh2/balls3@1"));
     // A 20% slower engine in its pairs is a regression.
     pair(find(&mut b, "grid/balls3@1"), 0.6);
-    let c = compare_sets(&a, &b, 5.0);
+    let c = compare_rounds(&a, &b, 5.0);
     let f = regression(&c, "grid/balls3@1");
     assert!((f.change_pct.unwrap() - 20.0).abs() < 0.5, "{f:?}");
 }
@@ -389,7 +441,7 @@ fn a_fallen_thread_speedup_is_a_regression() {
     scaling(find(&mut b, "grid/balls3@1"), 1.9);
     scaling(find(&mut a, "embree/balls3@1"), 1.8);
     scaling(find(&mut b, "embree/balls3@1"), 1.4);
-    let c = compare_sets(&a, &b, 5.0);
+    let c = compare_rounds(&a, &b, 5.0);
     let found: Vec<&str> = c
         .regressions
         .iter()
@@ -405,7 +457,7 @@ fn a_fallen_thread_speedup_is_a_regression() {
     assert!((f.change_pct.unwrap() + 22.2).abs() < 0.5, "{f:?}");
     // A risen speed-up is an improvement, not a regression.
     scaling(find(&mut b, "grid/balls3@1"), 2.0);
-    let c = compare_sets(&a, &b, 1.0);
+    let c = compare_rounds(&a, &b, 1.0);
     assert!(c
         .improvements
         .iter()
