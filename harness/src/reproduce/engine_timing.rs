@@ -3,8 +3,8 @@
 //! Shared by the tables that compare engines on the same rays (001's rendering experiments).
 
 use crate::error::Result;
-use crate::measure::repeat::Repeats;
-use crate::measure::span::Workers;
+use crate::measure::repeat::{self, Repeats};
+use crate::measure::span::{span, Workers};
 use crate::select::median;
 use crate::workload;
 use rtbench_engines::{BuildInput, Counters, Hit, Ray};
@@ -124,6 +124,51 @@ pub fn time_engines(
                 primitive_tests: counters.primitive_tests,
             },
         });
+    }
+    Ok(out)
+}
+
+/// Each of `overs` against `under` in pairs on the same rays (closest hit, the calling thread):
+/// the two traced back to back, which goes first alternating, at least `min` pairs and on until
+/// they span [`repeat::PAIR_SPAN_S`] (at most [`repeat::PAIR_CAP_FACTOR`] × `min`), after one
+/// untimed pass of each. Per `over`, each pair's CPU time of `over` ÷ `under`'s: a speed-up of
+/// `under` whose interval ([`rtbench_reports::interval::of_ratios`]) a burst of load on the
+/// machine touches on both sides, unlike the quotient of two separate medians.
+pub fn time_pairs(
+    overs: &[&Timee],
+    under: &Timee,
+    input: &BuildInput,
+    rays: &[Ray],
+    min: u32,
+    what: &str,
+) -> Result<Vec<Vec<f64>>> {
+    let build =
+        |&&(_, engine, kv): &&Timee| workload::build(engine, input, settings(kv)).map(|(e, _)| e);
+    let fast = build(&under)?;
+    let mut hits = vec![Hit::MISS; rays.len()];
+    let cpu = |e: &dyn rtbench_engines::Engine, hits: &mut [Hit]| {
+        let mut c = Counters::default();
+        span(Workers::Caller, || e.intersect(rays, hits, &mut c))
+            .1
+            .thread_cpu_s
+    };
+    cpu(fast.as_ref(), &mut hits);
+    let mut out = Vec::with_capacity(overs.len());
+    for over in overs {
+        eprintln!("{what}: {} over {} in pairs …", under.0, over.0);
+        let slow = build(over)?;
+        cpu(slow.as_ref(), &mut hits);
+        let ratios = repeat::pairs(min, u32::MAX, repeat::PAIR_SPAN_S, |i| -> Result<f64> {
+            let (a, b) = if i % 2 == 0 {
+                let a = cpu(slow.as_ref(), &mut hits);
+                (a, cpu(fast.as_ref(), &mut hits))
+            } else {
+                let b = cpu(fast.as_ref(), &mut hits);
+                (cpu(slow.as_ref(), &mut hits), b)
+            };
+            Ok(a / b.max(1e-12))
+        })?;
+        out.push(ratios);
     }
     Ok(out)
 }
