@@ -13,7 +13,10 @@
 //! all three (§3.5: "the base plate was excluded, the rest handled the same way"). One thread each:
 //! the thesis's machine had one processor, and the breadth-first engine runs on one. Times are medians
 //! of the repeats; preprocessing includes the scene's preparation (and for breadth-first the store's
-//! writing), not its generation.
+//! writing), not its generation. Each repeat runs the three one after another, so a ratio is the
+//! median of the repeats' own ratios, with its 95 % interval: a burst of load on the machine falls
+//! on both sides of a repeat's ratio, and the interval says how far the figure can be trusted
+//! against the thesis's printed bounds.
 
 use super::published::{self, Source};
 use super::{environment, Claim, Ctx, Fidelity, Kind, Output, Row, Runtime, Table, Verdict};
@@ -108,6 +111,9 @@ struct Timed {
 struct PhaseFigures {
     published: BTreeMap<&'static str, f64>,
     measured: BTreeMap<&'static str, f64>,
+    /// The 95 % intervals of the measured ratios (`bf/rss`, `bf/rss-r`), from two repeats on.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    intervals: BTreeMap<&'static str, [f64; 2]>,
 }
 
 #[derive(Serialize)]
@@ -222,10 +228,24 @@ fn measure(row: &PublishedRow, repeats: usize) -> Result<Measured> {
         runs[2].push(breadth_first_run(&prepared, floor)?);
     }
     let med = |c: usize, p: usize| median(&mut runs[c].iter().map(|t| t.s[p]).collect::<Vec<_>>());
+    // breadth-first over grid `c` in phase `p`: the median of the repeats' ratios and its interval
+    // (one repeat: its ratio, no interval).
+    let ratio = |c: usize, p: usize| -> (f64, Option<[f64; 2]>) {
+        let r: Vec<f64> = runs[2].iter().zip(&runs[c]).map(|(b, g)| b.s[p] / g.s[p]).collect();
+        match rtbench_reports::interval::of_ratios(&r) {
+            Some(i) => (i.estimate, Some([i.lo, i.hi])),
+            None => (r[0], None),
+        }
+    };
     let mut phases = BTreeMap::new();
     for (p, phase) in PHASES.iter().enumerate() {
         let pubv = row.phases[*phase];
         let m = [med(0, p), med(1, p), med(2, p)];
+        let (over_rss, over_rss_r) = (ratio(0, p), ratio(1, p));
+        let intervals = [("bf/rss", over_rss.1), ("bf/rss-r", over_rss_r.1)]
+            .into_iter()
+            .filter_map(|(k, i)| Some((k, i?)))
+            .collect();
         phases.insert(
             *phase,
             PhaseFigures {
@@ -240,9 +260,10 @@ fn measure(row: &PublishedRow, repeats: usize) -> Result<Measured> {
                     ("rss", m[0]),
                     ("rss-r", m[1]),
                     ("breadth-first", m[2]),
-                    ("bf/rss", m[2] / m[0]),
-                    ("bf/rss-r", m[2] / m[1]),
+                    ("bf/rss", over_rss.0),
+                    ("bf/rss-r", over_rss_r.0),
                 ]),
+                intervals,
             },
         );
     }
@@ -267,7 +288,7 @@ fn measure(row: &PublishedRow, repeats: usize) -> Result<Measured> {
 
 fn run(ctx: &Ctx) -> Result<Output> {
     let (p, raw): (Published, _) = published::load(ctx.id, PUBLISHED);
-    let repeats = if ctx.quick { 1 } else { 3 };
+    let repeats = if ctx.quick { 1 } else { 5 };
     let measured = p
         .rows
         .iter()
@@ -305,6 +326,21 @@ fn count_reason(scene: &str) -> &'static str {
 fn in_printed_range(v: f64, lo: f64, hi: f64) -> bool {
     let printed = (v * 100.0).round() / 100.0;
     (lo..=hi).contains(&printed)
+}
+
+/// Where a measured ratio lies against the printed range (its estimate decides, as printed to two
+/// places), and whether its 95 % interval reaches past a bound.
+fn side_of(v: f64, interval: Option<&[f64; 2]>, lo: f64, hi: f64) -> &'static str {
+    let inside = in_printed_range(v, lo, hi);
+    let across = interval.is_some_and(|&[a, b]| if inside { a < lo || b > hi } else { b >= lo && a <= hi });
+    match (inside, v < lo, across) {
+        (true, _, false) => "inside",
+        (true, _, true) => "inside (its interval reaches past a bound)",
+        (false, true, false) => "below the range",
+        (false, true, true) => "below the range (its interval reaches into it)",
+        (false, false, false) => "above the range",
+        (false, false, true) => "above the range (its interval reaches into it)",
+    }
 }
 
 /// Per scene: the test-count premise, the overall overhead (goal: smaller than the thesis's),
@@ -360,21 +396,15 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
             let key_p = format!("sray/{against}");
             let key_m = format!("bf/{against}");
             let (pv, mv) = (f.published[key_p.as_str()], f.measured[key_m.as_str()]);
-            let side = if in_printed_range(mv, lo, hi) {
-                "inside"
-            } else if mv < lo {
-                "below the range"
-            } else if mv > hi {
-                "above the range"
-            } else {
-                "inside"
-            };
+            let interval = f.intervals.get(key_m.as_str());
+            let side = side_of(mv, interval, lo, hi);
+            let shown = format!("{key_m} {}", ratio_text(mv, interval));
             rows.push(
                 Row::new(
                     claim,
                     &subject,
                     format!("{key_p} {pv:.2} (range {lo}-{hi})"),
-                    format!("{key_m} {mv:.2}"),
+                    shown,
                     Kind::Range,
                     Verdict::of(in_printed_range(mv, lo, hi)),
                 )
@@ -385,10 +415,18 @@ fn rows(p: &Published, measured: &[Measured]) -> Vec<Row> {
     rows
 }
 
+/// A measured ratio with its interval where it has one.
+fn ratio_text(v: f64, interval: Option<&[f64; 2]>) -> String {
+    match interval {
+        Some([a, b]) => format!("{v:.2} [{a:.2}, {b:.2}]"),
+        None => format!("{v:.2}"),
+    }
+}
+
 fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -> Document {
     let mut doc = Document::new("nakamaru-3.1: breadth-first vs Rayshade-style grid on small data");
     doc.paragraph(format!(
-        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-3.1{}`, one thread, 512×512, median of {repeats}; `rss`/`rss-r` = `grid` presets, `bf` = `breadth-first` with layout=basic (sray's one file read whole per sweep and in shading), registration fixed:1, grids sized on objects, out of core (store, spilled generations, shading in object order). Seconds; ratios are what compare.",
+        "Published: {} (machine: {}). Measured: `rtbench reproduce nakamaru-3.1{}`, one thread, 512×512, median of {repeats} (bf/rss and bf/rss-r: the median of the repeats' ratios, each repeat running the three one after another, with its 95 % interval); `rss`/`rss-r` = `grid` presets, `bf` = `breadth-first` with layout=basic (sray's one file read whole per sweep and in shading), registration fixed:1, grids sized on objects, out of core (store, spilled generations, shading in object order). Seconds; ratios are what compare.",
         p.source.cite(),
         p.source.machine.as_deref().unwrap_or(""),
         if quick { " --quick (tetra6 only, 1 repeat)" } else { "" },
@@ -409,8 +447,8 @@ fn document(p: &Published, measured: &[Measured], quick: bool, repeats: usize) -
                 format!("{:.3}", mv["rss"]),
                 format!("{:.3}", mv["rss-r"]),
                 format!("{:.3}", mv["breadth-first"]),
-                format!("{:.2}", mv["bf/rss"]),
-                format!("{:.2}", mv["bf/rss-r"]),
+                ratio_text(mv["bf/rss"], f.intervals.get("bf/rss")),
+                ratio_text(mv["bf/rss-r"], f.intervals.get("bf/rss-r")),
             ]);
         }
     }
@@ -455,7 +493,7 @@ mod tests {
                         let [rss, rss_r, sray] = r.phases[ph];
                         let published = BTreeMap::from([("sray/rss", sray / rss), ("sray/rss-r", sray / rss_r)]);
                         let measured = BTreeMap::from([("bf/rss", sray / rss), ("bf/rss-r", sray / rss_r)]);
-                        (ph, PhaseFigures { published, measured })
+                        (ph, PhaseFigures { published, measured, intervals: BTreeMap::new() })
                     })
                     .collect();
                 Measured {
@@ -476,5 +514,17 @@ mod tests {
             assert_ne!(r.verdict, Verdict::Fails, "{} {}: {} vs {}", r.claim, r.subject, r.published, r.measured);
         }
         assert_eq!(rows.iter().filter(|r| r.kind == Kind::Range).count(), 24);
+    }
+
+    /// The estimate decides against the printed range; an interval across a bound is said.
+    #[test]
+    fn a_ratio_says_when_its_interval_crosses_a_bound() {
+        assert_eq!(side_of(1.5, None, 0.95, 1.87), "inside");
+        assert_eq!(side_of(1.5, Some(&[1.4, 1.6]), 0.95, 1.87), "inside");
+        assert_eq!(side_of(1.85, Some(&[1.8, 1.9]), 0.95, 1.87), "inside (its interval reaches past a bound)");
+        assert_eq!(side_of(2.51, Some(&[2.4, 2.6]), 0.95, 1.87), "above the range");
+        assert_eq!(side_of(1.9, Some(&[1.8, 2.0]), 0.95, 1.87), "above the range (its interval reaches into it)");
+        assert_eq!(side_of(0.9, Some(&[0.85, 0.96]), 0.95, 1.87), "below the range (its interval reaches into it)");
+        assert_eq!(ratio_text(2.514, Some(&[2.4, 2.6])), "2.51 [2.40, 2.60]");
     }
 }
