@@ -47,6 +47,36 @@ pub struct Claim {
     pub why: &'static str,
 }
 
+/// Where a measured figure lies against a published range `[lo, hi]`, by `names` (below, inside,
+/// above), with a word on its 95 % interval when it reaches across the bound the verdict turns
+/// on. Whether the figure is `inside` is the caller's to say (a check may round as the source
+/// printed); the verdict rests on it, the note says how far to trust it.
+pub fn range_note(
+    inside: bool,
+    v: f64,
+    interval: Option<[f64; 2]>,
+    (lo, hi): (f64, f64),
+    names: [&str; 3],
+) -> String {
+    let across = interval.is_some_and(|[a, b]| {
+        if inside {
+            a < lo || b > hi
+        } else {
+            b >= lo && a <= hi
+        }
+    });
+    let name = match (inside, v < lo) {
+        (true, _) => names[1],
+        (false, true) => names[0],
+        (false, false) => names[2],
+    };
+    match (across, inside) {
+        (false, _) => name.to_string(),
+        (true, true) => format!("{name} (its interval reaches past a bound)"),
+        (true, false) => format!("{name} (its interval reaches into it)"),
+    }
+}
+
 /// How a published figure is compared with a measured one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]

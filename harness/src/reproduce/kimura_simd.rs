@@ -137,7 +137,7 @@ struct Speedup {
     pairs: usize,
     published_min: f64,
     published_max: f64,
-    compares: &'static str,
+    compares: String,
 }
 
 #[derive(Serialize)]
@@ -310,16 +310,9 @@ const PAIRS: u32 = 9;
 
 /// Whether a speed-up lies in 001's range: its estimate, and whether its 95 % interval `[a, b]`
 /// reaches past a bound (then the verdict rests on the estimate alone, and says so).
-fn in_range(s: f64, [a, b]: [f64; 2], lo: f64, hi: f64) -> &'static str {
-    if s < lo {
-        if b >= lo { "below 001's range (its interval reaches into it)" } else { "below 001's range" }
-    } else if s > hi {
-        if a <= hi { "above 001's range (its interval reaches into it)" } else { "above 001's range" }
-    } else if a < lo || b > hi {
-        "within 001's range (its interval reaches past a bound)"
-    } else {
-        "within 001's range"
-    }
+fn in_range(s: f64, interval: [f64; 2], lo: f64, hi: f64) -> String {
+    let names = ["below 001's range", "within 001's range", "above 001's range"];
+    super::claims::range_note((lo..=hi).contains(&s), s, Some(interval), (lo, hi), names)
 }
 
 /// bvh4 SIMD over each scalar baseline, per scene, from the pairs' ratios `(scene, over,
@@ -411,7 +404,7 @@ fn document(p: &Published, measured: &[Timed], speedups: &[Speedup], defaults: &
     doc.paragraph(format!("Speed-ups: the baseline and bvh4 SIMD traced back to back in pairs in this process (which goes first alternating; at least {PAIRS} pairs, more for fast traces, over two seconds), each pair's CPU-time ratio; the figure is the pairs' median with its 95 % interval. A check holds when the figure lies in 001's range, and says so when its interval reaches past a bound."));
     let mut s = DocTable::new("", &["scene", "bvh4 SIMD over", "speed-up (CPU time) [95 % CI]", "pairs", "001", "how it compares"]);
     for x in speedups {
-        s.push(vec![x.scene.clone(), x.over.into(), format!("{:.2} [{:.2}, {:.2}]", x.speedup, x.interval[0], x.interval[1]), x.pairs.to_string(), format!("{lo}-{hi}"), x.compares.into()]);
+        s.push(vec![x.scene.clone(), x.over.into(), format!("{:.2} [{:.2}, {:.2}]", x.speedup, x.interval[0], x.interval[1]), x.pairs.to_string(), format!("{lo}-{hi}"), x.compares.clone()]);
     }
     doc.table(s);
     doc.heading("The engines at their defaults, same rays (our engines' goals, not 001's claims)");

@@ -330,17 +330,9 @@ fn in_printed_range(v: f64, lo: f64, hi: f64) -> bool {
 
 /// Where a measured ratio lies against the printed range (its estimate decides, as printed to two
 /// places), and whether its 95 % interval reaches past a bound.
-fn side_of(v: f64, interval: Option<&[f64; 2]>, lo: f64, hi: f64) -> &'static str {
-    let inside = in_printed_range(v, lo, hi);
-    let across = interval.is_some_and(|&[a, b]| if inside { a < lo || b > hi } else { b >= lo && a <= hi });
-    match (inside, v < lo, across) {
-        (true, _, false) => "inside",
-        (true, _, true) => "inside (its interval reaches past a bound)",
-        (false, true, false) => "below the range",
-        (false, true, true) => "below the range (its interval reaches into it)",
-        (false, false, false) => "above the range",
-        (false, false, true) => "above the range (its interval reaches into it)",
-    }
+fn side_of(v: f64, interval: Option<&[f64; 2]>, lo: f64, hi: f64) -> String {
+    let names = ["below the range", "inside", "above the range"];
+    super::claims::range_note(in_printed_range(v, lo, hi), v, interval.copied(), (lo, hi), names)
 }
 
 /// Per scene: the test-count premise, the overall overhead (goal: smaller than the thesis's),
