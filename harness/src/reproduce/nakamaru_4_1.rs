@@ -67,7 +67,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "sg-ratio",
             fidelity: Fidelity::Substituted,
-            why: "settings that are ours: the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); our record format (f32, prepared primitives, checksums) makes balls' and gears' split stores 1.75x and 1.59x the thesis's sizes (the other scenes' within 13%); floor and backdrop polygons are tested apart from the grid in every scene (the thesis's Ch. 3 grouping did so for balls and tree only); the machine (a 2-core Xeon reading its disk cold, page cache dropped by posix_fadvise, 256 MiB engine budget) is stated, not the reason; time ratios only",
+            why: "settings that are ours: the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); our record format (f32, prepared primitives, checksums) makes balls' and gears' split stores 1.75x and 1.59x the thesis's sizes (the other scenes' within 13%); floor and backdrop polygons are tested apart from the grid in every scene (the thesis's Ch. 3 grouping did so for balls and tree only); the machine the record names (its disk read cold, page cache dropped by posix_fadvise, 256 MiB engine budget) is stated, not the reason; time ratios only",
         },
         Claim {
             key: "sgb-ratio",

@@ -64,7 +64,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "two-level-ratio",
             fidelity: Fidelity::Substituted,
-            why: "settings the thesis does not give, chosen by us: the pool of lower grids (1/16 of the 256 MiB budget), the rays per pass (the same for all three grids), the grid's shape by our reading of Klimaszewski's method (its formula is not in the thesis), and the single-level grid as the basic method's in-memory grid capped at 128 (our reading of the thesis's \"-l\"), so the two-level runs' on-disk grid and block traversal (§4.3.1-4.3.2) count in the overhead too and their passes may differ at equal rays per pass; the machine (a 2-core Xeon reading its disk cold, page cache dropped by posix_fadvise) is stated, not the reason; --quick rows are smaller scenes with the cap scaled to 32",
+            why: "settings the thesis does not give, chosen by us: the pool of lower grids (1/16 of the 256 MiB budget), the rays per pass (the same for all three grids), the grid's shape by our reading of Klimaszewski's method (its formula is not in the thesis), and the single-level grid as the basic method's in-memory grid capped at 128 (our reading of the thesis's \"-l\"), so the two-level runs' on-disk grid and block traversal (§4.3.1-4.3.2) count in the overhead too and their passes may differ at equal rays per pass; the machine the record names (its disk read cold, page cache dropped by posix_fadvise) is stated, not the reason; --quick rows are smaller scenes with the cap scaled to 32",
         },
         Claim {
             key: "overhead",

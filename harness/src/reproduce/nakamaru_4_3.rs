@@ -135,7 +135,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "sgb-ratio",
             fidelity: Fidelity::Substituted,
-            why: "both stores are zstd-compressed (level 3; the thesis's Table 4.3 stores were not compressed, ours must be to fit this disk: uncompressed, mount14's and rings368's split stores take ~55 and ~102 GB), one codec for all three methods; the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); the machine (a 2-core Xeon reading its disk cold, page cache dropped by posix_fadvise, 256 MiB engine budget) is stated, not the reason; a row whose basic time is extrapolated is a model",
+            why: "both stores are zstd-compressed (level 3; the thesis's Table 4.3 stores were not compressed, ours must be to fit this disk: uncompressed, mount14's and rings368's split stores take ~55 and ~102 GB), one codec for all three methods; the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); the machine the record names (its disk read cold, page cache dropped by posix_fadvise, 256 MiB engine budget) is stated, not the reason; a row whose basic time is extrapolated is a model",
         },
         Claim {
             key: "sg-ratio",
@@ -150,7 +150,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "per-ray-growth-thesis",
             fidelity: Fidelity::Substituted,
-            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; substituted as sgb-ratio is (zstd stores, our reading of Klimaszewski's method); each growth is a ratio within one machine (ours a 2-core Xeon, the thesis's a Pentium II 450 MHz with 256 MB)",
+            why: "ours beside the thesis's own S+G+B growth between the same rows (its time = basic time ÷ S+G+B ratio, Table 4.1 for the row near 10^6 objects, Table 4.3 for the 10^9 row; the same SPD workload at 512²), judged within 2× either way; substituted as sgb-ratio is (zstd stores, our reading of Klimaszewski's method); each growth is a ratio within one machine (ours the one the record names, the thesis's a Pentium II 450 MHz with 256 MB)",
         },
         Claim {
             key: "view",

@@ -68,7 +68,7 @@ pub const TABLE: Table = Table {
         Claim {
             key: "growth",
             fidelity: Fidelity::Substituted,
-            why: "the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); the figures' points are lost, so their text is judged by slopes of our curves; the machine (a 2-core Xeon, shared, reading its disk cold) is stated, not the reason; --quick uses small scenes with the cap scaled to 16",
+            why: "the grid's shape is our reading of Klimaszewski's method (its formula is not in the thesis); the figures' points are lost, so their text is judged by slopes of our curves; the machine the record names (its disk read cold) is stated, not the reason; --quick uses small scenes with the cap scaled to 16",
         },
         Claim {
             key: "image-equal",
