@@ -772,57 +772,45 @@ fn judge(ra: &RunRecord, j: Judged, c: &mut Comparison) {
         samples: Some(j.samples),
         message: String::new(),
     };
-    match verdict {
-        Some(_) if j.one_process => {
-            c.undecided += 1;
-            f.kind = FindingKind::Undecided;
-            f.message = format!(
-                "{}: {} {} → {} ({}%; {interval_text}, past the threshold {}%): not decided: a side ran in one process, whose samples cannot show how far two processes of one build differ; run both with --rounds 2 or more, and as many repeats ({n_text})",
-                ra.key,
-                j.what,
-                number::ratio(j.old),
-                number::ratio(j.new),
-                signed(est),
-                number::short(thr, 3)
-            );
-            c.notes.push(f);
-        }
-        Some(regressed) => {
-            let word = match (j.higher_is_worse, est > 0.0) {
-                (true, true) => "slower relative to Embree",
-                (true, false) => "faster relative to Embree",
-                (false, true) => "rose",
-                (false, false) => "fell",
-            };
-            f.message = format!(
-                "{}: {} {} → {} ({}% {word}; {interval_text}, beyond the threshold {}%; {n_text})",
-                ra.key,
-                j.what,
-                number::ratio(j.old),
-                number::ratio(j.new),
-                signed(est),
-                number::short(thr, 3)
-            );
-            if regressed {
-                c.regressions.push(f);
-            } else {
-                c.improvements.push(f);
-            }
-        }
-        None if est.abs() > thr => {
-            c.undecided += 1;
-            f.kind = FindingKind::Undecided;
-            f.message = format!(
-                "{}: {} {} → {} ({}%; {interval_text} reaches inside the threshold {}%): too few samples to decide ({n_text})",
-                ra.key,
-                j.what,
-                number::ratio(j.old),
-                number::ratio(j.new),
-                signed(est),
-                number::short(thr, 3)
-            );
-            c.notes.push(f);
-        }
-        None => {}
+    let head = format!(
+        "{}: {} {} → {}",
+        ra.key,
+        j.what,
+        number::ratio(j.old),
+        number::ratio(j.new)
+    );
+    let (est_text, thr_text) = (signed(est), number::short(thr, 3));
+    let undecided = match verdict {
+        Some(_) if j.one_process => Some(format!(
+            "{head} ({est_text}%; {interval_text}, past the threshold {thr_text}%): not decided: a side ran in one process, whose samples cannot show how far two processes of one build differ; run both with --rounds 2 or more, and as many repeats ({n_text})"
+        )),
+        None if est.abs() > thr => Some(format!(
+            "{head} ({est_text}%; {interval_text} reaches inside the threshold {thr_text}%): too few samples to decide ({n_text})"
+        )),
+        _ => None,
+    };
+    if let Some(message) = undecided {
+        c.undecided += 1;
+        f.kind = FindingKind::Undecided;
+        f.message = message;
+        c.notes.push(f);
+        return;
+    }
+    let Some(regressed) = verdict else {
+        return;
+    };
+    let word = match (j.higher_is_worse, est > 0.0) {
+        (true, true) => "slower relative to Embree",
+        (true, false) => "faster relative to Embree",
+        (false, true) => "rose",
+        (false, false) => "fell",
+    };
+    f.message = format!(
+        "{head} ({est_text}% {word}; {interval_text}, beyond the threshold {thr_text}%; {n_text})"
+    );
+    if regressed {
+        c.regressions.push(f);
+    } else {
+        c.improvements.push(f);
     }
 }
