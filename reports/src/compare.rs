@@ -16,8 +16,8 @@
 //!   "too few samples to decide", and so is a run with fewer than two samples on a side. Sets of one
 //!   process a run (`run --rounds 1`, `sweep`) decide no change of time either way: their
 //!   intervals are of one process's samples, which cannot show the few percent by which two
-//!   processes of one build differ (two such runs of one commit at 8² "regressed" by 11 %, interval
-//!   [+6.9 %, +15.6 %]), so a change past the threshold is reported as undecided, with the rounds
+//!   processes of one build differ (two such runs of one commit at 8² "regressed" by 11.9 %, interval
+//!   [+8.9 %, +15 %]), so a change past the threshold is reported as undecided, with the rounds
 //!   it needs. Embree's own times are the yardstick (ratio 1) and are not compared; its counters are;
 //! - where both sets timed a run's speed-up over one thread in pairs (`run --paired-threads N`), the
 //!   speed-up's change is judged the same way on its pairs (Embree's too: it measures how the harness
